@@ -1,0 +1,218 @@
+//! Progressive stream → mesh, one refinement batch at a time.
+
+mod conquest;
+
+use crate::base_mesh;
+use crate::format::{ChunkHeader, Header, Reader, BASE_TAG, BATCH_TAG};
+use crate::halfedge::Connectivity;
+use crate::quantize::Quantization;
+use crate::{Error, IndexedMesh, Result};
+use conquest::{PassInput, PassKind, Scratch};
+
+/// Budget a decoder enforces before it allocates or grows anything.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Limits {
+    pub max_vertices: u32,
+    pub max_faces: u32,
+    pub max_batches: u32,
+}
+
+impl Default for Limits {
+    fn default() -> Self {
+        Limits { max_vertices: 50_000_000, max_faces: 100_000_000, max_batches: 1024 }
+    }
+}
+
+/// The mesh at the current level, kept as GPU-ready buffers.
+pub(crate) struct Level {
+    pub conn: Connectivity,
+    pub quantization: Quantization,
+    pub positions_q: Vec<[i32; 3]>,
+    pub positions: Vec<[f32; 3]>,
+    pub colours: Option<Vec<[u8; 3]>>,
+}
+
+impl Level {
+    pub(crate) fn vertex_count(&self) -> usize {
+        self.positions_q.len()
+    }
+
+    pub(crate) fn push_vertex(&mut self, q: [i32; 3], colour: Option<[u8; 3]>) -> u32 {
+        let v = self.positions_q.len() as u32;
+        self.positions_q.push(q);
+        self.positions.push(self.quantization.dequantize(q));
+        if let (Some(colours), Some(c)) = (&mut self.colours, colour) {
+            colours.push(c);
+        }
+        self.conn.out.push(crate::halfedge::NONE);
+        v
+    }
+}
+
+/// Decodes a stream level by level.
+///
+/// ```
+/// # fn demo(stream: &[u8]) -> vitrine_codec::Result<()> {
+/// use vitrine_codec::{Decoder, Limits, StreamIndex};
+/// let index = StreamIndex::parse(stream)?;
+/// let mut decoder = Decoder::new(&stream[index.base.clone()], Limits::default())?;
+/// for batch in &index.batches {
+///     decoder.apply_batch(&stream[batch.clone()])?;
+///     let (_positions, _indices) = (decoder.positions(), decoder.indices());
+/// }
+/// # Ok(()) }
+/// ```
+/// After an error the decoder's buffers are unspecified: drop it.
+pub struct Decoder {
+    header: Header,
+    level: Level,
+    applied: usize,
+    limits: Limits,
+    scratch: Scratch,
+}
+
+impl Decoder {
+    /// `prefix` is the header followed by the base chunk.
+    pub fn new(prefix: &[u8], limits: Limits) -> Result<Decoder> {
+        let header = Header::parse(prefix)?;
+        if header.batch_count() > limits.max_batches as usize {
+            return Err(Error::Limit(format!("{} batches exceed the limit of {}", header.batch_count(), limits.max_batches)));
+        }
+        let last = header.final_level();
+        if last.vertices > limits.max_vertices || last.faces > limits.max_faces {
+            return Err(Error::Limit(format!(
+                "stream has {} vertices and {} faces, limits are {} and {}",
+                last.vertices, last.faces, limits.max_vertices, limits.max_faces
+            )));
+        }
+        let (chunk, payload) = ChunkHeader::parse(&prefix[header.byte_len()..], BASE_TAG)?;
+        let base = header.levels[0];
+        if chunk.vertices_after != base.vertices || chunk.faces_after != base.faces {
+            return Err(Error::stream("base chunk disagrees with the level table"));
+        }
+        let q = header.quantization;
+        let mesh = base_mesh::decode(payload, base.vertices, base.faces, header.has_colour, q.max_value())?;
+        let conn = Connectivity::from_triangles(mesh.positions.len(), &mesh.triangles)
+            .map_err(|e| Error::stream(format!("base mesh is not a manifold: {e}")))?;
+        let positions = mesh.positions.iter().map(|&p| q.dequantize(p)).collect();
+        let level = Level { conn, quantization: q, positions_q: mesh.positions, positions, colours: mesh.colours };
+        Ok(Decoder { header, level, applied: 0, limits, scratch: Scratch::default() })
+    }
+
+    pub fn header(&self) -> &Header {
+        &self.header
+    }
+
+    /// Number of batches applied so far (0 = base mesh).
+    pub fn level(&self) -> usize {
+        self.applied
+    }
+
+    pub fn is_complete(&self) -> bool {
+        self.applied == self.header.batch_count()
+    }
+
+    /// Applies the next refinement batch (a chunk as listed by [`crate::StreamIndex`]).
+    pub fn apply_batch(&mut self, chunk_bytes: &[u8]) -> Result<()> {
+        let (chunk, payload) = ChunkHeader::parse(chunk_bytes, BATCH_TAG)?;
+        let expected = self.applied + 1;
+        if chunk.level as usize != expected || expected > self.header.batch_count() {
+            return Err(Error::stream(format!("batch for level {} applied at level {}", chunk.level, self.applied)));
+        }
+        let info = self.header.levels[expected];
+        let n = self.level.vertex_count() as u32;
+        if chunk.vertices_before != n || chunk.vertices_after != info.vertices || chunk.faces_after != info.faces {
+            return Err(Error::stream("batch counts disagree with the level table"));
+        }
+        if info.vertices > self.limits.max_vertices || info.faces > self.limits.max_faces {
+            return Err(Error::Limit("batch exceeds the vertex or face limit".into()));
+        }
+        let mut r = Reader::new(payload);
+        let cleaning = read_pass(&mut r, PassKind::Cleaning)?;
+        let decimating = read_pass(&mut r, PassKind::Decimating)?;
+        if r.remaining() != 0 {
+            return Err(Error::stream("trailing bytes after the batch's passes"));
+        }
+        let added = cleaning.inserted as u64 + decimating.inserted as u64;
+        if added != (info.vertices - n) as u64 {
+            return Err(Error::stream("passes insert a different number of vertices than the batch"));
+        }
+        let grow = added as usize;
+        self.level.positions_q.reserve(grow);
+        self.level.positions.reserve(grow);
+        self.level.conn.origin.reserve(6 * grow);
+        self.level.conn.twin.reserve(6 * grow);
+        self.level.undo_pass(&cleaning, &mut self.scratch)?;
+        self.level.undo_pass(&decimating, &mut self.scratch)?;
+        self.applied = expected;
+        Ok(())
+    }
+
+    /// Positions as `x, y, z` per vertex, in model units.
+    pub fn positions(&self) -> &[f32] {
+        self.level.positions.as_flattened()
+    }
+
+    /// sRGB colours as `r, g, b` per vertex, when the stream has colour.
+    pub fn colours(&self) -> Option<&[u8]> {
+        self.level.colours.as_ref().map(|c| c.as_flattened())
+    }
+
+    /// Triangle list, three indices per face, counter-clockwise.
+    pub fn indices(&self) -> &[u32] {
+        &self.level.conn.origin
+    }
+
+    /// Quantized positions: exactly the encoder's input at this quantization.
+    pub fn quantized_positions(&self) -> &[[i32; 3]] {
+        &self.level.positions_q
+    }
+
+    pub fn vertex_count(&self) -> usize {
+        self.level.vertex_count()
+    }
+
+    pub fn face_count(&self) -> usize {
+        self.level.conn.origin.len() / 3
+    }
+
+    /// The current level as an indexed mesh (dequantized positions).
+    pub fn to_mesh(&self) -> IndexedMesh {
+        IndexedMesh {
+            positions: self.level.positions.clone(),
+            colors: self.level.colours.clone(),
+            triangles: self.level.conn.origin.chunks_exact(3).map(|t| [t[0], t[1], t[2]]).collect(),
+        }
+    }
+}
+
+fn read_pass<'a>(r: &mut Reader<'a>, kind: PassKind) -> Result<PassInput<'a>> {
+    let count = r.varint()? as usize;
+    // Each seed takes at least two bytes: never trust the count beyond that.
+    if count > r.remaining() / 2 {
+        return Err(Error::stream("pass declares more seeds than it has bytes"));
+    }
+    let mut seeds = Vec::with_capacity(count);
+    for _ in 0..count {
+        seeds.push([r.varint()?, r.varint()?]);
+    }
+    Ok(PassInput {
+        kind,
+        seeds,
+        inserted: r.varint()?,
+        connectivity: r.section()?,
+        geometry: r.section()?,
+        colour: r.section()?,
+    })
+}
+
+/// Decodes a whole stream up to `max_level` batches (all when `None`).
+pub fn decode(bytes: &[u8], max_level: Option<usize>, limits: Limits) -> Result<Decoder> {
+    let index = crate::StreamIndex::parse(bytes)?;
+    let mut decoder = Decoder::new(&bytes[index.base.clone()], limits)?;
+    let n = max_level.unwrap_or(usize::MAX).min(index.batches.len());
+    for range in &index.batches[..n] {
+        decoder.apply_batch(&bytes[range.clone()])?;
+    }
+    Ok(decoder)
+}

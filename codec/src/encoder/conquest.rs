@@ -1,0 +1,319 @@
+//! The encoder's conquests (AD01 §3): decimating and cleaning passes over
+//! the mesh, removing vertices patch by patch and emitting one code per gate.
+
+use std::collections::VecDeque;
+
+use crate::entropy::RangeEncoder;
+use crate::halfedge::{face, next, prev, Connectivity, NONE};
+use crate::patch::{pattern, Pattern, Tag, MAX_VALENCE, NO_TWIN};
+use crate::predict::{encode_colour, gate_context, predict_colour, PassModels, PatchPrediction};
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum PassKind {
+    /// Removes free vertices of valence 3–6.
+    Decimating,
+    /// Removes the valence-3 vertices decimation leaves behind.
+    Cleaning,
+}
+
+const FREE: u8 = 0;
+const CONQUERED: u8 = 1;
+const REMOVED: u8 = 2;
+
+/// What one pass produced, before vertex ids are final.
+pub(crate) struct PassOutput {
+    /// Seed gates as input-vertex pairs, one per connected component.
+    pub seeds: Vec<[u32; 2]>,
+    /// Removed input vertices, in the order the decoder will insert them.
+    pub removed: Vec<u32>,
+    pub connectivity: Vec<u8>,
+    pub geometry: Vec<u8>,
+    pub colour: Vec<u8>,
+}
+
+/// The mesh being simplified, with input-vertex ids throughout.
+pub(crate) struct Simplifier {
+    pub conn: Connectivity,
+    pub positions: Vec<[i32; 3]>,
+    pub colours: Option<Vec<[u8; 3]>>,
+    pub geometric_guard: bool,
+    pub live_vertices: usize,
+    pub live_faces: usize,
+    free_slots: Vec<u32>,
+    state: Vec<u8>,
+    tag: Vec<Tag>,
+    face_done: Vec<bool>,
+}
+
+/// A removable vertex and the patch around it.
+struct Patch {
+    valence: usize,
+    centre: u32,
+    /// Outgoing half-edges of the centre, the first towards the gate's origin.
+    ring: [u32; MAX_VALENCE],
+    polygon: [u32; MAX_VALENCE],
+    pattern: &'static Pattern,
+}
+
+struct Streams {
+    conn: RangeEncoder,
+    geom: RangeEncoder,
+    colour: RangeEncoder,
+    models: PassModels,
+}
+
+impl Simplifier {
+    pub(crate) fn new(
+        conn: Connectivity,
+        positions: Vec<[i32; 3]>,
+        colours: Option<Vec<[u8; 3]>>,
+        geometric_guard: bool,
+    ) -> Self {
+        let n = positions.len();
+        let live_faces = conn.face_count_slots();
+        Simplifier {
+            conn,
+            positions,
+            colours,
+            geometric_guard,
+            live_vertices: n,
+            live_faces,
+            free_slots: Vec::new(),
+            state: vec![FREE; n],
+            tag: vec![Tag::None; n],
+            face_done: Vec::new(),
+        }
+    }
+
+    pub(crate) fn run_pass(&mut self, kind: PassKind) -> PassOutput {
+        for (v, s) in self.state.iter_mut().enumerate() {
+            *s = if self.conn.out[v] == NONE { REMOVED } else { FREE };
+        }
+        self.tag.fill(Tag::None);
+        self.face_done.clear();
+        self.face_done.resize(self.conn.face_count_slots(), false);
+        let mut streams = Streams {
+            conn: RangeEncoder::new(),
+            geom: RangeEncoder::new(),
+            colour: RangeEncoder::new(),
+            models: PassModels::new(),
+        };
+        let mut out = PassOutput {
+            seeds: Vec::new(),
+            removed: Vec::new(),
+            connectivity: Vec::new(),
+            geometry: Vec::new(),
+            colour: Vec::new(),
+        };
+        let mut gates = VecDeque::new();
+        for f in 0..self.conn.face_count_slots() as u32 {
+            if !self.conn.face_alive(f) || self.face_done[f as usize] {
+                continue;
+            }
+            // A new connected component: its seed gate is the face's first edge.
+            let h = 3 * f;
+            let (a, b) = (self.conn.origin[h as usize], self.conn.target(h));
+            self.conquer(a, Tag::Plus);
+            self.conquer(b, Tag::Minus);
+            out.seeds.push([a, b]);
+            gates.push_back(h);
+            while let Some(g) = gates.pop_front() {
+                self.process_gate(g, kind, &mut gates, &mut streams, &mut out.removed);
+            }
+        }
+        out.connectivity = streams.conn.finish();
+        out.geometry = streams.geom.finish();
+        out.colour = streams.colour.finish();
+        out
+    }
+
+    fn conquer(&mut self, v: u32, tag: Tag) {
+        if self.state[v as usize] == FREE {
+            self.state[v as usize] = CONQUERED;
+        }
+        if self.tag[v as usize] == Tag::None {
+            self.tag[v as usize] = tag;
+        }
+    }
+
+    fn process_gate(
+        &mut self,
+        g: u32,
+        kind: PassKind,
+        gates: &mut VecDeque<u32>,
+        s: &mut Streams,
+        removed: &mut Vec<u32>,
+    ) {
+        let f = face(g);
+        if !self.conn.face_alive(f) || self.face_done[f as usize] {
+            return;
+        }
+        let t0 = self.tag[self.conn.origin[g as usize] as usize];
+        let t1 = self.tag[self.conn.target(g) as usize];
+        let ctx = gate_context(t0, t1);
+        if let Some(patch) = self.removable(g, kind, t0, t1) {
+            match kind {
+                PassKind::Decimating => s.conn.encode_symbol(&mut s.models.valence[ctx], patch.valence - 2),
+                PassKind::Cleaning => s.conn.encode_bit(&mut s.models.cleaning[ctx], true),
+            }
+            self.encode_vertex(&patch, s);
+            removed.push(patch.centre);
+            self.remove(&patch, gates);
+        } else {
+            match kind {
+                PassKind::Decimating => s.conn.encode_symbol(&mut s.models.valence[ctx], 0),
+                PassKind::Cleaning => s.conn.encode_bit(&mut s.models.cleaning[ctx], false),
+            }
+            // Null patch: conquer the front face and go on through its other two edges.
+            self.face_done[f as usize] = true;
+            let front = self.conn.origin[prev(g) as usize];
+            self.conquer(front, Tag::Plus);
+            for h in [next(g), prev(g)] {
+                let t = self.conn.twin[h as usize];
+                if t != NONE {
+                    gates.push_back(t);
+                }
+            }
+        }
+    }
+
+    /// The patch around the gate's front vertex, if removing it keeps the
+    /// mesh a manifold the decoder can rebuild exactly.
+    fn removable(&self, g: u32, kind: PassKind, t0: Tag, t1: Tag) -> Option<Patch> {
+        let c = &self.conn;
+        let centre = c.origin[prev(g) as usize];
+        if self.state[centre as usize] != FREE {
+            return None;
+        }
+        let max_valence = if kind == PassKind::Cleaning { 3 } else { MAX_VALENCE };
+        let mut ring = [NONE; MAX_VALENCE];
+        let mut polygon = [NONE; MAX_VALENCE];
+        let start = prev(g);
+        let mut h = start;
+        let mut valence = 0;
+        loop {
+            if valence == max_valence {
+                return None;
+            }
+            ring[valence] = h;
+            polygon[valence] = c.target(h);
+            valence += 1;
+            h = c.rotate_ccw(h);
+            if h == NONE {
+                return None; // border vertex: AD01 keeps borders intact
+            }
+            if h == start {
+                break;
+            }
+        }
+        if valence < 3 {
+            return None;
+        }
+        let pattern = pattern(valence, t0, t1);
+        if valence == 3 {
+            // Removing a valence-3 vertex whose link is already a face would
+            // leave two faces on the same three vertices (a tetrahedron's tip).
+            let outer = c.twin[g as usize];
+            if outer != NONE && c.origin[prev(outer) as usize] == polygon[2] {
+                return None;
+            }
+        } else {
+            for corner in 0..3 * pattern.triangle_count() {
+                let t = pattern.twin[corner] as usize;
+                if t < NO_TWIN as usize && corner < t {
+                    let a = polygon[pattern.corner_vertex(corner)];
+                    let b = polygon[pattern.corner_vertex(t)];
+                    if c.has_edge(a, b) {
+                        return None;
+                    }
+                }
+            }
+        }
+        let patch = Patch { valence, centre, ring, polygon, pattern };
+        if self.geometric_guard && self.folds(&patch) {
+            return None;
+        }
+        Some(patch)
+    }
+
+    /// Whether a new triangle would face against the patch (a visible fold).
+    fn folds(&self, p: &Patch) -> bool {
+        let pos = |v: u32| self.positions[v as usize].map(|x| x as f64);
+        let cross = |a: [f64; 3], b: [f64; 3], c: [f64; 3]| {
+            let u = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+            let w = [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
+            [u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2], u[0] * w[1] - u[1] * w[0]]
+        };
+        let centre = pos(p.centre);
+        let mut normal = [0.0; 3];
+        for i in 0..p.valence {
+            let n = cross(centre, pos(p.polygon[i]), pos(p.polygon[(i + 1) % p.valence]));
+            (0..3).for_each(|k| normal[k] += n[k]);
+        }
+        p.pattern.triangles[..p.pattern.triangle_count()].iter().any(|t| {
+            let n = cross(pos(p.polygon[t[0] as usize]), pos(p.polygon[t[1] as usize]), pos(p.polygon[t[2] as usize]));
+            n[0] * normal[0] + n[1] * normal[1] + n[2] * normal[2] <= 0.0
+        })
+    }
+
+    fn encode_vertex(&self, p: &Patch, s: &mut Streams) {
+        let polygon: Vec<[i32; 3]> = p.polygon[..p.valence].iter().map(|&v| self.positions[v as usize]).collect();
+        PatchPrediction::new(&polygon).encode(self.positions[p.centre as usize], &mut s.models, &mut s.geom);
+        if let Some(colours) = &self.colours {
+            let border: Vec<[u8; 3]> = p.polygon[..p.valence].iter().map(|&v| colours[v as usize]).collect();
+            encode_colour(colours[p.centre as usize], predict_colour(&border), &mut s.models, &mut s.colour);
+        }
+    }
+
+    /// Removes the patch's centre and retriangulates its polygon by the pattern.
+    fn remove(&mut self, p: &Patch, gates: &mut VecDeque<u32>) {
+        let d = p.valence;
+        let pat = p.pattern;
+        let mut outer = [NONE; MAX_VALENCE];
+        let mut old_faces = [NONE; MAX_VALENCE];
+        for i in 0..d {
+            outer[i] = self.conn.twin[next(p.ring[i]) as usize];
+            old_faces[i] = face(p.ring[i]);
+        }
+        let kept = d - 2;
+        for &f in &old_faces[kept..d] {
+            for k in 0..3 {
+                self.conn.origin[3 * f as usize + k] = NONE;
+                self.conn.twin[3 * f as usize + k] = NONE;
+            }
+            self.free_slots.push(f);
+        }
+        let half_edge = |corner: usize| 3 * old_faces[corner / 3] + (corner % 3) as u32;
+        for corner in 0..3 * kept {
+            let h = half_edge(corner);
+            self.conn.origin[h as usize] = p.polygon[pat.corner_vertex(corner)];
+            let t = pat.twin[corner];
+            if t >= NO_TWIN {
+                let o = outer[(t - NO_TWIN) as usize];
+                self.conn.twin[h as usize] = o;
+                if o != NONE {
+                    self.conn.twin[o as usize] = h;
+                }
+            } else {
+                self.conn.twin[h as usize] = half_edge(t as usize);
+            }
+        }
+        for &f in &old_faces[..kept] {
+            self.face_done[f as usize] = true;
+        }
+        for i in 0..d {
+            let v = p.polygon[i];
+            self.conn.out[v as usize] = half_edge(pat.polygon_corner[i] as usize);
+            self.conquer(v, pat.tags[i]);
+        }
+        self.conn.out[p.centre as usize] = NONE;
+        self.state[p.centre as usize] = REMOVED;
+        self.live_vertices -= 1;
+        self.live_faces -= 2;
+        for &o in &outer[1..d] {
+            if o != NONE {
+                gates.push_back(o);
+            }
+        }
+    }
+}

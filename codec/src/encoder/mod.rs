@@ -1,0 +1,217 @@
+//! Mesh → progressive stream.
+
+mod conquest;
+
+use crate::base_mesh::{self, BaseMesh};
+use crate::format::{write_section, write_varint, ChunkHeader, Header, LevelInfo, BASE_TAG, BATCH_TAG, VERSION};
+use crate::halfedge::connectivity;
+use crate::quantize::Quantization;
+use crate::{Error, IndexedMesh, Result};
+use conquest::{PassKind, PassOutput, Simplifier};
+
+/// How small the base mesh should get.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum BaseTarget {
+    /// Stop once the mesh has at most this many vertices.
+    Vertices(u32),
+    /// Stop once the mesh has at most this fraction of the input's vertices.
+    Fraction(f32),
+}
+
+/// Encoder settings; `EncodeOptions::default()` suits museum scans.
+#[derive(Clone, Debug, PartialEq)]
+pub struct EncodeOptions {
+    /// Position quantization, 8–16 bits on the bounding cube.
+    pub quantization_bits: u8,
+    pub base: BaseTarget,
+    /// Never fewer base vertices than this, whatever `base` says.
+    pub min_base_vertices: u32,
+    pub max_layers: u32,
+    /// Stop when a layer removes less than this fraction of the vertices.
+    pub min_layer_fraction: f32,
+    /// Refuse retriangulations whose new faces fold against the patch
+    /// (costs a little connectivity, keeps low levels clean).
+    pub geometric_guard: bool,
+}
+
+impl Default for EncodeOptions {
+    fn default() -> Self {
+        EncodeOptions {
+            quantization_bits: 12,
+            base: BaseTarget::Fraction(0.01),
+            min_base_vertices: 64,
+            max_layers: 64,
+            min_layer_fraction: 0.02,
+            geometric_guard: true,
+        }
+    }
+}
+
+/// Progress reported after every layer.
+#[derive(Clone, Copy, Debug)]
+pub struct EncodeProgress {
+    pub layer: u32,
+    pub vertices: usize,
+    pub input_vertices: usize,
+}
+
+/// An encoded stream and how its vertices map back to the input.
+#[derive(Clone, Debug)]
+pub struct Encoded {
+    pub bytes: Vec<u8>,
+    /// Decoded vertex `i` (at the final level) is input vertex `vertex_order[i]`.
+    pub vertex_order: Vec<u32>,
+    pub header: Header,
+}
+
+struct Layer {
+    decimating: PassOutput,
+    cleaning: PassOutput,
+    faces_after: usize,
+}
+
+/// Encodes a manifold mesh (see [`crate::repair::prepare`]).
+pub fn encode(mesh: &IndexedMesh, options: &EncodeOptions) -> Result<Encoded> {
+    encode_with_progress(mesh, options, |_| {})
+}
+
+pub fn encode_with_progress(
+    mesh: &IndexedMesh,
+    options: &EncodeOptions,
+    mut progress: impl FnMut(EncodeProgress),
+) -> Result<Encoded> {
+    if mesh.triangles.is_empty() {
+        return Err(Error::input("mesh", "no triangles"));
+    }
+    if let Some(c) = &mesh.colors {
+        if c.len() != mesh.positions.len() {
+            return Err(Error::Parameter("colour count differs from vertex count".into()));
+        }
+    }
+    if mesh.positions.len() >= u32::MAX as usize / 2 {
+        return Err(Error::Limit("more than 2^31 vertices".into()));
+    }
+    let quantization = Quantization::for_positions(&mesh.positions, options.quantization_bits)?;
+    let positions: Vec<[i32; 3]> = mesh.positions.iter().map(|&p| quantization.quantize(p)).collect();
+    let conn = connectivity(mesh)?;
+    let input_vertices = mesh.positions.len();
+    if conn.out.iter().any(|&h| h == crate::halfedge::NONE) {
+        return Err(Error::Unsupported("mesh has vertices no face uses (run repair first)".into()));
+    }
+    let target = match options.base {
+        BaseTarget::Vertices(n) => n as usize,
+        BaseTarget::Fraction(f) => (input_vertices as f64 * f as f64) as usize,
+    }
+    .max(options.min_base_vertices as usize);
+
+    let mut s = Simplifier::new(conn, positions, mesh.colors.clone(), options.geometric_guard);
+    let mut layers = Vec::new();
+    while s.live_vertices > target && layers.len() < options.max_layers as usize {
+        let before = s.live_vertices;
+        let decimating = s.run_pass(PassKind::Decimating);
+        let cleaning = s.run_pass(PassKind::Cleaning);
+        let removed = before - s.live_vertices;
+        if removed == 0 {
+            break;
+        }
+        layers.push(Layer { decimating, cleaning, faces_after: s.live_faces });
+        progress(EncodeProgress { layer: layers.len() as u32, vertices: s.live_vertices, input_vertices });
+        if (removed as f64) < before as f64 * options.min_layer_fraction as f64 {
+            break;
+        }
+    }
+    let _ = layers.last().map(|l| l.faces_after);
+    Ok(write_stream(&s, &layers, quantization, input_vertices, mesh))
+}
+
+fn write_stream(
+    s: &Simplifier,
+    layers: &[Layer],
+    quantization: Quantization,
+    input_vertices: usize,
+    mesh: &IndexedMesh,
+) -> Encoded {
+    // Final numbering: base vertices by first appearance, then each batch's
+    // vertices in insertion order (coarsest layer first, cleaning before decimation).
+    let base_triangles: Vec<[u32; 3]> = s.conn.triangles().collect();
+    let mut vertex_order = base_mesh::first_appearance_order(input_vertices, &base_triangles);
+    let base_vertices = vertex_order.len();
+    for layer in layers.iter().rev() {
+        vertex_order.extend_from_slice(&layer.cleaning.removed);
+        vertex_order.extend_from_slice(&layer.decimating.removed);
+    }
+    let mut new_id = vec![u32::MAX; input_vertices];
+    for (new, &old) in vertex_order.iter().enumerate() {
+        new_id[old as usize] = new as u32;
+    }
+    let base = BaseMesh {
+        positions: vertex_order[..base_vertices].iter().map(|&v| s.positions[v as usize]).collect(),
+        colours: mesh
+            .colors
+            .as_ref()
+            .map(|c| vertex_order[..base_vertices].iter().map(|&v| c[v as usize]).collect()),
+        triangles: base_triangles.iter().map(|t| t.map(|v| new_id[v as usize])).collect(),
+    };
+    let base_payload = base_mesh::encode(&base);
+    let mut base_chunk = Vec::new();
+    ChunkHeader {
+        tag: BASE_TAG,
+        level: 0,
+        vertices_before: 0,
+        vertices_after: base_vertices as u32,
+        faces_after: base.triangles.len() as u32,
+        payload_len: base_payload.len() as u32,
+    }
+    .write(&mut base_chunk);
+    base_chunk.extend_from_slice(&base_payload);
+
+    let mut levels = vec![LevelInfo {
+        vertices: base_vertices as u32,
+        faces: base.triangles.len() as u32,
+        bytes: base_chunk.len() as u32,
+    }];
+    let mut batches = Vec::new();
+    let mut vertices = base_vertices;
+    let mut faces = base.triangles.len();
+    for (i, layer) in layers.iter().rev().enumerate() {
+        let mut payload = Vec::new();
+        write_pass(&mut payload, &layer.cleaning, &new_id);
+        write_pass(&mut payload, &layer.decimating, &new_id);
+        let added = layer.cleaning.removed.len() + layer.decimating.removed.len();
+        let mut chunk = Vec::new();
+        ChunkHeader {
+            tag: BATCH_TAG,
+            level: (i + 1) as u16,
+            vertices_before: vertices as u32,
+            vertices_after: (vertices + added) as u32,
+            faces_after: (faces + 2 * added) as u32,
+            payload_len: payload.len() as u32,
+        }
+        .write(&mut chunk);
+        chunk.extend_from_slice(&payload);
+        vertices += added;
+        faces += 2 * added;
+        levels.push(LevelInfo { vertices: vertices as u32, faces: faces as u32, bytes: chunk.len() as u32 });
+        batches.push(chunk);
+    }
+    let header = Header { version: VERSION, has_colour: mesh.colors.is_some(), quantization, levels };
+    let mut bytes = Vec::new();
+    header.write(&mut bytes);
+    bytes.extend_from_slice(&base_chunk);
+    for b in &batches {
+        bytes.extend_from_slice(b);
+    }
+    Encoded { bytes, vertex_order, header }
+}
+
+fn write_pass(out: &mut Vec<u8>, pass: &PassOutput, new_id: &[u32]) {
+    write_varint(out, pass.seeds.len() as u32);
+    for seed in &pass.seeds {
+        write_varint(out, new_id[seed[0] as usize]);
+        write_varint(out, new_id[seed[1] as usize]);
+    }
+    write_varint(out, pass.removed.len() as u32);
+    write_section(out, &pass.connectivity);
+    write_section(out, &pass.geometry);
+    write_section(out, &pass.colour);
+}

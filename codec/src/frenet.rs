@@ -1,0 +1,149 @@
+//! Residuals in the patch's local Frenet frame, losslessly (AD01 §4;
+//! Lee, Lavoué & Dupont 2009 make the rotation integer-to-integer).
+//!
+//! The frame is (tangent from the gate edge, bitangent, patch normal). The
+//! rotation into it is split into three Givens rotations, each applied as
+//! three lifting shears with rounding, so the integer map is a bijection.
+//! Only `+ − × / sqrt` on `f64` are used: IEEE 754 makes them bit-identical
+//! on x86_64 and wasm32, so encoder and decoder agree on every rounding.
+
+/// One plane rotation as lifting coefficients.
+#[derive(Clone, Copy, Debug)]
+struct Givens {
+    flip: bool,
+    a: f64,
+    b: f64,
+}
+
+impl Givens {
+    /// The rotation taking the direction `(x, y)` onto the positive first axis.
+    fn aligning(x: f64, y: f64) -> Givens {
+        let r = (x * x + y * y).sqrt();
+        if r == 0.0 {
+            return Givens { flip: false, a: 0.0, b: 0.0 };
+        }
+        let (mut c, mut s) = (x / r, y / r);
+        // Rotating by π first keeps |a| ≤ 1 (the shear for angles near π blows up).
+        let flip = c < 0.0;
+        if flip {
+            c = -c;
+            s = -s;
+        }
+        // Rotation by −θ (cos θ = c, sin θ = s): shears a = (1 − c)/s = s/(1 + c), b = −s.
+        Givens { flip, a: s / (1.0 + c), b: -s }
+    }
+
+    fn apply_f64(&self, x: f64, y: f64) -> (f64, f64) {
+        let (mut x, mut y) = if self.flip { (-x, -y) } else { (x, y) };
+        x += self.a * y;
+        y += self.b * x;
+        x += self.a * y;
+        (x, y)
+    }
+
+    fn forward(&self, x: &mut i64, y: &mut i64) {
+        if self.flip {
+            *x = -*x;
+            *y = -*y;
+        }
+        *x += round(self.a * *y as f64);
+        *y += round(self.b * *x as f64);
+        *x += round(self.a * *y as f64);
+    }
+
+    fn inverse(&self, x: &mut i64, y: &mut i64) {
+        *x -= round(self.a * *y as f64);
+        *y -= round(self.b * *x as f64);
+        *x -= round(self.a * *y as f64);
+        if self.flip {
+            *x = -*x;
+            *y = -*y;
+        }
+    }
+}
+
+/// Round half away from zero with casts only (no libm), identical everywhere.
+#[inline]
+fn round(x: f64) -> i64 {
+    if x >= 0.0 {
+        (x + 0.5) as i64
+    } else {
+        -((-x + 0.5) as i64)
+    }
+}
+
+/// The local frame of one patch.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Frame {
+    xy: Givens,
+    zx: Givens,
+    tangent: Givens,
+}
+
+impl Frame {
+    /// `normal` and `tangent` need not be unit length; zero vectors give the identity.
+    pub(crate) fn new(normal: [i64; 3], tangent: [i64; 3]) -> Frame {
+        let n = normal.map(|c| c as f64);
+        let xy = Givens::aligning(n[0], n[1]);
+        let (nx, _) = xy.apply_f64(n[0], n[1]);
+        // Second rotation brings the normal onto +z: align (z, x) onto the z axis.
+        let zx = Givens::aligning(n[2], nx);
+        let t = tangent.map(|c| c as f64);
+        let (tx, ty) = xy.apply_f64(t[0], t[1]);
+        let (_, tx) = zx.apply_f64(t[2], tx);
+        let tangent = Givens::aligning(tx, ty);
+        Frame { xy, zx, tangent }
+    }
+
+    /// World residual → (tangent, bitangent, normal).
+    pub(crate) fn to_local(&self, r: [i64; 3]) -> [i64; 3] {
+        let [mut x, mut y, mut z] = r;
+        self.xy.forward(&mut x, &mut y);
+        self.zx.forward(&mut z, &mut x);
+        self.tangent.forward(&mut x, &mut y);
+        [x, y, z]
+    }
+
+    pub(crate) fn to_world(&self, l: [i64; 3]) -> [i64; 3] {
+        let [mut x, mut y, mut z] = l;
+        self.tangent.inverse(&mut x, &mut y);
+        self.zx.inverse(&mut z, &mut x);
+        self.xy.inverse(&mut x, &mut y);
+        [x, y, z]
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn lcg(seed: &mut u64) -> i64 {
+        *seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        ((*seed >> 33) % 8001) as i64 - 4000
+    }
+
+    #[test]
+    fn integer_rotation_is_a_bijection() {
+        let mut seed = 7;
+        for _ in 0..20_000 {
+            let n = [lcg(&mut seed), lcg(&mut seed), lcg(&mut seed)];
+            let t = [lcg(&mut seed), lcg(&mut seed), lcg(&mut seed)];
+            let r = [lcg(&mut seed) / 8, lcg(&mut seed) / 8, lcg(&mut seed) / 8];
+            let f = Frame::new(n, t);
+            assert_eq!(f.to_world(f.to_local(r)), r, "n {n:?} t {t:?}");
+        }
+    }
+
+    #[test]
+    fn normal_component_lands_on_z() {
+        let f = Frame::new([0, 0, 5], [1, 0, 0]);
+        assert_eq!(f.to_local([0, 0, 9]), [0, 0, 9]);
+        let f = Frame::new([10, 0, 0], [0, 1, 0]);
+        let l = f.to_local([7, 0, 0]);
+        assert_eq!(l[2], 7);
+        assert!(l[0].abs() <= 1 && l[1].abs() <= 1);
+        let f = Frame::new([3, 4, 12], [4, -3, 0]);
+        let l = f.to_local([30, 40, 120]);
+        assert!((l[2] - 130).abs() <= 1, "{l:?}");
+    }
+}

@@ -1,0 +1,228 @@
+//! Index-based half-edge connectivity shared by the encoder and the decoder.
+//!
+//! Half-edge `h` lives in face `h / 3`; the face's half-edges are
+//! `3f, 3f+1, 3f+2` in counter-clockwise order, so `next` and `prev` are
+//! arithmetic and only `origin` and `twin` are stored. A half-edge runs from
+//! `origin[h]` to `origin[next(h)]`. Dead face slots have `origin[3f] == NONE`.
+
+use crate::{Error, IndexedMesh, Result};
+
+pub(crate) const NONE: u32 = u32::MAX;
+
+#[inline]
+pub(crate) fn next(h: u32) -> u32 {
+    if h % 3 == 2 {
+        h - 2
+    } else {
+        h + 1
+    }
+}
+
+#[inline]
+pub(crate) fn prev(h: u32) -> u32 {
+    if h % 3 == 0 {
+        h + 2
+    } else {
+        h - 1
+    }
+}
+
+#[inline]
+pub(crate) fn face(h: u32) -> u32 {
+    h / 3
+}
+
+#[derive(Clone, Debug, Default)]
+pub(crate) struct Connectivity {
+    pub origin: Vec<u32>,
+    pub twin: Vec<u32>,
+    /// One live outgoing half-edge per vertex (`NONE` once removed).
+    pub out: Vec<u32>,
+}
+
+impl Connectivity {
+    /// Builds twins from a triangle list. Fails on a non-manifold or
+    /// inconsistently oriented edge: [`crate::repair::prepare`] removes those.
+    pub(crate) fn from_triangles(vertex_count: usize, triangles: &[[u32; 3]]) -> Result<Self> {
+        let mut origin = Vec::with_capacity(triangles.len() * 3);
+        for t in triangles {
+            if t.iter().any(|&v| v as usize >= vertex_count) {
+                return Err(Error::Unsupported(format!("face {t:?} indexes a missing vertex")));
+            }
+            origin.extend_from_slice(t);
+        }
+        let mut twin = vec![NONE; origin.len()];
+        // Sort half-edges by undirected edge; equal keys must come in
+        // opposite-direction pairs.
+        let mut keys: Vec<(u64, u32)> = (0..origin.len() as u32)
+            .map(|h| {
+                let (a, b) = (origin[h as usize], origin[next(h) as usize]);
+                (((a.min(b) as u64) << 32) | a.max(b) as u64, h)
+            })
+            .collect();
+        keys.sort_unstable();
+        let mut i = 0;
+        while i < keys.len() {
+            let mut j = i + 1;
+            while j < keys.len() && keys[j].0 == keys[i].0 {
+                j += 1;
+            }
+            match j - i {
+                1 => {}
+                2 => {
+                    let (h, g) = (keys[i].1, keys[i + 1].1);
+                    if origin[h as usize] == origin[g as usize] {
+                        return Err(non_manifold("inconsistently oriented", &origin, h));
+                    }
+                    twin[h as usize] = g;
+                    twin[g as usize] = h;
+                }
+                _ => return Err(non_manifold("shared by more than two faces", &origin, keys[i].1)),
+            }
+            i = j;
+        }
+        let mut out = vec![NONE; vertex_count];
+        for (h, &v) in origin.iter().enumerate() {
+            out[v as usize] = h as u32;
+        }
+        let conn = Connectivity { origin, twin, out };
+        conn.check_vertex_fans()?;
+        Ok(conn)
+    }
+
+    /// Every vertex's faces must form one fan, or rotation would miss some.
+    fn check_vertex_fans(&self) -> Result<()> {
+        let mut seen = vec![0u32; self.out.len()];
+        for v in 0..self.out.len() as u32 {
+            if self.out[v as usize] == NONE {
+                continue;
+            }
+            let mut count = 0u32;
+            self.for_each_outgoing(v, |_| count += 1);
+            seen[v as usize] = count;
+        }
+        let mut total = vec![0u32; self.out.len()];
+        for &v in &self.origin {
+            total[v as usize] += 1;
+        }
+        if let Some(v) = (0..self.out.len()).find(|&v| seen[v] != total[v]) {
+            return Err(Error::Unsupported(format!(
+                "vertex {v} is non-manifold: its faces form more than one fan"
+            )));
+        }
+        Ok(())
+    }
+
+    #[inline]
+    pub(crate) fn target(&self, h: u32) -> u32 {
+        self.origin[next(h) as usize]
+    }
+
+    /// Appends an empty face slot and returns its index.
+    pub(crate) fn append_face(&mut self) -> u32 {
+        let f = self.face_count_slots() as u32;
+        self.origin.extend_from_slice(&[NONE; 3]);
+        self.twin.extend_from_slice(&[NONE; 3]);
+        f
+    }
+
+    pub(crate) fn face_count_slots(&self) -> usize {
+        self.origin.len() / 3
+    }
+
+    #[inline]
+    pub(crate) fn face_alive(&self, f: u32) -> bool {
+        self.origin[3 * f as usize] != NONE
+    }
+
+    /// Counter-clockwise neighbour of outgoing half-edge `h` around its origin.
+    #[inline]
+    pub(crate) fn rotate_ccw(&self, h: u32) -> u32 {
+        self.twin[prev(h) as usize]
+    }
+
+    /// Calls `f` on every outgoing half-edge of `v`, border vertices included.
+    pub(crate) fn for_each_outgoing(&self, v: u32, mut f: impl FnMut(u32)) {
+        let start = self.out[v as usize];
+        let mut h = start;
+        loop {
+            f(h);
+            h = self.rotate_ccw(h);
+            if h == start {
+                return;
+            }
+            if h == NONE {
+                break;
+            }
+        }
+        // Border: walk clockwise from the start to reach the rest.
+        let mut h = self.twin[start as usize];
+        while h != NONE {
+            let out = next(h);
+            f(out);
+            h = self.twin[out as usize];
+        }
+    }
+
+    /// The outgoing half-edge `a → b`, if the edge exists.
+    pub(crate) fn find_half_edge(&self, a: u32, b: u32) -> Option<u32> {
+        let mut found = None;
+        self.for_each_outgoing(a, |h| {
+            if found.is_none() && self.target(h) == b {
+                found = Some(h);
+            }
+        });
+        found
+    }
+
+    /// Whether some edge joins `a` and `b`, in either direction.
+    pub(crate) fn has_edge(&self, a: u32, b: u32) -> bool {
+        let mut found = false;
+        self.for_each_outgoing(a, |h| {
+            found |= self.target(h) == b || self.origin[prev(h) as usize] == b;
+        });
+        found
+    }
+
+    /// Live triangles in slot order.
+    pub(crate) fn triangles(&self) -> impl Iterator<Item = [u32; 3]> + '_ {
+        self.origin
+            .chunks_exact(3)
+            .filter(|t| t[0] != NONE)
+            .map(|t| [t[0], t[1], t[2]])
+    }
+}
+
+fn non_manifold(what: &str, origin: &[u32], h: u32) -> Error {
+    let (a, b) = (origin[h as usize], origin[next(h) as usize]);
+    Error::Unsupported(format!("edge ({a}, {b}) is non-manifold: {what}"))
+}
+
+/// Builds connectivity for a mesh that passed repair.
+pub(crate) fn connectivity(mesh: &IndexedMesh) -> Result<Connectivity> {
+    Connectivity::from_triangles(mesh.positions.len(), &mesh.triangles)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn rotation_visits_all_neighbours_of_border_vertex() {
+        // A fan of three triangles around vertex 0, open on one side.
+        let tris = [[0, 1, 2], [0, 2, 3], [0, 3, 4]];
+        let c = Connectivity::from_triangles(5, &tris).unwrap();
+        let mut targets = Vec::new();
+        c.for_each_outgoing(0, |h| targets.push(c.target(h)));
+        targets.sort();
+        assert_eq!(targets, vec![1, 2, 3]);
+        assert!(c.has_edge(0, 4));
+        assert!(!c.has_edge(1, 3));
+    }
+
+    #[test]
+    fn rejects_edge_with_three_faces() {
+        let tris = [[0, 1, 2], [1, 0, 3], [0, 1, 4]];
+        assert!(Connectivity::from_triangles(5, &tris).is_err());
+    }
+}

@@ -1,0 +1,44 @@
+//! Vitrine's progressive mesh codec: Alliez–Desbrun 2001 valence-driven
+//! coding, lossless at the chosen quantization.
+//!
+//! ```
+//! use vitrine_codec::{decode, encode, EncodeOptions, IndexedMesh, Limits};
+//! # fn demo(mesh: &IndexedMesh) -> vitrine_codec::Result<()> {
+//! let encoded = encode(mesh, &EncodeOptions::default())?;
+//! // Base mesh plus every refinement batch:
+//! let decoder = decode(&encoded.bytes, None, Limits::default())?;
+//! assert_eq!(decoder.vertex_count(), mesh.positions.len());
+//! # Ok(()) }
+//! ```
+//! A server splits the stream with [`StreamIndex`]; a viewer feeds the
+//! pieces to a [`Decoder`] one batch at a time.
+#![forbid(unsafe_code)]
+
+mod base_mesh;
+mod decoder;
+mod encoder;
+mod entropy;
+mod error;
+mod format;
+mod frenet;
+mod halfedge;
+mod mesh;
+mod patch;
+mod predict;
+mod quantize;
+pub mod samples;
+
+pub use decoder::{decode, Decoder, Limits};
+pub use encoder::{encode, encode_with_progress, BaseTarget, EncodeOptions, EncodeProgress, Encoded};
+pub use error::{Error, Result};
+pub use format::{Header, LevelInfo, StreamIndex, MAGIC, VERSION};
+pub use mesh::IndexedMesh;
+pub use quantize::Quantization;
+
+// --- import/repair/export (helper) ---
+#[cfg(feature = "import")]
+pub mod export;
+#[cfg(feature = "import")]
+pub mod import;
+pub mod repair;
+// --- end ---

@@ -1,0 +1,125 @@
+//! Prediction of a removed vertex from its patch, and the adaptive models the
+//! residuals are coded with. Encoder and decoder call the same functions.
+
+use crate::entropy::{BitModel, IntModel, RangeDecoder, RangeEncoder, SymbolModel};
+use crate::frenet::Frame;
+use crate::patch::{Tag, MAX_VALENCE};
+
+/// Context for a gate: the retriangulation tags of its two vertices.
+#[inline]
+pub(crate) fn gate_context(t0: Tag, t1: Tag) -> usize {
+    (t0 as usize % 3) * 3 + (t1 as usize % 3)
+}
+
+pub(crate) const GATE_CONTEXTS: usize = 9;
+/// Decimation symbols: 0 = null patch, `valence − 2` otherwise (1..=4).
+pub(crate) const DECIMATION_SYMBOLS: usize = MAX_VALENCE - 1;
+
+/// Adaptive models of one conquest pass; reset per pass so every batch
+/// decodes on its own given the previous level (AD01 resets per layer too).
+pub(crate) struct PassModels {
+    pub valence: Vec<SymbolModel>,
+    pub cleaning: [BitModel; GATE_CONTEXTS],
+    pub tangent: IntModel,
+    pub normal: IntModel,
+    pub colour: [IntModel; 3],
+}
+
+impl PassModels {
+    pub(crate) fn new() -> Self {
+        PassModels {
+            valence: (0..GATE_CONTEXTS).map(|_| SymbolModel::new(DECIMATION_SYMBOLS)).collect(),
+            cleaning: [BitModel::default(); GATE_CONTEXTS],
+            tangent: IntModel::new(),
+            normal: IntModel::new(),
+            colour: [IntModel::new(), IntModel::new(), IntModel::new()],
+        }
+    }
+}
+
+/// Barycentric prediction and Frenet frame of one patch (AD01 §4).
+pub(crate) struct PatchPrediction {
+    pub position: [i64; 3],
+    frame: Frame,
+}
+
+impl PatchPrediction {
+    pub(crate) fn new(polygon: &[[i32; 3]]) -> Self {
+        let d = polygon.len() as i64;
+        let mut sum = [0i64; 3];
+        for p in polygon {
+            for k in 0..3 {
+                sum[k] += p[k] as i64;
+            }
+        }
+        let position = sum.map(|s| s.div_euclid(d) + i64::from(2 * s.rem_euclid(d) >= d));
+        // Newell normal of the polygon, relative to its first vertex to keep products small.
+        let o = polygon[0];
+        let rel = |p: &[i32; 3]| [0, 1, 2].map(|k| (p[k] - o[k]) as i64);
+        let mut normal = [0i64; 3];
+        for i in 0..polygon.len() {
+            let a = rel(&polygon[i]);
+            let b = rel(&polygon[(i + 1) % polygon.len()]);
+            normal[0] += a[1] * b[2] - a[2] * b[1];
+            normal[1] += a[2] * b[0] - a[0] * b[2];
+            normal[2] += a[0] * b[1] - a[1] * b[0];
+        }
+        let tangent = rel(&polygon[1]);
+        PatchPrediction { position, frame: Frame::new(normal, tangent) }
+    }
+
+    pub(crate) fn encode(&self, actual: [i32; 3], m: &mut PassModels, enc: &mut RangeEncoder) {
+        let r = [0, 1, 2].map(|k| actual[k] as i64 - self.position[k]);
+        let l = self.frame.to_local(r);
+        enc.encode_int(&mut m.tangent, l[0] as i32);
+        enc.encode_int(&mut m.tangent, l[1] as i32);
+        enc.encode_int(&mut m.normal, l[2] as i32);
+    }
+
+    /// Returns `None` when the decoded position falls outside `[0, max]`: a corrupt stream.
+    pub(crate) fn decode(&self, max: i32, m: &mut PassModels, dec: &mut RangeDecoder) -> Option<[i32; 3]> {
+        let l = [
+            dec.decode_int(&mut m.tangent) as i64,
+            dec.decode_int(&mut m.tangent) as i64,
+            dec.decode_int(&mut m.normal) as i64,
+        ];
+        let r = self.frame.to_world(l);
+        let mut out = [0i32; 3];
+        for k in 0..3 {
+            let v = self.position[k].checked_add(r[k])?;
+            if !(0..=max as i64).contains(&v) {
+                return None;
+            }
+            out[k] = v as i32;
+        }
+        Some(out)
+    }
+}
+
+/// Mean colour of the patch border, the predictor for the removed vertex.
+pub(crate) fn predict_colour(polygon: &[[u8; 3]]) -> [u8; 3] {
+    let d = polygon.len() as u32;
+    std::array::from_fn(|k| {
+        let s: u32 = polygon.iter().map(|c| c[k] as u32).sum();
+        ((s + d / 2) / d) as u8
+    })
+}
+
+/// Colour residual, green first and red/blue relative to it (decorrelates
+/// luminance), all modulo 256 so the map is a bijection.
+pub(crate) fn encode_colour(actual: [u8; 3], pred: [u8; 3], m: &mut PassModels, enc: &mut RangeEncoder) {
+    let d = [0, 1, 2].map(|k| actual[k].wrapping_sub(pred[k]));
+    let g = d[1] as i8;
+    let r = d[0].wrapping_sub(d[1]) as i8;
+    let b = d[2].wrapping_sub(d[1]) as i8;
+    enc.encode_int(&mut m.colour[0], g as i32);
+    enc.encode_int(&mut m.colour[1], r as i32);
+    enc.encode_int(&mut m.colour[2], b as i32);
+}
+
+pub(crate) fn decode_colour(pred: [u8; 3], m: &mut PassModels, dec: &mut RangeDecoder) -> [u8; 3] {
+    let g = dec.decode_int(&mut m.colour[0]) as u8;
+    let r = (dec.decode_int(&mut m.colour[1]) as u8).wrapping_add(g);
+    let b = (dec.decode_int(&mut m.colour[2]) as u8).wrapping_add(g);
+    [pred[0].wrapping_add(r), pred[1].wrapping_add(g), pred[2].wrapping_add(b)]
+}
