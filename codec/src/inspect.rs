@@ -1,0 +1,58 @@
+//! Per-level byte breakdown of a stream, read from section lengths only.
+
+use crate::format::{ChunkHeader, Reader, BASE_TAG, BATCH_TAG};
+use crate::{Result, StreamIndex};
+
+/// Where the bytes of one level went.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct LevelBreakdown {
+    pub vertices: u32,
+    pub faces: u32,
+    /// Whole chunk, framing included.
+    pub bytes: u32,
+    pub connectivity: u32,
+    pub geometry: u32,
+    pub colour: u32,
+    /// Chunk header, seeds and section lengths.
+    pub overhead: u32,
+}
+
+/// One entry per level; entry 0 is the base mesh (all its payload counted as geometry
+/// and connectivity together under `geometry`).
+pub fn breakdown(stream: &[u8]) -> Result<Vec<LevelBreakdown>> {
+    let index = StreamIndex::parse(stream)?;
+    let levels = &index.header.levels;
+    let base_chunk = &stream[index.header.byte_len()..index.base.end];
+    let (_, base_payload) = ChunkHeader::parse(base_chunk, BASE_TAG)?;
+    let mut out = vec![LevelBreakdown {
+        vertices: levels[0].vertices,
+        faces: levels[0].faces,
+        bytes: levels[0].bytes,
+        geometry: base_payload.len() as u32,
+        overhead: levels[0].bytes - base_payload.len() as u32,
+        ..Default::default()
+    }];
+    for (k, range) in index.batches.iter().enumerate() {
+        let (_, payload) = ChunkHeader::parse(&stream[range.clone()], BATCH_TAG)?;
+        let mut r = Reader::new(payload);
+        let mut b = LevelBreakdown {
+            vertices: levels[k + 1].vertices,
+            faces: levels[k + 1].faces,
+            bytes: levels[k + 1].bytes,
+            ..Default::default()
+        };
+        for _pass in 0..2 {
+            let seeds = r.varint()?;
+            for _ in 0..2 * seeds {
+                r.varint()?;
+            }
+            r.varint()?;
+            b.connectivity += r.section()?.len() as u32;
+            b.geometry += r.section()?.len() as u32;
+            b.colour += r.section()?.len() as u32;
+        }
+        b.overhead = b.bytes - b.connectivity - b.geometry - b.colour;
+        out.push(b);
+    }
+    Ok(out)
+}

@@ -1,0 +1,150 @@
+//! A tiny pointer+length ABI over [`vitrine_codec::Decoder`] for WebAssembly.
+//!
+//! Hand-written rather than wasm-bindgen: the surface is eight functions on
+//! integers, the JS side (`web/src/codec.js`) is forty lines, and the build
+//! needs only `cargo build --target wasm32-unknown-unknown` — no CLI whose
+//! version must match a crate's. The calling pattern:
+//!
+//! 1. `input_reserve(len) -> ptr`; JS copies the bytes to `memory[ptr..]`.
+//! 2. `decoder_new(len) -> handle` (0 on error) or `decoder_apply(handle, len) -> 0 | -1`.
+//! 3. `buffer_ptr(handle, kind)` / `buffer_len(handle, kind)`: views on the
+//!    level's positions (f32), colours (u8) or indices (u32); copy them
+//!    before the next call, which may move memory.
+//! 4. On error `error_ptr()` / `error_len()` give a UTF-8 message.
+//!
+//! Exported symbols need `#[no_mangle]`, which the `unsafe_code` lint flags;
+//! nothing here dereferences a raw pointer: all memory is Rust-owned `Vec`s.
+#![deny(unsafe_code)]
+
+use std::cell::RefCell;
+use vitrine_codec::{Decoder, Limits};
+
+thread_local! {
+    static INPUT: RefCell<Vec<u8>> = const { RefCell::new(Vec::new()) };
+    static ERROR: RefCell<String> = const { RefCell::new(String::new()) };
+    static DECODERS: RefCell<Vec<Option<Decoder>>> = const { RefCell::new(Vec::new()) };
+}
+
+/// Buffer kinds for [`buffer_ptr`] and [`buffer_len`].
+pub const POSITIONS: u32 = 0;
+pub const COLOURS: u32 = 1;
+pub const INDICES: u32 = 2;
+
+fn fail(message: String) -> i32 {
+    ERROR.with(|e| *e.borrow_mut() = message);
+    -1
+}
+
+/// Makes room for `len` input bytes and returns where JS should write them.
+#[allow(unsafe_code)]
+#[no_mangle]
+pub extern "C" fn input_reserve(len: u32) -> u32 {
+    INPUT.with(|i| {
+        let mut i = i.borrow_mut();
+        i.clear();
+        i.resize(len as usize, 0);
+        i.as_ptr() as usize as u32
+    })
+}
+
+/// Starts a decoder on the header + base mesh in the input buffer; returns a handle > 0.
+#[allow(unsafe_code)]
+#[no_mangle]
+pub extern "C" fn decoder_new(len: u32) -> u32 {
+    let result = INPUT.with(|i| {
+        let i = i.borrow();
+        Decoder::new(&i[..(len as usize).min(i.len())], Limits::default())
+    });
+    match result {
+        Ok(d) => DECODERS.with(|ds| {
+            let mut ds = ds.borrow_mut();
+            ds.push(Some(d));
+            ds.len() as u32
+        }),
+        Err(e) => {
+            fail(e.to_string());
+            0
+        }
+    }
+}
+
+fn with_decoder<T>(handle: u32, f: impl FnOnce(&mut Decoder) -> T) -> Option<T> {
+    DECODERS.with(|ds| {
+        let mut ds = ds.borrow_mut();
+        let slot = ds.get_mut((handle as usize).checked_sub(1)?)?;
+        slot.as_mut().map(f)
+    })
+}
+
+/// Applies the refinement batch in the input buffer. 0 on success, −1 on error.
+#[allow(unsafe_code)]
+#[no_mangle]
+pub extern "C" fn decoder_apply(handle: u32, len: u32) -> i32 {
+    let result = INPUT.with(|i| {
+        let i = i.borrow();
+        with_decoder(handle, |d| d.apply_batch(&i[..(len as usize).min(i.len())]))
+    });
+    match result {
+        Some(Ok(())) => 0,
+        Some(Err(e)) => fail(e.to_string()),
+        None => fail(format!("no decoder with handle {handle}")),
+    }
+}
+
+/// Vertex count at the current level.
+#[allow(unsafe_code)]
+#[no_mangle]
+pub extern "C" fn decoder_vertices(handle: u32) -> u32 {
+    with_decoder(handle, |d| d.vertex_count() as u32).unwrap_or(0)
+}
+
+/// Batches applied so far.
+#[allow(unsafe_code)]
+#[no_mangle]
+pub extern "C" fn decoder_level(handle: u32) -> u32 {
+    with_decoder(handle, |d| d.level() as u32).unwrap_or(0)
+}
+
+fn buffer(d: &Decoder, kind: u32) -> (usize, usize) {
+    match kind {
+        POSITIONS => (d.positions().as_ptr() as usize, d.positions().len()),
+        COLOURS => d.colours().map_or((0, 0), |c| (c.as_ptr() as usize, c.len())),
+        _ => (d.indices().as_ptr() as usize, d.indices().len()),
+    }
+}
+
+/// Address of a level buffer (see the kinds above); 0 when absent.
+#[allow(unsafe_code)]
+#[no_mangle]
+pub extern "C" fn buffer_ptr(handle: u32, kind: u32) -> u32 {
+    with_decoder(handle, |d| buffer(d, kind).0 as u32).unwrap_or(0)
+}
+
+/// Length of a level buffer in elements (f32, u8 or u32).
+#[allow(unsafe_code)]
+#[no_mangle]
+pub extern "C" fn buffer_len(handle: u32, kind: u32) -> u32 {
+    with_decoder(handle, |d| buffer(d, kind).1 as u32).unwrap_or(0)
+}
+
+#[allow(unsafe_code)]
+#[no_mangle]
+pub extern "C" fn decoder_free(handle: u32) {
+    DECODERS.with(|ds| {
+        if let Some(slot) = ds.borrow_mut().get_mut((handle as usize).wrapping_sub(1)) {
+            *slot = None;
+        }
+    });
+}
+
+#[allow(unsafe_code)]
+#[no_mangle]
+pub extern "C" fn error_ptr() -> u32 {
+    ERROR.with(|e| e.borrow().as_ptr() as usize as u32)
+}
+
+#[allow(unsafe_code)]
+#[no_mangle]
+pub extern "C" fn error_len() -> u32 {
+    ERROR.with(|e| e.borrow().len() as u32)
+}

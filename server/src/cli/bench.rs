@@ -1,0 +1,255 @@
+//! `vitrine bench`: bits per vertex, speed and peak memory on a set of meshes,
+//! optionally beside Google Draco, as a markdown table for BENCHMARKS.md.
+//!
+//! Each mesh runs in a child process (`vitrine bench-one`) so its peak
+//! resident memory is its own.
+
+use anyhow::{bail, Context};
+use clap::Args;
+use serde::{Deserialize, Serialize};
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+use std::time::Instant;
+use vitrine_codec::{breakdown, decode, encode, EncodeOptions, Limits};
+
+#[derive(Args, Debug)]
+pub struct BenchArgs {
+    /// Mesh files or folders of meshes.
+    #[arg(required = true)]
+    pub inputs: Vec<PathBuf>,
+    #[arg(short = 'q', long, default_value_t = 12)]
+    pub bits: u8,
+    /// Timed runs per mesh; the median is reported.
+    #[arg(long, default_value_t = 5)]
+    pub runs: usize,
+    /// Run Google Draco on the same meshes through this script (peer_draco.py).
+    #[arg(long)]
+    pub draco: Option<PathBuf>,
+    /// Also write the table to this markdown file.
+    #[arg(long)]
+    pub markdown: Option<PathBuf>,
+}
+
+#[derive(Args, Debug)]
+pub struct BenchOneArgs {
+    pub input: PathBuf,
+    #[arg(short = 'q', long, default_value_t = 12)]
+    pub bits: u8,
+    #[arg(long, default_value_t = 5)]
+    pub runs: usize,
+}
+
+#[derive(Serialize, Deserialize, Debug)]
+pub struct BenchResult {
+    pub name: String,
+    pub vertices: usize,
+    pub faces: usize,
+    pub colour: bool,
+    pub levels: usize,
+    pub base_vertices: u32,
+    pub bytes: usize,
+    pub connectivity_bpv: f64,
+    pub geometry_bpv: f64,
+    pub colour_bpv: f64,
+    pub base_bpv: f64,
+    pub total_bpv: f64,
+    pub encode_ms: f64,
+    pub decode_ms: f64,
+    pub peak_rss_mib: f64,
+}
+
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v[v.len() / 2]
+}
+
+/// Peak resident set size of this process (Linux `VmHWM`), in MiB.
+fn peak_rss_mib() -> f64 {
+    std::fs::read_to_string("/proc/self/status")
+        .ok()
+        .and_then(|s| {
+            s.lines()
+                .find(|l| l.starts_with("VmHWM:"))
+                .and_then(|l| l.split_whitespace().nth(1)?.parse::<f64>().ok())
+        })
+        .map_or(f64::NAN, |kib| kib / 1024.0)
+}
+
+pub fn run_one(args: BenchOneArgs) -> anyhow::Result<()> {
+    let (mesh, _) = super::load_mesh(&args.input)?;
+    let options = EncodeOptions { quantization_bits: args.bits, ..EncodeOptions::default() };
+    let mut encode_ms = Vec::new();
+    let mut encoded = None;
+    for _ in 0..args.runs.max(1) {
+        let t = Instant::now();
+        encoded = Some(encode(&mesh, &options)?);
+        encode_ms.push(t.elapsed().as_secs_f64() * 1e3);
+    }
+    let encoded = encoded.expect("at least one run");
+    let mut decode_ms = Vec::new();
+    for _ in 0..args.runs.max(1) {
+        let t = Instant::now();
+        let d = decode(&encoded.bytes, None, Limits::default())?;
+        decode_ms.push(t.elapsed().as_secs_f64() * 1e3);
+        std::hint::black_box(d.indices().len());
+    }
+    let levels = breakdown(&encoded.bytes)?;
+    let n = mesh.positions.len() as f64;
+    let per_vertex = |f: fn(&vitrine_codec::LevelBreakdown) -> u32| levels[1..].iter().map(f).sum::<u32>() as f64 * 8.0 / n;
+    let result = BenchResult {
+        name: args.input.file_name().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default(),
+        vertices: mesh.positions.len(),
+        faces: mesh.triangles.len(),
+        colour: mesh.colors.is_some(),
+        levels: encoded.header.batch_count(),
+        base_vertices: encoded.header.levels[0].vertices,
+        bytes: encoded.bytes.len(),
+        connectivity_bpv: per_vertex(|l| l.connectivity + l.overhead),
+        geometry_bpv: per_vertex(|l| l.geometry),
+        colour_bpv: per_vertex(|l| l.colour),
+        base_bpv: (levels[0].bytes as usize + encoded.header.byte_len()) as f64 * 8.0 / n,
+        total_bpv: encoded.bytes.len() as f64 * 8.0 / n,
+        encode_ms: median(encode_ms),
+        decode_ms: median(decode_ms),
+        peak_rss_mib: peak_rss_mib(),
+    };
+    println!("{}", serde_json::to_string(&result)?);
+    Ok(())
+}
+
+fn mesh_files(inputs: &[PathBuf]) -> anyhow::Result<Vec<PathBuf>> {
+    let is_mesh = |p: &Path| {
+        matches!(
+            p.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).as_deref(),
+            Some("ply" | "obj" | "off" | "gltf" | "glb")
+        )
+    };
+    let mut out = Vec::new();
+    for input in inputs {
+        if input.is_dir() {
+            let mut entries: Vec<PathBuf> = std::fs::read_dir(input)?.filter_map(|e| Some(e.ok()?.path())).collect();
+            entries.sort();
+            for e in entries {
+                if e.is_dir() {
+                    out.extend(mesh_files(&[e])?);
+                } else if is_mesh(&e) {
+                    out.push(e);
+                }
+            }
+        } else {
+            out.push(input.clone());
+        }
+    }
+    Ok(out)
+}
+
+/// Draco's bits per vertex and decode speed per mesh file name.
+fn run_draco(script: &Path, files: &[PathBuf], bits: u8) -> anyhow::Result<HashMap<String, (f64, f64)>> {
+    let out = Command::new("python3")
+        .arg(script)
+        .arg("--bits")
+        .arg(bits.to_string())
+        .args(files)
+        .output()
+        .context("running python3 for Draco")?;
+    if !out.status.success() {
+        bail!("Draco script failed: {}", String::from_utf8_lossy(&out.stderr));
+    }
+    let mut map = HashMap::new();
+    for line in String::from_utf8_lossy(&out.stdout).lines().skip(1) {
+        let cols: Vec<&str> = line.split('\t').collect();
+        if cols.len() >= 9 {
+            let name = Path::new(cols[0]).file_name().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
+            map.insert(name, (cols[5].parse().unwrap_or(f64::NAN), cols[8].parse().unwrap_or(f64::NAN)));
+        }
+    }
+    Ok(map)
+}
+
+pub fn run(args: BenchArgs) -> anyhow::Result<()> {
+    let files = mesh_files(&args.inputs)?;
+    let exe = std::env::current_exe()?;
+    let mut results = Vec::new();
+    for file in &files {
+        eprintln!("bench {}", file.display());
+        let out = Command::new(&exe)
+            .arg("bench-one")
+            .arg(file)
+            .args(["--bits", &args.bits.to_string(), "--runs", &args.runs.to_string()])
+            .output()?;
+        if !out.status.success() {
+            eprintln!("  skipped: {}", String::from_utf8_lossy(&out.stderr).trim());
+            continue;
+        }
+        results.push(serde_json::from_slice::<BenchResult>(&out.stdout)?);
+    }
+    let draco = match &args.draco {
+        Some(script) => Some(run_draco(script, &files, args.bits)?),
+        None => None,
+    };
+    let table = markdown(&results, draco.as_ref(), args.bits, args.runs);
+    println!("{table}");
+    if let Some(path) = &args.markdown {
+        std::fs::write(path, &table)?;
+    }
+    Ok(())
+}
+
+fn markdown(results: &[BenchResult], draco: Option<&HashMap<String, (f64, f64)>>, bits: u8, runs: usize) -> String {
+    let mut s = format!(
+        "{bits}-bit quantization; speeds are the median of {runs} runs on one core; bits per vertex (b/v) over the final vertex count.\n\n"
+    );
+    s += "| mesh | vertices | levels | base v | conn b/v | geom b/v | colour b/v | base b/v | total b/v |";
+    if draco.is_some() {
+        s += " Draco b/v | ours / Draco |";
+    }
+    s += " encode Mv/s | decode Mv/s |";
+    if draco.is_some() {
+        s += " Draco decode Mv/s |";
+    }
+    s += " peak MiB |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|";
+    if draco.is_some() {
+        s += "---:|---:|";
+    }
+    s += "---:|---:|";
+    if draco.is_some() {
+        s += "---:|";
+    }
+    s += "---:|\n";
+    let mut sums = [0.0; 3];
+    for r in results {
+        let mv = |ms: f64| r.vertices as f64 / ms / 1e3;
+        s += &format!(
+            "| {} | {} | {} | {} | {:.2} | {:.2} | {:.2} | {:.2} | {:.2} |",
+            r.name, r.vertices, r.levels, r.base_vertices, r.connectivity_bpv, r.geometry_bpv, r.colour_bpv, r.base_bpv, r.total_bpv
+        );
+        let peer = draco.and_then(|d| d.get(&r.name));
+        if draco.is_some() {
+            match peer {
+                Some((bpv, _)) => s += &format!(" {bpv:.2} | {:.3} |", r.total_bpv / bpv),
+                None => s += " – | – |",
+            }
+        }
+        s += &format!(" {:.2} | {:.2} |", mv(r.encode_ms), mv(r.decode_ms));
+        if draco.is_some() {
+            match peer {
+                Some((_, speed)) => s += &format!(" {speed:.2} |"),
+                None => s += " – |",
+            }
+        }
+        s += &format!(" {:.0} |\n", r.peak_rss_mib);
+        sums[0] += r.connectivity_bpv;
+        sums[1] += r.total_bpv;
+        sums[2] += 1.0;
+    }
+    if sums[2] > 0.0 {
+        s += &format!(
+            "\nMean connectivity {:.2} b/v, mean total {:.2} b/v over {} meshes.\n",
+            sums[0] / sums[2],
+            sums[1] / sums[2],
+            sums[2]
+        );
+    }
+    s
+}

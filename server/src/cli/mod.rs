@@ -1,0 +1,38 @@
+//! The codec commands: encode, decode, inspect, bench.
+
+pub mod bench;
+pub mod decode;
+pub mod dump;
+pub mod encode;
+pub mod inspect;
+pub mod sample;
+
+use anyhow::Context;
+use std::path::Path;
+use vitrine_codec::import::{import_path, ImportOptions};
+use vitrine_codec::repair::{prepare, RepairOptions, RepairReport};
+use vitrine_codec::IndexedMesh;
+
+/// Reads any supported mesh file and repairs it into an encodable manifold.
+pub fn load_mesh(path: &Path) -> anyhow::Result<(IndexedMesh, RepairReport)> {
+    let mesh = import_path(path, &ImportOptions::default()).with_context(|| format!("reading {}", path.display()))?;
+    prepare(mesh, &RepairOptions::default()).with_context(|| format!("repairing {}", path.display()))
+}
+
+/// Human summary of what repair changed, or `None` when nothing did.
+pub fn describe_repair(r: &RepairReport) -> Option<String> {
+    let parts: Vec<String> = [
+        (r.welded_vertices, "vertices welded"),
+        (r.degenerate_faces, "degenerate faces dropped"),
+        (r.duplicate_faces, "duplicate faces dropped"),
+        (r.non_manifold_edges, "non-manifold edges split"),
+        (r.non_manifold_vertices, "non-manifold vertices split"),
+        (r.unreferenced_vertices, "unreferenced vertices dropped"),
+        (r.flipped_faces, "faces reoriented"),
+    ]
+    .iter()
+    .filter(|(n, _)| *n > 0)
+    .map(|(n, what)| format!("{n} {what}"))
+    .collect();
+    (!parts.is_empty()).then(|| parts.join(", "))
+}

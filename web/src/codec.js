@@ -1,0 +1,147 @@
+// @ts-check
+/**
+ * The Vitrine decoder compiled to WebAssembly (crate `vitrine-wasm`), behind a
+ * small promise-free API. Works in browsers, Web Workers and Node.
+ *
+ * Buffers returned by a level are copies: they stay valid after later calls
+ * and can be transferred to another thread.
+ */
+
+const POSITIONS = 0;
+const COLOURS = 1;
+const INDICES = 2;
+
+/**
+ * @typedef {object} Level
+ * @property {number} level      batches applied (0 = base mesh)
+ * @property {number} vertices
+ * @property {Float32Array} positions  x, y, z per vertex
+ * @property {Uint8Array | null} colours  r, g, b per vertex
+ * @property {Uint32Array} indices   three per triangle
+ */
+
+export class DecodeError extends Error {}
+
+export class VitrineCodec {
+  /** @param {WebAssembly.Instance} instance */
+  constructor(instance) {
+    /** @type {any} */
+    this.exports = instance.exports;
+  }
+
+  /**
+   * @param {WebAssembly.Module | BufferSource} module compiled module or wasm bytes
+   * @returns {Promise<VitrineCodec>}
+   */
+  static async instantiate(module) {
+    const compiled = module instanceof WebAssembly.Module ? module : await WebAssembly.compile(module);
+    const instance = await WebAssembly.instantiate(compiled, {});
+    return new VitrineCodec(instance);
+  }
+
+  /** @returns {Uint8Array} */
+  memory() {
+    return new Uint8Array(this.exports.memory.buffer);
+  }
+
+  /** @param {Uint8Array} bytes */
+  #write(bytes) {
+    const ptr = this.exports.input_reserve(bytes.length);
+    this.memory().set(bytes, ptr);
+  }
+
+  #error() {
+    const ptr = this.exports.error_ptr();
+    const len = this.exports.error_len();
+    return new DecodeError(new TextDecoder().decode(this.memory().slice(ptr, ptr + len)));
+  }
+
+  /**
+   * Starts decoding from the stream's header + base mesh.
+   * @param {Uint8Array} base
+   * @returns {StreamDecoder}
+   */
+  decoder(base) {
+    this.#write(base);
+    const handle = this.exports.decoder_new(base.length);
+    if (handle === 0) throw this.#error();
+    return new StreamDecoder(this, handle);
+  }
+
+  /**
+   * @param {number} handle
+   * @param {Uint8Array} batch
+   */
+  apply(handle, batch) {
+    this.#write(batch);
+    if (this.exports.decoder_apply(handle, batch.length) !== 0) throw this.#error();
+  }
+
+  /**
+   * @param {number} handle
+   * @param {number} kind
+   * @param {number} bytesPerElement
+   */
+  copyBuffer(handle, kind, bytesPerElement) {
+    const ptr = this.exports.buffer_ptr(handle, kind);
+    const len = this.exports.buffer_len(handle, kind);
+    if (ptr === 0 && len === 0) return null;
+    return this.exports.memory.buffer.slice(ptr, ptr + len * bytesPerElement);
+  }
+}
+
+export class StreamDecoder {
+  /**
+   * @param {VitrineCodec} codec
+   * @param {number} handle
+   */
+  constructor(codec, handle) {
+    this.codec = codec;
+    this.handle = handle;
+  }
+
+  /** Applies the next refinement batch. @param {Uint8Array} batch */
+  apply(batch) {
+    this.codec.apply(this.handle, batch);
+  }
+
+  /** @returns {Level} */
+  level() {
+    const e = this.codec.exports;
+    const positions = this.codec.copyBuffer(this.handle, POSITIONS, 4);
+    const colours = this.codec.copyBuffer(this.handle, COLOURS, 1);
+    const indices = this.codec.copyBuffer(this.handle, INDICES, 4);
+    return {
+      level: e.decoder_level(this.handle),
+      vertices: e.decoder_vertices(this.handle),
+      positions: new Float32Array(/** @type {ArrayBuffer} */ (positions)),
+      colours: colours ? new Uint8Array(colours) : null,
+      indices: new Uint32Array(/** @type {ArrayBuffer} */ (indices)),
+    };
+  }
+
+  free() {
+    this.codec.exports.decoder_free(this.handle);
+  }
+}
+
+/**
+ * Splits a whole stream file into its base part and batches, reading only
+ * the level table (see codec/FORMAT.md).
+ * @param {Uint8Array} stream
+ */
+export function splitStream(stream) {
+  const view = new DataView(stream.buffer, stream.byteOffset, stream.byteLength);
+  const magic = String.fromCharCode(...stream.subarray(0, 4));
+  if (magic !== 'VTRN') throw new DecodeError('not a Vitrine stream');
+  const batches = view.getUint32(24, true);
+  const headerLen = 40 + 12 * batches;
+  let at = headerLen;
+  const parts = [];
+  for (let k = 0; k <= batches; k++) {
+    const bytes = view.getUint32(28 + 12 * k + 8, true);
+    parts.push(stream.subarray(k === 0 ? 0 : at, at + bytes));
+    at += bytes;
+  }
+  return { base: parts[0], batches: parts.slice(1) };
+}
