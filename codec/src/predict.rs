@@ -5,13 +5,22 @@ use crate::entropy::{BitModel, IntModel, RangeDecoder, RangeEncoder, SymbolModel
 use crate::frenet::Frame;
 use crate::patch::{Tag, MAX_VALENCE};
 
-/// Context for a gate: the retriangulation tags of its two vertices.
+/// Context for a gate's code: the tags of its two vertices and of the
+/// third vertex of its front face *as the decoder sees it* (the coarse
+/// mesh). The encoder knows that vertex once it has decided the code: the
+/// front vertex for a null patch, the pattern's third vertex for a patch.
+/// An untagged third vertex is still free, which makes a patch likely; a
+/// tagged one was conquered, which a null patch then requires.
 #[inline]
-pub(crate) fn gate_context(t0: Tag, t1: Tag) -> usize {
-    (t0 as usize % 3) * 3 + (t1 as usize % 3)
+pub(crate) fn gate_context(t0: Tag, t1: Tag, third: Tag) -> usize {
+    (t0 as usize % 3) * 9 + (t1 as usize % 3) * 3 + (third as usize % 3)
 }
 
-pub(crate) const GATE_CONTEXTS: usize = 9;
+pub(crate) const GATE_CONTEXTS: usize = 27;
+
+/// Residual magnitude grows with the patch's size: code each size class
+/// (≈ log2 of the mean border edge length) with its own models.
+pub(crate) const SCALE_CLASSES: usize = 16;
 /// Decimation symbols: 0 = null patch, `valence − 2` otherwise (1..=4).
 pub(crate) const DECIMATION_SYMBOLS: usize = MAX_VALENCE - 1;
 
@@ -20,8 +29,8 @@ pub(crate) const DECIMATION_SYMBOLS: usize = MAX_VALENCE - 1;
 pub(crate) struct PassModels {
     pub valence: Vec<SymbolModel>,
     pub cleaning: [BitModel; GATE_CONTEXTS],
-    pub tangent: IntModel,
-    pub normal: IntModel,
+    pub tangent: Vec<IntModel>,
+    pub normal: Vec<IntModel>,
     pub colour: [IntModel; 3],
 }
 
@@ -30,8 +39,8 @@ impl PassModels {
         PassModels {
             valence: (0..GATE_CONTEXTS).map(|_| SymbolModel::new(DECIMATION_SYMBOLS)).collect(),
             cleaning: [BitModel::default(); GATE_CONTEXTS],
-            tangent: IntModel::new(),
-            normal: IntModel::new(),
+            tangent: (0..SCALE_CLASSES).map(|_| IntModel::new()).collect(),
+            normal: (0..SCALE_CLASSES).map(|_| IntModel::new()).collect(),
             colour: [IntModel::new(), IntModel::new(), IntModel::new()],
         }
     }
@@ -41,6 +50,7 @@ impl PassModels {
 pub(crate) struct PatchPrediction {
     pub position: [i64; 3],
     frame: Frame,
+    scale: usize,
 }
 
 impl PatchPrediction {
@@ -65,23 +75,30 @@ impl PatchPrediction {
             normal[2] += a[0] * b[1] - a[1] * b[0];
         }
         let tangent = rel(&polygon[1]);
-        PatchPrediction { position, frame: Frame::new(normal, tangent) }
+        let mut squared = 0u64;
+        for i in 0..polygon.len() {
+            let (a, b) = (polygon[i], polygon[(i + 1) % polygon.len()]);
+            squared += (0..3).map(|k| ((a[k] - b[k]) as i64).pow(2) as u64).sum::<u64>();
+        }
+        let mean = squared / polygon.len() as u64;
+        let scale = (((64 - mean.leading_zeros()) / 2) as usize).min(SCALE_CLASSES - 1);
+        PatchPrediction { position, frame: Frame::new(normal, tangent), scale }
     }
 
     pub(crate) fn encode(&self, actual: [i32; 3], m: &mut PassModels, enc: &mut RangeEncoder) {
         let r = [0, 1, 2].map(|k| actual[k] as i64 - self.position[k]);
         let l = self.frame.to_local(r);
-        enc.encode_int(&mut m.tangent, l[0] as i32);
-        enc.encode_int(&mut m.tangent, l[1] as i32);
-        enc.encode_int(&mut m.normal, l[2] as i32);
+        enc.encode_int(&mut m.tangent[self.scale], l[0] as i32);
+        enc.encode_int(&mut m.tangent[self.scale], l[1] as i32);
+        enc.encode_int(&mut m.normal[self.scale], l[2] as i32);
     }
 
     /// Returns `None` when the decoded position falls outside `[0, max]`: a corrupt stream.
     pub(crate) fn decode(&self, max: i32, m: &mut PassModels, dec: &mut RangeDecoder) -> Option<[i32; 3]> {
         let l = [
-            dec.decode_int(&mut m.tangent) as i64,
-            dec.decode_int(&mut m.tangent) as i64,
-            dec.decode_int(&mut m.normal) as i64,
+            dec.decode_int(&mut m.tangent[self.scale]) as i64,
+            dec.decode_int(&mut m.tangent[self.scale]) as i64,
+            dec.decode_int(&mut m.normal[self.scale]) as i64,
         ];
         let r = self.frame.to_world(l);
         let mut out = [0i32; 3];

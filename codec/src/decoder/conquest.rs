@@ -105,7 +105,8 @@ impl Level {
         let tag_of = |scratch: &Scratch, v: u32| scratch.tag.get(v as usize).copied().unwrap_or(Tag::None);
         let t0 = tag_of(scratch, self.conn.origin[g as usize]);
         let t1 = tag_of(scratch, self.conn.target(g));
-        let ctx = gate_context(t0, t1);
+        let front = self.conn.origin[prev(g) as usize];
+        let ctx = gate_context(t0, t1, tag_of(scratch, front));
         let valence = match kind {
             PassKind::Decimating => match s.conn.decode_symbol(&mut s.models.valence[ctx]) {
                 0 => 0,
@@ -121,7 +122,6 @@ impl Level {
         };
         if valence == 0 {
             scratch.face_done[f as usize] = true;
-            let front = self.conn.origin[prev(g) as usize];
             conquer(scratch, front, Tag::Plus);
             for h in [next(g), prev(g)] {
                 let t = self.conn.twin[h as usize];

@@ -122,6 +122,15 @@ impl Simplifier {
             }
         }
         out.connectivity = streams.conn.finish();
+        if std::env::var_os("VITRINE_DEBUG_PASSES").is_some() {
+            eprintln!(
+                "{kind:?}: live {} removed {} conn bytes {} geom bytes {}",
+                self.live_vertices,
+                out.removed.len(),
+                out.connectivity.len(),
+                streams.geom.clone().finish().len()
+            );
+        }
         out.geometry = streams.geom.finish();
         out.colour = streams.colour.finish();
         out
@@ -150,8 +159,10 @@ impl Simplifier {
         }
         let t0 = self.tag[self.conn.origin[g as usize] as usize];
         let t1 = self.tag[self.conn.target(g) as usize];
-        let ctx = gate_context(t0, t1);
         if let Some(patch) = self.removable(g, kind, t0, t1) {
+            let pat = patch.pattern;
+            let third = pat.corner_vertex(3 * pat.gate_triangle as usize + (pat.gate_corner as usize + 2) % 3);
+            let ctx = gate_context(t0, t1, self.tag[patch.polygon[third] as usize]);
             match kind {
                 PassKind::Decimating => s.conn.encode_symbol(&mut s.models.valence[ctx], patch.valence - 2),
                 PassKind::Cleaning => s.conn.encode_bit(&mut s.models.cleaning[ctx], true),
@@ -160,13 +171,14 @@ impl Simplifier {
             removed.push(patch.centre);
             self.remove(&patch, gates);
         } else {
+            let front = self.conn.origin[prev(g) as usize];
+            let ctx = gate_context(t0, t1, self.tag[front as usize]);
             match kind {
                 PassKind::Decimating => s.conn.encode_symbol(&mut s.models.valence[ctx], 0),
                 PassKind::Cleaning => s.conn.encode_bit(&mut s.models.cleaning[ctx], false),
             }
             // Null patch: conquer the front face and go on through its other two edges.
             self.face_done[f as usize] = true;
-            let front = self.conn.origin[prev(g) as usize];
             self.conquer(front, Tag::Plus);
             for h in [next(g), prev(g)] {
                 let t = self.conn.twin[h as usize];
