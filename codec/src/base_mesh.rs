@@ -74,9 +74,16 @@ pub(crate) fn decode(
     let mut dec = RangeDecoder::new(payload)?;
     let mut corner = IntModel::new();
     let mut next_new = 0u32;
-    // Counts were checked against the Limits and the level table by the caller.
-    let mut triangles = Vec::with_capacity(faces as usize);
-    for _ in 0..faces {
+    // Counts were checked against the Limits and the level table by the
+    // caller, but the Limits may be generous and the bytes few: reserve no
+    // more than one face per payload byte up front (growth is then paid for
+    // by decoded faces), and stop once the payload has run out rather than
+    // decoding billions of faces from the zeros past its end.
+    let mut triangles = Vec::with_capacity((faces as usize).min(payload.len()));
+    for f in 0..faces {
+        if f % 256 == 0 {
+            dec.check_overrun()?;
+        }
         let mut t = [0u32; 3];
         for v in &mut t {
             let back = dec.decode_int(&mut corner);
@@ -99,7 +106,10 @@ pub(crate) fn decode(
     let mut axis = [IntModel::new(), IntModel::new(), IntModel::new()];
     let mut prev = [0i32; 3];
     let mut positions = Vec::with_capacity(vertices as usize);
-    for _ in 0..vertices {
+    for v in 0..vertices {
+        if v % 256 == 0 {
+            dec.check_overrun()?;
+        }
         let mut p = [0i32; 3];
         for k in 0..3 {
             p[k] = prev[k].wrapping_add(dec.decode_int(&mut axis[k]));

@@ -51,35 +51,41 @@ impl Connectivity {
             }
             origin.extend_from_slice(t);
         }
+        // Outgoing half-edges per vertex in CSR form; a half-edge a → b finds
+        // its twin among b's outgoing ones. Linear time, unlike sorting edge keys.
+        let mut first = vec![0u32; vertex_count + 1];
+        for &v in &origin {
+            first[v as usize + 1] += 1;
+        }
+        for v in 0..vertex_count {
+            first[v + 1] += first[v];
+        }
+        let mut fill = first.clone();
+        let mut outgoing = vec![0u32; origin.len()];
+        for (h, &v) in origin.iter().enumerate() {
+            outgoing[fill[v as usize] as usize] = h as u32;
+            fill[v as usize] += 1;
+        }
         let mut twin = vec![NONE; origin.len()];
-        // Sort half-edges by undirected edge; equal keys must come in
-        // opposite-direction pairs.
-        let mut keys: Vec<(u64, u32)> = (0..origin.len() as u32)
-            .map(|h| {
-                let (a, b) = (origin[h as usize], origin[next(h) as usize]);
-                (((a.min(b) as u64) << 32) | a.max(b) as u64, h)
-            })
-            .collect();
-        keys.sort_unstable();
-        let mut i = 0;
-        while i < keys.len() {
-            let mut j = i + 1;
-            while j < keys.len() && keys[j].0 == keys[i].0 {
-                j += 1;
+        for h in 0..origin.len() as u32 {
+            let (a, b) = (origin[h as usize], origin[next(h) as usize]);
+            let mut same = 0;
+            let mut found = NONE;
+            for &g in &outgoing[first[a as usize] as usize..first[a as usize + 1] as usize] {
+                same += u32::from(origin[next(g) as usize] == b);
             }
-            match j - i {
-                1 => {}
-                2 => {
-                    let (h, g) = (keys[i].1, keys[i + 1].1);
-                    if origin[h as usize] == origin[g as usize] {
-                        return Err(non_manifold("inconsistently oriented", &origin, h));
+            for &g in &outgoing[first[b as usize] as usize..first[b as usize + 1] as usize] {
+                if origin[next(g) as usize] == a {
+                    if found != NONE {
+                        return Err(non_manifold("shared by more than two faces", &origin, h));
                     }
-                    twin[h as usize] = g;
-                    twin[g as usize] = h;
+                    found = g;
                 }
-                _ => return Err(non_manifold("shared by more than two faces", &origin, keys[i].1)),
             }
-            i = j;
+            if same > 1 {
+                return Err(non_manifold("inconsistently oriented or shared by more than two faces", &origin, h));
+            }
+            twin[h as usize] = found;
         }
         let mut out = vec![NONE; vertex_count];
         for (h, &v) in origin.iter().enumerate() {

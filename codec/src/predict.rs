@@ -74,7 +74,6 @@ impl PatchPrediction {
             normal[1] += a[2] * b[0] - a[0] * b[2];
             normal[2] += a[0] * b[1] - a[1] * b[0];
         }
-        let tangent = rel(&polygon[1]);
         let mut squared = 0u64;
         for i in 0..polygon.len() {
             let (a, b) = (polygon[i], polygon[(i + 1) % polygon.len()]);
@@ -82,7 +81,7 @@ impl PatchPrediction {
         }
         let mean = squared / polygon.len() as u64;
         let scale = (((64 - mean.leading_zeros()) / 2) as usize).min(SCALE_CLASSES - 1);
-        PatchPrediction { position, frame: Frame::new(normal, tangent), scale }
+        PatchPrediction { position, frame: Frame::new(normal), scale }
     }
 
     pub(crate) fn encode(&self, actual: [i32; 3], m: &mut PassModels, enc: &mut RangeEncoder) {

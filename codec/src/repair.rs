@@ -271,7 +271,9 @@ fn validate(mesh: &IndexedMesh, what: &'static str) -> Result<()> {
             ));
         }
     }
-    if n >= NONE as usize || mesh.triangles.len() >= (NONE / 3) as usize {
+    // Half-edge ids (3 per face) and vertex ids after splitting (at most
+    // 3 more per face) must stay below u32::MAX.
+    if n as u64 + 3 * mesh.triangles.len() as u64 >= NONE as u64 {
         return Err(Error::Limit(format!(
             "{n} vertices and {} triangles: at most 2^32 vertices and 2^32/3 triangles",
             mesh.triangles.len()
@@ -755,6 +757,18 @@ mod tests {
         want[4] = [t[1], t[2], t[0]]; // swapped (0,1), then flipped (1,2)
         assert_eq!(out.triangles, want);
         check_manifold(&out).unwrap();
+    }
+
+    #[test]
+    fn extra_face_in_the_same_fans_is_detached() {
+        // Edge 1–2 has three faces, and the extra one is joined to the kept
+        // pair around both ends, so splitting fans cannot separate it.
+        let p = (0..5).map(|i| [i as f32, (i * i) as f32, 0.0]).collect();
+        let t = vec![[4, 1, 2], [3, 1, 2], [2, 0, 3], [0, 1, 3], [0, 2, 1]];
+        let (out, report) = prepare(mesh(p, t), &RepairOptions::default()).unwrap();
+        check_manifold(&out).unwrap();
+        assert!(report.non_manifold_edges >= 1, "{report:?}");
+        assert!(report.split_vertices >= 1, "{report:?}");
     }
 
     #[test]

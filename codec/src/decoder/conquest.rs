@@ -47,6 +47,13 @@ struct Streams<'a> {
 impl Level {
     pub(crate) fn undo_pass(&mut self, pass: &PassInput, scratch: &mut Scratch) -> Result<()> {
         let n = self.vertex_count();
+        if pass.seeds.is_empty() {
+            // A skipped pass (the encoder found nothing worth a traversal).
+            return match pass.inserted {
+                0 => Ok(()),
+                _ => Err(Error::stream("pass without seeds claims inserted vertices")),
+            };
+        }
         let target = n + pass.inserted as usize;
         scratch.state.clear();
         scratch.state.resize(n, FREE);

@@ -31,15 +31,23 @@ pub(crate) struct PassOutput {
     pub colour: Vec<u8>,
 }
 
+impl PassOutput {
+    /// A pass that removes nothing: the decoder skips it.
+    pub(crate) fn empty() -> Self {
+        PassOutput { seeds: Vec::new(), removed: Vec::new(), connectivity: Vec::new(), geometry: Vec::new(), colour: Vec::new() }
+    }
+}
+
 /// The mesh being simplified, with input-vertex ids throughout.
 pub(crate) struct Simplifier {
     pub conn: Connectivity,
+    /// Input-vertex id of each current vertex (the mesh is compacted per layer).
+    pub ids: Vec<u32>,
     pub positions: Vec<[i32; 3]>,
     pub colours: Option<Vec<[u8; 3]>>,
     pub geometric_guard: bool,
     pub live_vertices: usize,
     pub live_faces: usize,
-    free_slots: Vec<u32>,
     state: Vec<u8>,
     tag: Vec<Tag>,
     face_done: Vec<bool>,
@@ -73,12 +81,12 @@ impl Simplifier {
         let live_faces = conn.face_count_slots();
         Simplifier {
             conn,
+            ids: (0..n as u32).collect(),
             positions,
             colours,
             geometric_guard,
             live_vertices: n,
             live_faces,
-            free_slots: Vec::new(),
             state: vec![FREE; n],
             tag: vec![Tag::None; n],
             face_done: Vec::new(),
@@ -105,7 +113,7 @@ impl Simplifier {
             geometry: Vec::new(),
             colour: Vec::new(),
         };
-        let mut gates = VecDeque::new();
+        let mut gates = VecDeque::with_capacity(self.conn.face_count_slots());
         for f in 0..self.conn.face_count_slots() as u32 {
             if !self.conn.face_alive(f) || self.face_done[f as usize] {
                 continue;
@@ -121,6 +129,9 @@ impl Simplifier {
                 self.process_gate(g, kind, &mut gates, &mut streams, &mut out.removed);
             }
         }
+        for v in out.removed.iter_mut().chain(out.seeds.iter_mut().flatten()) {
+            *v = self.ids[*v as usize];
+        }
         out.connectivity = streams.conn.finish();
         if std::env::var_os("VITRINE_DEBUG_PASSES").is_some() {
             eprintln!(
@@ -134,6 +145,79 @@ impl Simplifier {
         out.geometry = streams.geom.finish();
         out.colour = streams.colour.finish();
         out
+    }
+
+    /// Drops dead vertices and face slots so later passes walk dense,
+    /// cache-friendly arrays; order is kept, so output does not change.
+    pub(crate) fn compact(&mut self) {
+        let mut vertex_map = vec![NONE; self.ids.len()];
+        let mut kept = 0u32;
+        for (v, m) in vertex_map.iter_mut().enumerate() {
+            if self.conn.out[v] != NONE {
+                *m = kept;
+                self.ids[kept as usize] = self.ids[v];
+                self.positions[kept as usize] = self.positions[v];
+                if let Some(c) = &mut self.colours {
+                    c[kept as usize] = c[v];
+                }
+                kept += 1;
+            }
+        }
+        let n = kept as usize;
+        self.ids.truncate(n);
+        self.positions.truncate(n);
+        if let Some(c) = &mut self.colours {
+            c.truncate(n);
+        }
+        let slots = self.conn.face_count_slots();
+        let mut face_map = vec![NONE; slots];
+        let mut faces = 0u32;
+        for (f, m) in face_map.iter_mut().enumerate() {
+            if self.conn.face_alive(f as u32) {
+                *m = faces;
+                faces += 1;
+            }
+        }
+        let remap_half_edge = |h: u32| if h == NONE { NONE } else { 3 * face_map[face(h) as usize] + h % 3 };
+        let mut origin = Vec::with_capacity(3 * faces as usize);
+        let mut twin = Vec::with_capacity(3 * faces as usize);
+        for f in 0..slots {
+            if face_map[f] != NONE {
+                for k in 0..3 {
+                    origin.push(vertex_map[self.conn.origin[3 * f + k] as usize]);
+                    twin.push(remap_half_edge(self.conn.twin[3 * f + k]));
+                }
+            }
+        }
+        let mut out = vec![NONE; n];
+        for (v, &h) in self.conn.out.iter().enumerate() {
+            if h != NONE {
+                out[vertex_map[v] as usize] = remap_half_edge(h);
+            }
+        }
+        self.conn = Connectivity { origin, twin, out };
+        self.state.truncate(n);
+        self.tag.truncate(n);
+    }
+
+    /// Interior vertices of valence 3: what a cleaning pass could remove.
+    pub(crate) fn valence_three_vertices(&self) -> usize {
+        (0..self.conn.out.len() as u32)
+            .filter(|&v| {
+                let start = self.conn.out[v as usize];
+                if start == NONE {
+                    return false;
+                }
+                let mut h = start;
+                for _ in 0..3 {
+                    h = self.conn.rotate_ccw(h);
+                    if h == NONE {
+                        return false;
+                    }
+                }
+                h == start
+            })
+            .count()
     }
 
     fn conquer(&mut self, v: u32, tag: Tag) {
@@ -293,7 +377,6 @@ impl Simplifier {
                 self.conn.origin[3 * f as usize + k] = NONE;
                 self.conn.twin[3 * f as usize + k] = NONE;
             }
-            self.free_slots.push(f);
         }
         let half_edge = |corner: usize| 3 * old_faces[corner / 3] + (corner % 3) as u32;
         for corner in 0..3 * kept {

@@ -9,6 +9,9 @@ use crate::quantize::Quantization;
 use crate::{Error, IndexedMesh, Result};
 use conquest::{PassKind, PassOutput, Simplifier};
 
+/// Below this fraction of valence-3 vertices a layer skips its cleaning conquest.
+const CLEANING_MIN_FRACTION: f64 = 0.1;
+
 /// How small the base mesh should get.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum BaseTarget {
@@ -104,36 +107,44 @@ pub fn encode_with_progress(
     }
     .max(options.min_base_vertices as usize);
 
-    let mut s = Simplifier::new(conn, positions, mesh.colors.clone(), options.geometric_guard);
+    let mut s = Simplifier::new(conn, positions.clone(), mesh.colors.clone(), options.geometric_guard);
     let mut layers = Vec::new();
     while s.live_vertices > target && layers.len() < options.max_layers as usize {
         let before = s.live_vertices;
         let decimating = s.run_pass(PassKind::Decimating);
-        let cleaning = s.run_pass(PassKind::Cleaning);
+        // A cleaning traversal costs a code per face; skip it when few
+        // valence-3 vertices exist to be removed (common on irregular scans).
+        let cleaning = if (s.valence_three_vertices() as f64) < CLEANING_MIN_FRACTION * s.live_vertices as f64 {
+            PassOutput::empty()
+        } else {
+            s.run_pass(PassKind::Cleaning)
+        };
         let removed = before - s.live_vertices;
         if removed == 0 {
             break;
         }
         layers.push(Layer { decimating, cleaning, faces_after: s.live_faces });
+        s.compact();
         progress(EncodeProgress { layer: layers.len() as u32, vertices: s.live_vertices, input_vertices });
         if (removed as f64) < before as f64 * options.min_layer_fraction as f64 {
             break;
         }
     }
     let _ = layers.last().map(|l| l.faces_after);
-    Ok(write_stream(&s, &layers, quantization, input_vertices, mesh))
+    Ok(write_stream(&s, &layers, quantization, &positions, mesh))
 }
 
 fn write_stream(
     s: &Simplifier,
     layers: &[Layer],
     quantization: Quantization,
-    input_vertices: usize,
+    quantized: &[[i32; 3]],
     mesh: &IndexedMesh,
 ) -> Encoded {
+    let input_vertices = quantized.len();
     // Final numbering: base vertices by first appearance, then each batch's
     // vertices in insertion order (coarsest layer first, cleaning before decimation).
-    let base_triangles: Vec<[u32; 3]> = s.conn.triangles().collect();
+    let base_triangles: Vec<[u32; 3]> = s.conn.triangles().map(|t| t.map(|v| s.ids[v as usize])).collect();
     let mut vertex_order = base_mesh::first_appearance_order(input_vertices, &base_triangles);
     let base_vertices = vertex_order.len();
     for layer in layers.iter().rev() {
@@ -145,7 +156,7 @@ fn write_stream(
         new_id[old as usize] = new as u32;
     }
     let base = BaseMesh {
-        positions: vertex_order[..base_vertices].iter().map(|&v| s.positions[v as usize]).collect(),
+        positions: vertex_order[..base_vertices].iter().map(|&v| quantized[v as usize]).collect(),
         colours: mesh
             .colors
             .as_ref()

@@ -505,9 +505,6 @@ fn read_payload<S: Source>(
                 ),
             }
         };
-        if e.props.is_empty() {
-            continue; // no payload at all
-        }
         match e.name.as_str() {
             "vertex" if !seen_vertex => {
                 seen_vertex = true;
@@ -641,6 +638,7 @@ fn read_payload<S: Source>(
                     }
                 }
             }
+            _ if e.props.is_empty() => {} // no payload at all
             _ => {
                 // Unknown element (or a second vertex element): skip its records.
                 for i in 0..count {
@@ -779,6 +777,19 @@ mod tests {
         .unwrap();
         // (0,1,2), (1,2,2) and (2,2,3) dropped, then (2,3,4) in odd position.
         assert_eq!(m.triangles, vec![[0, 1, 2], [3, 2, 4]]);
+    }
+
+    #[test]
+    fn elements_without_properties() {
+        let e = read_str("ply\nformat ascii 1.0\nelement vertex 3\nelement face 1\nend_header\n")
+            .unwrap_err();
+        assert!(e.to_string().contains("no scalar \"x\""), "{e}");
+        let e = read_str(
+            "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\n\
+             property float z\nelement face 1\nend_header\n0 0 0\n",
+        )
+        .unwrap_err();
+        assert!(e.to_string().contains("no vertex_indices"), "{e}");
     }
 
     #[test]

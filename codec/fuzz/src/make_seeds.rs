@@ -1,0 +1,103 @@
+//! Writes seed inputs for the fuzz targets: `make_seeds DIR` creates
+//! `DIR/<target>/seed-*` (existing files are overwritten). Streams come from
+//! the current encoder, so the seeds follow format changes.
+
+use std::path::Path;
+
+use vitrine_codec::export::{write_glb, write_obj, write_ply};
+use vitrine_codec::samples::{icosphere, plate_with_tunnels};
+use vitrine_codec::{encode, EncodeOptions, StreamIndex};
+use vitrine_codec_fuzz::{sample_meshes, sample_streams};
+
+fn base64(data: &[u8]) -> String {
+    const T: &[u8; 64] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    let mut s = String::new();
+    for c in data.chunks(3) {
+        let b = [c[0], *c.get(1).unwrap_or(&0), *c.get(2).unwrap_or(&0)];
+        let n = (b[0] as u32) << 16 | (b[1] as u32) << 8 | b[2] as u32;
+        for k in 0..4 {
+            s.push(if k <= c.len() { T[(n >> (18 - 6 * k) & 63) as usize] as char } else { '=' });
+        }
+    }
+    s
+}
+
+fn main() {
+    let dir = std::env::args().nth(1).expect("usage: make_seeds DIR");
+    let write = |target: &str, name: &str, bytes: &[u8]| {
+        let d = Path::new(&dir).join(target);
+        std::fs::create_dir_all(&d).unwrap();
+        std::fs::write(d.join(format!("seed-{name}")), bytes).unwrap();
+    };
+
+    // decode_stream: whole streams.
+    for (i, s) in sample_streams().iter().enumerate() {
+        write("decode_stream", &format!("sample-{i}"), s);
+    }
+    let plate = encode(&plate_with_tunnels(1, 2), &EncodeOptions { min_base_vertices: 8, ..Default::default() }).unwrap();
+    write("decode_stream", "plate", &plate.bytes);
+    let coarse = encode(&icosphere(1), &EncodeOptions { quantization_bits: 8, min_base_vertices: 4, ..Default::default() });
+    write("decode_stream", "coarse", &coarse.unwrap().bytes);
+
+    // decode_batch: selector byte, then batch 1's payload or whole chunk.
+    for (i, s) in sample_streams().iter().enumerate() {
+        let index = StreamIndex::parse(s).unwrap();
+        let chunk = &s[index.batches[0].clone()];
+        let mut payload = vec![i as u8];
+        payload.extend_from_slice(&chunk[20..]);
+        write("decode_batch", &format!("payload-{i}"), &payload);
+        let mut whole = vec![i as u8 | 2];
+        whole.extend_from_slice(chunk);
+        write("decode_batch", &format!("chunk-{i}"), &whole);
+    }
+
+    // Importers: the sample meshes as each format writes them.
+    let small = [icosphere(0), sample_meshes()[1].clone()];
+    for (i, m) in small.iter().enumerate() {
+        let mut b = Vec::new();
+        write_ply(m, &mut b).unwrap();
+        write("import_ply", &format!("binary-{i}"), &b);
+        let mut b = Vec::new();
+        write_obj(m, &mut b).unwrap();
+        write("import_obj", &format!("mesh-{i}"), &b);
+        let mut b = Vec::new();
+        write_glb(m, &mut b).unwrap();
+        write("import_gltf", &format!("glb-{i}"), &b);
+        // The same GLB as glTF JSON with its binary chunk in a data URI.
+        let json_len = u32::from_le_bytes(b[12..16].try_into().unwrap()) as usize;
+        let json = std::str::from_utf8(&b[20..20 + json_len]).unwrap().trim_end();
+        let bin = &b[20 + json_len + 8..];
+        let uri = format!("\"uri\":\"data:application/octet-stream;base64,{}\",", base64(bin));
+        let gltf = json.replacen("\"byteLength\"", &format!("{uri}\"byteLength\""), 1);
+        write("import_gltf", &format!("json-{i}"), gltf.as_bytes());
+        // OFF / COFF by hand.
+        let mut off = String::from(if m.colors.is_some() { "COFF\n" } else { "OFF\n" });
+        off += &format!("{} {} 0\n", m.positions.len(), m.triangles.len());
+        for (v, p) in m.positions.iter().enumerate() {
+            off += &format!("{} {} {}", p[0], p[1], p[2]);
+            if let Some(c) = &m.colors {
+                off += &format!(" {} {} {} 255", c[v][0], c[v][1], c[v][2]);
+            }
+            off += "\n";
+        }
+        for t in &m.triangles {
+            off += &format!("3 {} {} {}\n", t[0], t[1], t[2]);
+        }
+        write("import_off", &format!("mesh-{i}"), off.as_bytes());
+    }
+    write(
+        "import_ply",
+        "ascii",
+        b"ply\nformat ascii 1.0\ncomment x\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\n\
+          property uchar red\nproperty uchar green\nproperty uchar blue\nelement face 2\n\
+          property list uchar int vertex_indices\nend_header\n0 0 0 255 0 0\n1 0 0 0 255 0\n1 1 0 0 0 255\n0 1 0 9 9 9\n\
+          3 0 1 2\n4 0 1 2 3\n",
+    );
+    write(
+        "import_ply",
+        "strips-be",
+        b"ply\nformat binary_big_endian 1.0\nelement vertex 0\nproperty double x\nproperty double y\nproperty double z\n\
+          element tristrips 0\nproperty list int int vertex_indices\nend_header\n",
+    );
+    write("import_obj", "polygons", b"v 0 0 0 1 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt 0 0\nf 1/1 2/1 3/1 4/1\nf -1 -2 -3\n");
+}
