@@ -7,7 +7,12 @@ use vitrine_codec::{decode, encode, EncodeOptions, Limits};
 fn main() {
     let path = std::env::args().nth(1).expect("mesh path");
     let runs: usize = std::env::args().nth(2).map_or(10, |s| s.parse().unwrap());
-    let mesh = prepare(import_path(path.as_ref(), &ImportOptions::default()).unwrap(), &RepairOptions::default()).unwrap().0;
+    let mesh = prepare(
+        import_path(path.as_ref(), &ImportOptions::default()).unwrap(),
+        &RepairOptions::default(),
+    )
+    .unwrap()
+    .0;
     let t = Instant::now();
     let e = encode(&mesh, &EncodeOptions::default()).unwrap();
     println!("encode {:.1} ms", t.elapsed().as_secs_f64() * 1e3);
@@ -20,5 +25,9 @@ fn main() {
     }
     times.sort_by(f64::total_cmp);
     let n = mesh.positions.len() as f64;
-    println!("decode median {:.1} ms = {:.2} Mv/s", times[runs / 2] * 1e3, n / times[runs / 2] / 1e6);
+    println!(
+        "decode median {:.1} ms = {:.2} Mv/s",
+        times[runs / 2] * 1e3,
+        n / times[runs / 2] / 1e6
+    );
 }

@@ -9,13 +9,19 @@ use vitrine_codec::{breakdown, decode, encode, EncodeOptions, IndexedMesh, Limit
 fn main() {
     let paths: Vec<String> = std::env::args().skip(1).collect();
     let meshes: Vec<(String, IndexedMesh)> = if paths.is_empty() {
-        vec![("icosphere(6)".into(), icosphere(6)), ("torus".into(), torus(400, 160, 1.0, 0.3))]
+        vec![
+            ("icosphere(6)".into(), icosphere(6)),
+            ("torus".into(), torus(400, 160, 1.0, 0.3)),
+        ]
     } else {
         paths
             .iter()
             .map(|p| {
                 let m = import_path(p.as_ref(), &ImportOptions::default()).unwrap();
-                (p.rsplit('/').next().unwrap().to_string(), prepare(m, &RepairOptions::default()).unwrap().0)
+                (
+                    p.rsplit('/').next().unwrap().to_string(),
+                    prepare(m, &RepairOptions::default()).unwrap().0,
+                )
             })
             .collect()
     };
@@ -29,7 +35,9 @@ fn main() {
         let dec = t.elapsed().as_secs_f64();
         let n = mesh.positions.len() as f64;
         let b = breakdown(&e.bytes).unwrap();
-        let sum = |f: fn(&vitrine_codec::LevelBreakdown) -> u32| b[1..].iter().map(f).sum::<u32>() as f64 * 8.0 / n;
+        let sum = |f: fn(&vitrine_codec::LevelBreakdown) -> u32| {
+            b[1..].iter().map(f).sum::<u32>() as f64 * 8.0 / n
+        };
         let conn = sum(|l| l.connectivity + l.overhead);
         conn_sum += conn;
         total_sum += e.bytes.len() as f64 * 8.0 / n;
@@ -47,5 +55,9 @@ fn main() {
             n / dec / 1e6
         );
     }
-    println!("mean conn {:.2} total {:.2}", conn_sum / meshes.len() as f64, total_sum / meshes.len() as f64);
+    println!(
+        "mean conn {:.2} total {:.2}",
+        conn_sum / meshes.len() as f64,
+        total_sum / meshes.len() as f64
+    );
 }

@@ -88,7 +88,9 @@ pub(crate) fn decode(
         for v in &mut t {
             let back = dec.decode_int(&mut corner);
             if back < 0 || back as u32 > next_new {
-                return Err(Error::stream("base mesh face refers to a vertex not yet seen"));
+                return Err(Error::stream(
+                    "base mesh face refers to a vertex not yet seen",
+                ));
             }
             *v = next_new - back as u32;
             if back == 0 {
@@ -114,7 +116,9 @@ pub(crate) fn decode(
         for k in 0..3 {
             p[k] = prev[k].wrapping_add(dec.decode_int(&mut axis[k]));
             if !(0..=max_coordinate).contains(&p[k]) {
-                return Err(Error::stream("base mesh position outside the quantization range"));
+                return Err(Error::stream(
+                    "base mesh position outside the quantization range",
+                ));
             }
         }
         positions.push(p);
@@ -125,7 +129,9 @@ pub(crate) fn decode(
         let mut prev = [0u8; 3];
         let mut colours = Vec::with_capacity(vertices as usize);
         for _ in 0..vertices {
-            let c: [u8; 3] = std::array::from_fn(|k| prev[k].wrapping_add(dec.decode_int(&mut channel[k]) as u8));
+            let c: [u8; 3] = std::array::from_fn(|k| {
+                prev[k].wrapping_add(dec.decode_int(&mut channel[k]) as u8)
+            });
             colours.push(c);
             prev = c;
         }
@@ -134,5 +140,9 @@ pub(crate) fn decode(
         None
     };
     dec.check_overrun()?;
-    Ok(BaseMesh { positions, colours, triangles })
+    Ok(BaseMesh {
+        positions,
+        colours,
+        triangles,
+    })
 }

@@ -11,7 +11,6 @@ pub(crate) const HEADER_FIXED: usize = 40;
 pub(crate) const LEVEL_ENTRY: usize = 12;
 pub(crate) const BASE_TAG: u8 = b'M';
 pub(crate) const BATCH_TAG: u8 = b'L';
-pub(crate) const CHUNK_HEADER: usize = 20;
 pub(crate) const FLAG_COLOUR: u8 = 1;
 
 /// Vertex, face and byte counts after one level (the base mesh is level 0).
@@ -44,7 +43,10 @@ impl Header {
     }
 
     pub fn final_level(&self) -> LevelInfo {
-        *self.levels.last().expect("a header always has the base level")
+        *self
+            .levels
+            .last()
+            .expect("a header always has the base level")
     }
 
     pub(crate) fn write(&self, out: &mut Vec<u8>) {
@@ -73,7 +75,9 @@ impl Header {
         }
         let version = r.u8()?;
         if version != VERSION {
-            return Err(Error::stream(format!("unsupported version {version} (this build reads {VERSION})")));
+            return Err(Error::stream(format!(
+                "unsupported version {version} (this build reads {VERSION})"
+            )));
         }
         let flags = r.u8()?;
         if flags & !FLAG_COLOUR != 0 {
@@ -81,7 +85,9 @@ impl Header {
         }
         let bits = r.u8()?;
         if !(Quantization::MIN_BITS..=Quantization::MAX_BITS).contains(&bits) {
-            return Err(Error::stream(format!("quantization of {bits} bits is out of range")));
+            return Err(Error::stream(format!(
+                "quantization of {bits} bits is out of range"
+            )));
         }
         r.u8()?;
         let min = [r.f32()?, r.f32()?, r.f32()?];
@@ -92,11 +98,17 @@ impl Header {
         let batches = r.u32()? as usize;
         // Each level entry takes 12 bytes: refuse counts the input cannot hold.
         if batches > r.remaining() / LEVEL_ENTRY {
-            return Err(Error::stream(format!("header declares {batches} batches but is truncated")));
+            return Err(Error::stream(format!(
+                "header declares {batches} batches but is truncated"
+            )));
         }
         let mut levels = Vec::with_capacity(batches + 1);
         for _ in 0..=batches {
-            levels.push(LevelInfo { vertices: r.u32()?, faces: r.u32()?, bytes: r.u32()? });
+            levels.push(LevelInfo {
+                vertices: r.u32()?,
+                faces: r.u32()?,
+                bytes: r.u32()?,
+            });
         }
         for pair in levels.windows(2) {
             if pair[1].vertices <= pair[0].vertices || pair[1].faces < pair[0].faces {
@@ -137,7 +149,11 @@ impl StreamIndex {
         }
         let base = 0..ranges[0].end;
         ranges.remove(0);
-        Ok(StreamIndex { header, base, batches: ranges })
+        Ok(StreamIndex {
+            header,
+            base,
+            batches: ranges,
+        })
     }
 }
 
@@ -222,11 +238,15 @@ impl<'a> Reader<'a> {
     }
 
     pub(crate) fn u16(&mut self) -> Result<u16> {
-        Ok(u16::from_le_bytes(self.take(2)?.try_into().expect("2 bytes")))
+        Ok(u16::from_le_bytes(
+            self.take(2)?.try_into().expect("2 bytes"),
+        ))
     }
 
     pub(crate) fn u32(&mut self) -> Result<u32> {
-        Ok(u32::from_le_bytes(self.take(4)?.try_into().expect("4 bytes")))
+        Ok(u32::from_le_bytes(
+            self.take(4)?.try_into().expect("4 bytes"),
+        ))
     }
 
     pub(crate) fn f32(&mut self) -> Result<f32> {

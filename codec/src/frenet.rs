@@ -24,7 +24,11 @@ impl Givens {
     fn aligning(x: f64, y: f64) -> Givens {
         let r = (x * x + y * y).sqrt();
         if r == 0.0 {
-            return Givens { flip: false, a: 0.0, b: 0.0 };
+            return Givens {
+                flip: false,
+                a: 0.0,
+                b: 0.0,
+            };
         }
         let (mut c, mut s) = (x / r, y / r);
         // Rotating by π first keeps |a| ≤ 1 (the shear for angles near π blows up).
@@ -34,7 +38,11 @@ impl Givens {
             s = -s;
         }
         // Rotation by −θ (cos θ = c, sin θ = s): shears a = (1 − c)/s = s/(1 + c), b = −s.
-        Givens { flip, a: s / (1.0 + c), b: -s }
+        Givens {
+            flip,
+            a: s / (1.0 + c),
+            b: -s,
+        }
     }
 
     fn apply_f64(&self, x: f64, y: f64) -> (f64, f64) {
@@ -95,14 +103,14 @@ impl Frame {
     }
 
     /// World residual → (tangent, bitangent, normal).
-    pub(crate) fn to_local(&self, r: [i64; 3]) -> [i64; 3] {
+    pub(crate) fn to_local(self, r: [i64; 3]) -> [i64; 3] {
         let [mut x, mut y, mut z] = r;
         self.xy.forward(&mut x, &mut y);
         self.zx.forward(&mut z, &mut x);
         [x, y, z]
     }
 
-    pub(crate) fn to_world(&self, l: [i64; 3]) -> [i64; 3] {
+    pub(crate) fn to_world(self, l: [i64; 3]) -> [i64; 3] {
         let [mut x, mut y, mut z] = l;
         self.zx.inverse(&mut z, &mut x);
         self.xy.inverse(&mut x, &mut y);
@@ -115,7 +123,9 @@ mod tests {
     use super::*;
 
     fn lcg(seed: &mut u64) -> i64 {
-        *seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        *seed = seed
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
         ((*seed >> 33) % 8001) as i64 - 4000
     }
 

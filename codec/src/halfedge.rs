@@ -20,7 +20,7 @@ pub(crate) fn next(h: u32) -> u32 {
 
 #[inline]
 pub(crate) fn prev(h: u32) -> u32 {
-    if h % 3 == 0 {
+    if h.is_multiple_of(3) {
         h + 2
     } else {
         h - 1
@@ -47,7 +47,9 @@ impl Connectivity {
         let mut origin = Vec::with_capacity(triangles.len() * 3);
         for t in triangles {
             if t.iter().any(|&v| v as usize >= vertex_count) {
-                return Err(Error::Unsupported(format!("face {t:?} indexes a missing vertex")));
+                return Err(Error::Unsupported(format!(
+                    "face {t:?} indexes a missing vertex"
+                )));
             }
             origin.extend_from_slice(t);
         }
@@ -61,9 +63,10 @@ impl Connectivity {
             first[v + 1] += first[v];
         }
         let mut fill = first.clone();
-        let mut outgoing = vec![0u32; origin.len()];
+        // Half-edge id and target side by side, so the scans below stay in one cache line.
+        let mut outgoing = vec![(0u32, 0u32); origin.len()];
         for (h, &v) in origin.iter().enumerate() {
-            outgoing[fill[v as usize] as usize] = h as u32;
+            outgoing[fill[v as usize] as usize] = (h as u32, origin[next(h as u32) as usize]);
             fill[v as usize] += 1;
         }
         let mut twin = vec![NONE; origin.len()];
@@ -71,11 +74,11 @@ impl Connectivity {
             let (a, b) = (origin[h as usize], origin[next(h) as usize]);
             let mut same = 0;
             let mut found = NONE;
-            for &g in &outgoing[first[a as usize] as usize..first[a as usize + 1] as usize] {
-                same += u32::from(origin[next(g) as usize] == b);
+            for &(_, t) in &outgoing[first[a as usize] as usize..first[a as usize + 1] as usize] {
+                same += u32::from(t == b);
             }
-            for &g in &outgoing[first[b as usize] as usize..first[b as usize + 1] as usize] {
-                if origin[next(g) as usize] == a {
+            for &(g, t) in &outgoing[first[b as usize] as usize..first[b as usize + 1] as usize] {
+                if t == a {
                     if found != NONE {
                         return Err(non_manifold("shared by more than two faces", &origin, h));
                     }
@@ -83,7 +86,11 @@ impl Connectivity {
                 }
             }
             if same > 1 {
-                return Err(non_manifold("inconsistently oriented or shared by more than two faces", &origin, h));
+                return Err(non_manifold(
+                    "inconsistently oriented or shared by more than two faces",
+                    &origin,
+                    h,
+                ));
             }
             twin[h as usize] = found;
         }

@@ -30,10 +30,12 @@ mod quantize;
 pub mod samples;
 
 pub use decoder::{decode, Decoder, Limits};
-pub use encoder::{encode, encode_with_progress, BaseTarget, EncodeOptions, EncodeProgress, Encoded};
+pub use encoder::{
+    encode, encode_with_progress, BaseTarget, EncodeOptions, EncodeProgress, Encoded,
+};
 pub use error::{Error, Result};
-pub use inspect::{breakdown, LevelBreakdown};
 pub use format::{Header, LevelInfo, StreamIndex, MAGIC, VERSION};
+pub use inspect::{breakdown, LevelBreakdown};
 pub use mesh::IndexedMesh;
 pub use quantize::Quantization;
 

@@ -104,9 +104,7 @@ impl Pattern {
                 }
             } else {
                 let other = (0..3 * count)
-                    .find(|&o| {
-                        triangles[o / 3][o % 3] == b && triangles[o / 3][(o + 1) % 3] == a
-                    })
+                    .find(|&o| triangles[o / 3][o % 3] == b && triangles[o / 3][(o + 1) % 3] == a)
                     .expect("a diagonal is shared by two triangles");
                 twin[c] = other as u8;
             }
@@ -148,7 +146,10 @@ mod tests {
     #[test]
     fn regular_hexagon_is_inverse_sqrt3() {
         let p = pattern(6, Tag::Plus, Tag::Minus);
-        assert_eq!(&p.triangles[..4], &[[0, 1, 2], [2, 3, 4], [4, 5, 0], [0, 2, 4]]);
+        assert_eq!(
+            &p.triangles[..4],
+            &[[0, 1, 2], [2, 3, 4], [4, 5, 0], [0, 2, 4]]
+        );
     }
 
     #[test]

@@ -37,7 +37,9 @@ pub(crate) struct PassModels {
 impl PassModels {
     pub(crate) fn new() -> Self {
         PassModels {
-            valence: (0..GATE_CONTEXTS).map(|_| SymbolModel::new(DECIMATION_SYMBOLS)).collect(),
+            valence: (0..GATE_CONTEXTS)
+                .map(|_| SymbolModel::new(DECIMATION_SYMBOLS))
+                .collect(),
             cleaning: [BitModel::default(); GATE_CONTEXTS],
             tangent: (0..SCALE_CLASSES).map(|_| IntModel::new()).collect(),
             normal: (0..SCALE_CLASSES).map(|_| IntModel::new()).collect(),
@@ -77,11 +79,17 @@ impl PatchPrediction {
         let mut squared = 0u64;
         for i in 0..polygon.len() {
             let (a, b) = (polygon[i], polygon[(i + 1) % polygon.len()]);
-            squared += (0..3).map(|k| ((a[k] - b[k]) as i64).pow(2) as u64).sum::<u64>();
+            squared += (0..3)
+                .map(|k| ((a[k] - b[k]) as i64).pow(2) as u64)
+                .sum::<u64>();
         }
         let mean = squared / polygon.len() as u64;
         let scale = (((64 - mean.leading_zeros()) / 2) as usize).min(SCALE_CLASSES - 1);
-        PatchPrediction { position, frame: Frame::new(normal), scale }
+        PatchPrediction {
+            position,
+            frame: Frame::new(normal),
+            scale,
+        }
     }
 
     pub(crate) fn encode(&self, actual: [i32; 3], m: &mut PassModels, enc: &mut RangeEncoder) {
@@ -93,7 +101,12 @@ impl PatchPrediction {
     }
 
     /// Returns `None` when the decoded position falls outside `[0, max]`: a corrupt stream.
-    pub(crate) fn decode(&self, max: i32, m: &mut PassModels, dec: &mut RangeDecoder) -> Option<[i32; 3]> {
+    pub(crate) fn decode(
+        &self,
+        max: i32,
+        m: &mut PassModels,
+        dec: &mut RangeDecoder,
+    ) -> Option<[i32; 3]> {
         let l = [
             dec.decode_int(&mut m.tangent[self.scale]) as i64,
             dec.decode_int(&mut m.tangent[self.scale]) as i64,
@@ -123,7 +136,12 @@ pub(crate) fn predict_colour(polygon: &[[u8; 3]]) -> [u8; 3] {
 
 /// Colour residual, green first and red/blue relative to it (decorrelates
 /// luminance), all modulo 256 so the map is a bijection.
-pub(crate) fn encode_colour(actual: [u8; 3], pred: [u8; 3], m: &mut PassModels, enc: &mut RangeEncoder) {
+pub(crate) fn encode_colour(
+    actual: [u8; 3],
+    pred: [u8; 3],
+    m: &mut PassModels,
+    enc: &mut RangeEncoder,
+) {
     let d = [0, 1, 2].map(|k| actual[k].wrapping_sub(pred[k]));
     let g = d[1] as i8;
     let r = d[0].wrapping_sub(d[1]) as i8;
@@ -137,5 +155,9 @@ pub(crate) fn decode_colour(pred: [u8; 3], m: &mut PassModels, dec: &mut RangeDe
     let g = dec.decode_int(&mut m.colour[0]) as u8;
     let r = (dec.decode_int(&mut m.colour[1]) as u8).wrapping_add(g);
     let b = (dec.decode_int(&mut m.colour[2]) as u8).wrapping_add(g);
-    [pred[0].wrapping_add(r), pred[1].wrapping_add(g), pred[2].wrapping_add(b)]
+    [
+        pred[0].wrapping_add(r),
+        pred[1].wrapping_add(g),
+        pred[2].wrapping_add(b),
+    ]
 }

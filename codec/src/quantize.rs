@@ -30,7 +30,10 @@ impl Quantization {
         for (i, p) in positions.iter().enumerate() {
             for k in 0..3 {
                 if !p[k].is_finite() {
-                    return Err(Error::input("mesh", format!("vertex {i} has a non-finite coordinate")));
+                    return Err(Error::input(
+                        "mesh",
+                        format!("vertex {i} has a non-finite coordinate"),
+                    ));
                 }
                 min[k] = min[k].min(p[k]);
                 max[k] = max[k].max(p[k]);
@@ -39,9 +42,15 @@ impl Quantization {
         if positions.is_empty() {
             return Err(Error::input("mesh", "no vertices"));
         }
-        let extent = (0..3).map(|k| max[k] as f64 - min[k] as f64).fold(0.0, f64::max);
+        let extent = (0..3)
+            .map(|k| max[k] as f64 - min[k] as f64)
+            .fold(0.0, f64::max);
         let levels = ((1u32 << bits) - 1) as f64;
-        let step = if extent > 0.0 { (extent / levels) as f32 } else { 1.0 };
+        let step = if extent > 0.0 {
+            (extent / levels) as f32
+        } else {
+            1.0
+        };
         // f32 rounding of the step may leave the top value past 2^bits − 1; nudge up.
         let mut step = step;
         while (extent / step as f64).round() > levels {

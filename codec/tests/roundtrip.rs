@@ -1,8 +1,12 @@
 //! Bit-exact round trips on generated meshes: every level decodes to a
 //! manifold, and the final level is exactly the quantized input.
 
-use vitrine_codec::samples::{add_noise, icosphere, merge, paint, plate_with_tunnels, punch_holes, torus};
-use vitrine_codec::{decode, encode, EncodeOptions, IndexedMesh, Limits, Quantization, StreamIndex};
+use vitrine_codec::samples::{
+    add_noise, icosphere, merge, paint, plate_with_tunnels, punch_holes, torus,
+};
+use vitrine_codec::{
+    decode, encode, EncodeOptions, IndexedMesh, Limits, Quantization, StreamIndex,
+};
 
 fn canonical(t: [u32; 3]) -> [u32; 3] {
     let i = (0..3).min_by_key(|&i| t[i]).unwrap();
@@ -16,9 +20,12 @@ fn assert_round_trip(mesh: &IndexedMesh, options: &EncodeOptions) -> usize {
     assert_eq!(encoded.bytes, again.bytes, "encoding is deterministic");
 
     let index = StreamIndex::parse(&encoded.bytes).unwrap();
-    let mut decoder = vitrine_codec::Decoder::new(&encoded.bytes[index.base.clone()], Limits::default()).unwrap();
+    let mut decoder =
+        vitrine_codec::Decoder::new(&encoded.bytes[index.base.clone()], Limits::default()).unwrap();
     for (k, range) in index.batches.iter().enumerate() {
-        decoder.apply_batch(&encoded.bytes[range.clone()]).unwrap_or_else(|e| panic!("batch {k}: {e}"));
+        decoder
+            .apply_batch(&encoded.bytes[range.clone()])
+            .unwrap_or_else(|e| panic!("batch {k}: {e}"));
         let level = index.header.levels[k + 1];
         assert_eq!(decoder.vertex_count(), level.vertices as usize);
         assert_eq!(decoder.face_count(), level.faces as usize);
@@ -29,13 +36,23 @@ fn assert_round_trip(mesh: &IndexedMesh, options: &EncodeOptions) -> usize {
     let order = &encoded.vertex_order;
     assert_eq!(order.len(), mesh.positions.len());
     for (i, &v) in order.iter().enumerate() {
-        assert_eq!(decoder.quantized_positions()[i], q.quantize(mesh.positions[v as usize]), "vertex {i}");
+        assert_eq!(
+            decoder.quantized_positions()[i],
+            q.quantize(mesh.positions[v as usize]),
+            "vertex {i}"
+        );
     }
     let mut expected: Vec<[u32; 3]> = mesh.triangles.iter().map(|&t| canonical(t)).collect();
     let mut got: Vec<[u32; 3]> = decoder
         .indices()
         .chunks_exact(3)
-        .map(|t| canonical([order[t[0] as usize], order[t[1] as usize], order[t[2] as usize]]))
+        .map(|t| {
+            canonical([
+                order[t[0] as usize],
+                order[t[1] as usize],
+                order[t[2] as usize],
+            ])
+        })
         .collect();
     expected.sort_unstable();
     got.sort_unstable();
@@ -44,7 +61,11 @@ fn assert_round_trip(mesh: &IndexedMesh, options: &EncodeOptions) -> usize {
         Some(colours) => {
             let decoded = decoder.colours().expect("stream keeps colour");
             for (i, &v) in order.iter().enumerate() {
-                assert_eq!(&decoded[3 * i..3 * i + 3], &colours[v as usize], "colour {i}");
+                assert_eq!(
+                    &decoded[3 * i..3 * i + 3],
+                    &colours[v as usize],
+                    "colour {i}"
+                );
             }
         }
         None => assert!(decoder.colours().is_none()),
@@ -56,14 +77,20 @@ fn assert_round_trip(mesh: &IndexedMesh, options: &EncodeOptions) -> usize {
 }
 
 fn layers(mesh: &IndexedMesh) -> usize {
-    encode(mesh, &EncodeOptions::default()).unwrap().header.batch_count()
+    encode(mesh, &EncodeOptions::default())
+        .unwrap()
+        .header
+        .batch_count()
 }
 
 #[test]
 fn icosphere_round_trips() {
     let mesh = icosphere(5);
     assert_round_trip(&mesh, &EncodeOptions::default());
-    assert!(layers(&mesh) >= 3, "a regular sphere decimates over several layers");
+    assert!(
+        layers(&mesh) >= 3,
+        "a regular sphere decimates over several layers"
+    );
 }
 
 #[test]
@@ -81,14 +108,23 @@ fn genus_two_and_three_round_trip() {
 #[test]
 fn holes_round_trip() {
     let sphere = icosphere(4);
-    let holed = punch_holes(&sphere, &[[1.0, 0.0, 0.0], [0.0, -1.0, 0.0], [0.0, 0.3, 0.95]], 0.35);
+    let holed = punch_holes(
+        &sphere,
+        &[[1.0, 0.0, 0.0], [0.0, -1.0, 0.0], [0.0, 0.3, 0.95]],
+        0.35,
+    );
     assert!(holed.triangles.len() < sphere.triangles.len());
     assert_round_trip(&holed, &EncodeOptions::default());
 }
 
 #[test]
 fn several_components_round_trip() {
-    let parts = [icosphere(3), torus(40, 16, 1.0, 0.4), icosphere(1), plate_with_tunnels(1, 6)];
+    let parts = [
+        icosphere(3),
+        torus(40, 16, 1.0, 0.4),
+        icosphere(1),
+        plate_with_tunnels(1, 6),
+    ];
     assert_round_trip(&merge(&parts, 3.0), &EncodeOptions::default());
 }
 
@@ -105,7 +141,10 @@ fn every_quantization_round_trips() {
     let mut mesh = icosphere(3);
     add_noise(&mut mesh, 0.01, 3);
     for bits in [8, 10, 12, 14, 16] {
-        let options = EncodeOptions { quantization_bits: bits, ..Default::default() };
+        let options = EncodeOptions {
+            quantization_bits: bits,
+            ..Default::default()
+        };
         assert_round_trip(&mesh, &options);
     }
 }
@@ -114,5 +153,11 @@ fn every_quantization_round_trips() {
 fn geometric_guard_off_round_trips() {
     let mut mesh = plate_with_tunnels(2, 8);
     add_noise(&mut mesh, 0.02, 5);
-    assert_round_trip(&mesh, &EncodeOptions { geometric_guard: false, ..Default::default() });
+    assert_round_trip(
+        &mesh,
+        &EncodeOptions {
+            geometric_guard: false,
+            ..Default::default()
+        },
+    );
 }

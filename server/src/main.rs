@@ -5,7 +5,11 @@ mod cli;
 use clap::{Parser, Subcommand};
 
 #[derive(Parser)]
-#[command(name = "vitrine", version, about = "Progressive 3D scans for museum websites")]
+#[command(
+    name = "vitrine",
+    version,
+    about = "Progressive 3D scans for museum websites"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -13,6 +17,12 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
+    /// Encode a mesh and store it in the database (one transaction).
+    Ingest(vitrine::IngestArgs),
+    /// Serve models, refinement batches and the viewer over HTTP.
+    Serve(vitrine::ServeArgs),
+    /// Create an access token for researcher-level audiences.
+    Token(vitrine::TokenArgs),
     /// Encode a mesh (PLY, OBJ, OFF, glTF/GLB) into a progressive stream file.
     Encode(cli::encode::EncodeArgs),
     /// Decode a stream file up to a level and write PLY, OBJ or GLB.
@@ -33,7 +43,15 @@ enum Command {
 
 fn main() -> anyhow::Result<()> {
     let cli = Cli::parse();
+    let runtime = || {
+        tokio::runtime::Builder::new_multi_thread()
+            .enable_all()
+            .build()
+    };
     match cli.command {
+        Command::Ingest(args) => runtime()?.block_on(vitrine::run_ingest(args)),
+        Command::Serve(args) => runtime()?.block_on(vitrine::run_serve(args)),
+        Command::Token(args) => runtime()?.block_on(vitrine::run_token(args)),
         Command::Encode(args) => cli::encode::run(args),
         Command::Decode(args) => cli::decode::run(args),
         Command::Inspect(args) => cli::inspect::run(args),

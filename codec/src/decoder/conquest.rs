@@ -60,7 +60,9 @@ impl Level {
         scratch.tag.clear();
         scratch.tag.resize(n, Tag::None);
         scratch.face_done.clear();
-        scratch.face_done.resize(self.conn.face_count_slots(), false);
+        scratch
+            .face_done
+            .resize(self.conn.face_count_slots(), false);
         let mut s = Streams {
             conn: RangeDecoder::new(pass.connectivity)?,
             geom: RangeDecoder::new(pass.geometry)?,
@@ -69,7 +71,9 @@ impl Level {
         };
         for &[a, b] in &pass.seeds {
             if a as usize >= n || b as usize >= n {
-                return Err(Error::stream("seed gate names a vertex that does not exist yet"));
+                return Err(Error::stream(
+                    "seed gate names a vertex that does not exist yet",
+                ));
             }
             let h = self
                 .conn
@@ -109,7 +113,8 @@ impl Level {
         if scratch.face_done[f as usize] {
             return Ok(());
         }
-        let tag_of = |scratch: &Scratch, v: u32| scratch.tag.get(v as usize).copied().unwrap_or(Tag::None);
+        let tag_of =
+            |scratch: &Scratch, v: u32| scratch.tag.get(v as usize).copied().unwrap_or(Tag::None);
         let t0 = tag_of(scratch, self.conn.origin[g as usize]);
         let t1 = tag_of(scratch, self.conn.target(g));
         let front = self.conn.origin[prev(g) as usize];
@@ -139,7 +144,9 @@ impl Level {
             return Ok(());
         }
         if self.vertex_count() >= target {
-            return Err(Error::stream("pass inserts more vertices than its header says"));
+            return Err(Error::stream(
+                "pass inserts more vertices than its header says",
+            ));
         }
         let pat = pattern(valence, as_gate_tag(t0), as_gate_tag(t1));
         let region = self.find_patch(g, pat, scratch)?;
@@ -150,7 +157,12 @@ impl Level {
     fn find_patch(&self, g: u32, pat: &Pattern, scratch: &Scratch) -> Result<Region> {
         let c = &self.conn;
         let count = pat.triangle_count();
-        let mut r = Region { valence: pat.valence, polygon: [NONE; MAX_VALENCE], outer: [NONE; MAX_VALENCE], corner0: [NONE; MAX_VALENCE - 2] };
+        let mut r = Region {
+            valence: pat.valence,
+            polygon: [NONE; MAX_VALENCE],
+            outer: [NONE; MAX_VALENCE],
+            corner0: [NONE; MAX_VALENCE - 2],
+        };
         let mut first = g;
         for _ in 0..pat.gate_corner {
             first = prev(first);
@@ -186,7 +198,11 @@ impl Level {
                             return Err(Error::stream("patch crosses a border"));
                         }
                         let f2 = face(h2);
-                        if scratch.face_done[f2 as usize] || r.corner0[..count].iter().any(|&x| x != NONE && face(x) == f2) {
+                        if scratch.face_done[f2 as usize]
+                            || r.corner0[..count]
+                                .iter()
+                                .any(|&x| x != NONE && face(x) == f2)
+                        {
                             return Err(Error::stream("patch overlaps conquered faces"));
                         }
                         let mut first = h2;
@@ -204,11 +220,17 @@ impl Level {
         Ok(r)
     }
 
-    fn insert_vertex(&mut self, r: &Region, pat: &Pattern, scratch: &mut Scratch, s: &mut Streams) -> Result<()> {
+    fn insert_vertex(
+        &mut self,
+        r: &Region,
+        pat: &Pattern,
+        scratch: &mut Scratch,
+        s: &mut Streams,
+    ) -> Result<()> {
         let d = r.valence;
         let mut polygon_q = [[0i32; 3]; MAX_VALENCE];
-        for i in 0..d {
-            polygon_q[i] = self.positions_q[r.polygon[i] as usize];
+        for (q, &v) in polygon_q.iter_mut().zip(&r.polygon[..d]) {
+            *q = self.positions_q[v as usize];
         }
         let position = PatchPrediction::new(&polygon_q[..d])
             .decode(self.quantization.max_value(), &mut s.models, &mut s.geom)
@@ -219,7 +241,11 @@ impl Level {
                 for i in 0..d {
                     border[i] = colours[r.polygon[i] as usize];
                 }
-                Some(decode_colour(predict_colour(&border[..d]), &mut s.models, &mut s.colour))
+                Some(decode_colour(
+                    predict_colour(&border[..d]),
+                    &mut s.models,
+                    &mut s.colour,
+                ))
             }
             None => None,
         };
@@ -227,7 +253,11 @@ impl Level {
         // Faces (v, p_i, p_i+1): reuse the patch's d − 2 slots, append two.
         let mut slots = [NONE; MAX_VALENCE];
         for (i, slot) in slots.iter_mut().enumerate().take(d) {
-            *slot = if i < d - 2 { face(r.corner0[i]) } else { self.conn.append_face() };
+            *slot = if i < d - 2 {
+                face(r.corner0[i])
+            } else {
+                self.conn.append_face()
+            };
         }
         for i in 0..d {
             let base = 3 * slots[i];
@@ -247,7 +277,9 @@ impl Level {
             self.conn.out[a as usize] = base + 1;
         }
         self.conn.out[v as usize] = 3 * slots[0];
-        scratch.face_done.resize(self.conn.face_count_slots(), false);
+        scratch
+            .face_done
+            .resize(self.conn.face_count_slots(), false);
         for &slot in &slots[..d] {
             scratch.face_done[slot as usize] = true;
         }

@@ -19,7 +19,11 @@ pub struct Limits {
 
 impl Default for Limits {
     fn default() -> Self {
-        Limits { max_vertices: 50_000_000, max_faces: 100_000_000, max_batches: 1024 }
+        Limits {
+            max_vertices: 50_000_000,
+            max_faces: 100_000_000,
+            max_batches: 1024,
+        }
     }
 }
 
@@ -76,7 +80,11 @@ impl Decoder {
     pub fn new(prefix: &[u8], limits: Limits) -> Result<Decoder> {
         let header = Header::parse(prefix)?;
         if header.batch_count() > limits.max_batches as usize {
-            return Err(Error::Limit(format!("{} batches exceed the limit of {}", header.batch_count(), limits.max_batches)));
+            return Err(Error::Limit(format!(
+                "{} batches exceed the limit of {}",
+                header.batch_count(),
+                limits.max_batches
+            )));
         }
         let last = header.final_level();
         if last.vertices > limits.max_vertices || last.faces > limits.max_faces {
@@ -91,12 +99,30 @@ impl Decoder {
             return Err(Error::stream("base chunk disagrees with the level table"));
         }
         let q = header.quantization;
-        let mesh = base_mesh::decode(payload, base.vertices, base.faces, header.has_colour, q.max_value())?;
+        let mesh = base_mesh::decode(
+            payload,
+            base.vertices,
+            base.faces,
+            header.has_colour,
+            q.max_value(),
+        )?;
         let conn = Connectivity::from_triangles(mesh.positions.len(), &mesh.triangles)
             .map_err(|e| Error::stream(format!("base mesh is not a manifold: {e}")))?;
         let positions = mesh.positions.iter().map(|&p| q.dequantize(p)).collect();
-        let level = Level { conn, quantization: q, positions_q: mesh.positions, positions, colours: mesh.colours };
-        Ok(Decoder { header, level, applied: 0, limits, scratch: Scratch::default() })
+        let level = Level {
+            conn,
+            quantization: q,
+            positions_q: mesh.positions,
+            positions,
+            colours: mesh.colours,
+        };
+        Ok(Decoder {
+            header,
+            level,
+            applied: 0,
+            limits,
+            scratch: Scratch::default(),
+        })
     }
 
     pub fn header(&self) -> &Header {
@@ -117,15 +143,23 @@ impl Decoder {
         let (chunk, payload) = ChunkHeader::parse(chunk_bytes, BATCH_TAG)?;
         let expected = self.applied + 1;
         if chunk.level as usize != expected || expected > self.header.batch_count() {
-            return Err(Error::stream(format!("batch for level {} applied at level {}", chunk.level, self.applied)));
+            return Err(Error::stream(format!(
+                "batch for level {} applied at level {}",
+                chunk.level, self.applied
+            )));
         }
         let info = self.header.levels[expected];
         let n = self.level.vertex_count() as u32;
-        if chunk.vertices_before != n || chunk.vertices_after != info.vertices || chunk.faces_after != info.faces {
+        if chunk.vertices_before != n
+            || chunk.vertices_after != info.vertices
+            || chunk.faces_after != info.faces
+        {
             return Err(Error::stream("batch counts disagree with the level table"));
         }
         if info.vertices > self.limits.max_vertices || info.faces > self.limits.max_faces {
-            return Err(Error::Limit("batch exceeds the vertex or face limit".into()));
+            return Err(Error::Limit(
+                "batch exceeds the vertex or face limit".into(),
+            ));
         }
         let mut r = Reader::new(payload);
         let cleaning = read_pass(&mut r, PassKind::Cleaning)?;
@@ -135,7 +169,9 @@ impl Decoder {
         }
         let added = cleaning.inserted as u64 + decimating.inserted as u64;
         if added != (info.vertices - n) as u64 {
-            return Err(Error::stream("passes insert a different number of vertices than the batch"));
+            return Err(Error::stream(
+                "passes insert a different number of vertices than the batch",
+            ));
         }
         let grow = added as usize;
         self.level.positions_q.reserve(grow);
@@ -181,7 +217,13 @@ impl Decoder {
         IndexedMesh {
             positions: self.level.positions.clone(),
             colors: self.level.colours.clone(),
-            triangles: self.level.conn.origin.chunks_exact(3).map(|t| [t[0], t[1], t[2]]).collect(),
+            triangles: self
+                .level
+                .conn
+                .origin
+                .chunks_exact(3)
+                .map(|t| [t[0], t[1], t[2]])
+                .collect(),
         }
     }
 }

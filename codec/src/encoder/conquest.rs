@@ -34,7 +34,13 @@ pub(crate) struct PassOutput {
 impl PassOutput {
     /// A pass that removes nothing: the decoder skips it.
     pub(crate) fn empty() -> Self {
-        PassOutput { seeds: Vec::new(), removed: Vec::new(), connectivity: Vec::new(), geometry: Vec::new(), colour: Vec::new() }
+        PassOutput {
+            seeds: Vec::new(),
+            removed: Vec::new(),
+            connectivity: Vec::new(),
+            geometry: Vec::new(),
+            colour: Vec::new(),
+        }
     }
 }
 
@@ -95,7 +101,11 @@ impl Simplifier {
 
     pub(crate) fn run_pass(&mut self, kind: PassKind) -> PassOutput {
         for (v, s) in self.state.iter_mut().enumerate() {
-            *s = if self.conn.out[v] == NONE { REMOVED } else { FREE };
+            *s = if self.conn.out[v] == NONE {
+                REMOVED
+            } else {
+                FREE
+            };
         }
         self.tag.fill(Tag::None);
         self.face_done.clear();
@@ -178,7 +188,13 @@ impl Simplifier {
                 faces += 1;
             }
         }
-        let remap_half_edge = |h: u32| if h == NONE { NONE } else { 3 * face_map[face(h) as usize] + h % 3 };
+        let remap_half_edge = |h: u32| {
+            if h == NONE {
+                NONE
+            } else {
+                3 * face_map[face(h) as usize] + h % 3
+            }
+        };
         let mut origin = Vec::with_capacity(3 * faces as usize);
         let mut twin = Vec::with_capacity(3 * faces as usize);
         for f in 0..slots {
@@ -245,10 +261,13 @@ impl Simplifier {
         let t1 = self.tag[self.conn.target(g) as usize];
         if let Some(patch) = self.removable(g, kind, t0, t1) {
             let pat = patch.pattern;
-            let third = pat.corner_vertex(3 * pat.gate_triangle as usize + (pat.gate_corner as usize + 2) % 3);
+            let third = pat
+                .corner_vertex(3 * pat.gate_triangle as usize + (pat.gate_corner as usize + 2) % 3);
             let ctx = gate_context(t0, t1, self.tag[patch.polygon[third] as usize]);
             match kind {
-                PassKind::Decimating => s.conn.encode_symbol(&mut s.models.valence[ctx], patch.valence - 2),
+                PassKind::Decimating => s
+                    .conn
+                    .encode_symbol(&mut s.models.valence[ctx], patch.valence - 2),
                 PassKind::Cleaning => s.conn.encode_bit(&mut s.models.cleaning[ctx], true),
             }
             self.encode_vertex(&patch, s);
@@ -281,7 +300,11 @@ impl Simplifier {
         if self.state[centre as usize] != FREE {
             return None;
         }
-        let max_valence = if kind == PassKind::Cleaning { 3 } else { MAX_VALENCE };
+        let max_valence = if kind == PassKind::Cleaning {
+            3
+        } else {
+            MAX_VALENCE
+        };
         let mut ring = [NONE; MAX_VALENCE];
         let mut polygon = [NONE; MAX_VALENCE];
         let start = prev(g);
@@ -325,7 +348,13 @@ impl Simplifier {
                 }
             }
         }
-        let patch = Patch { valence, centre, ring, polygon, pattern };
+        let patch = Patch {
+            valence,
+            centre,
+            ring,
+            polygon,
+            pattern,
+        };
         if self.geometric_guard && self.folds(&patch) {
             return None;
         }
@@ -338,26 +367,55 @@ impl Simplifier {
         let cross = |a: [f64; 3], b: [f64; 3], c: [f64; 3]| {
             let u = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
             let w = [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
-            [u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2], u[0] * w[1] - u[1] * w[0]]
+            [
+                u[1] * w[2] - u[2] * w[1],
+                u[2] * w[0] - u[0] * w[2],
+                u[0] * w[1] - u[1] * w[0],
+            ]
         };
         let centre = pos(p.centre);
         let mut normal = [0.0; 3];
         for i in 0..p.valence {
-            let n = cross(centre, pos(p.polygon[i]), pos(p.polygon[(i + 1) % p.valence]));
+            let n = cross(
+                centre,
+                pos(p.polygon[i]),
+                pos(p.polygon[(i + 1) % p.valence]),
+            );
             (0..3).for_each(|k| normal[k] += n[k]);
         }
-        p.pattern.triangles[..p.pattern.triangle_count()].iter().any(|t| {
-            let n = cross(pos(p.polygon[t[0] as usize]), pos(p.polygon[t[1] as usize]), pos(p.polygon[t[2] as usize]));
-            n[0] * normal[0] + n[1] * normal[1] + n[2] * normal[2] <= 0.0
-        })
+        p.pattern.triangles[..p.pattern.triangle_count()]
+            .iter()
+            .any(|t| {
+                let n = cross(
+                    pos(p.polygon[t[0] as usize]),
+                    pos(p.polygon[t[1] as usize]),
+                    pos(p.polygon[t[2] as usize]),
+                );
+                n[0] * normal[0] + n[1] * normal[1] + n[2] * normal[2] <= 0.0
+            })
     }
 
     fn encode_vertex(&self, p: &Patch, s: &mut Streams) {
-        let polygon: Vec<[i32; 3]> = p.polygon[..p.valence].iter().map(|&v| self.positions[v as usize]).collect();
-        PatchPrediction::new(&polygon).encode(self.positions[p.centre as usize], &mut s.models, &mut s.geom);
+        let polygon: Vec<[i32; 3]> = p.polygon[..p.valence]
+            .iter()
+            .map(|&v| self.positions[v as usize])
+            .collect();
+        PatchPrediction::new(&polygon).encode(
+            self.positions[p.centre as usize],
+            &mut s.models,
+            &mut s.geom,
+        );
         if let Some(colours) = &self.colours {
-            let border: Vec<[u8; 3]> = p.polygon[..p.valence].iter().map(|&v| colours[v as usize]).collect();
-            encode_colour(colours[p.centre as usize], predict_colour(&border), &mut s.models, &mut s.colour);
+            let border: Vec<[u8; 3]> = p.polygon[..p.valence]
+                .iter()
+                .map(|&v| colours[v as usize])
+                .collect();
+            encode_colour(
+                colours[p.centre as usize],
+                predict_colour(&border),
+                &mut s.models,
+                &mut s.colour,
+            );
         }
     }
 

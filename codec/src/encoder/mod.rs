@@ -3,7 +3,9 @@
 mod conquest;
 
 use crate::base_mesh::{self, BaseMesh};
-use crate::format::{write_section, write_varint, ChunkHeader, Header, LevelInfo, BASE_TAG, BATCH_TAG, VERSION};
+use crate::format::{
+    write_section, write_varint, ChunkHeader, Header, LevelInfo, BASE_TAG, BATCH_TAG, VERSION,
+};
 use crate::halfedge::connectivity;
 use crate::quantize::Quantization;
 use crate::{Error, IndexedMesh, Result};
@@ -88,18 +90,26 @@ pub fn encode_with_progress(
     }
     if let Some(c) = &mesh.colors {
         if c.len() != mesh.positions.len() {
-            return Err(Error::Parameter("colour count differs from vertex count".into()));
+            return Err(Error::Parameter(
+                "colour count differs from vertex count".into(),
+            ));
         }
     }
     if mesh.positions.len() >= u32::MAX as usize / 2 {
         return Err(Error::Limit("more than 2^31 vertices".into()));
     }
     let quantization = Quantization::for_positions(&mesh.positions, options.quantization_bits)?;
-    let positions: Vec<[i32; 3]> = mesh.positions.iter().map(|&p| quantization.quantize(p)).collect();
+    let positions: Vec<[i32; 3]> = mesh
+        .positions
+        .iter()
+        .map(|&p| quantization.quantize(p))
+        .collect();
     let conn = connectivity(mesh)?;
     let input_vertices = mesh.positions.len();
-    if conn.out.iter().any(|&h| h == crate::halfedge::NONE) {
-        return Err(Error::Unsupported("mesh has vertices no face uses (run repair first)".into()));
+    if conn.out.contains(&crate::halfedge::NONE) {
+        return Err(Error::Unsupported(
+            "mesh has vertices no face uses (run repair first)".into(),
+        ));
     }
     let target = match options.base {
         BaseTarget::Vertices(n) => n as usize,
@@ -107,14 +117,21 @@ pub fn encode_with_progress(
     }
     .max(options.min_base_vertices as usize);
 
-    let mut s = Simplifier::new(conn, positions.clone(), mesh.colors.clone(), options.geometric_guard);
+    let mut s = Simplifier::new(
+        conn,
+        positions.clone(),
+        mesh.colors.clone(),
+        options.geometric_guard,
+    );
     let mut layers = Vec::new();
     while s.live_vertices > target && layers.len() < options.max_layers as usize {
         let before = s.live_vertices;
         let decimating = s.run_pass(PassKind::Decimating);
         // A cleaning traversal costs a code per face; skip it when few
         // valence-3 vertices exist to be removed (common on irregular scans).
-        let cleaning = if (s.valence_three_vertices() as f64) < CLEANING_MIN_FRACTION * s.live_vertices as f64 {
+        let cleaning = if (s.valence_three_vertices() as f64)
+            < CLEANING_MIN_FRACTION * s.live_vertices as f64
+        {
             PassOutput::empty()
         } else {
             s.run_pass(PassKind::Cleaning)
@@ -123,9 +140,17 @@ pub fn encode_with_progress(
         if removed == 0 {
             break;
         }
-        layers.push(Layer { decimating, cleaning, faces_after: s.live_faces });
+        layers.push(Layer {
+            decimating,
+            cleaning,
+            faces_after: s.live_faces,
+        });
         s.compact();
-        progress(EncodeProgress { layer: layers.len() as u32, vertices: s.live_vertices, input_vertices });
+        progress(EncodeProgress {
+            layer: layers.len() as u32,
+            vertices: s.live_vertices,
+            input_vertices,
+        });
         if (removed as f64) < before as f64 * options.min_layer_fraction as f64 {
             break;
         }
@@ -144,7 +169,11 @@ fn write_stream(
     let input_vertices = quantized.len();
     // Final numbering: base vertices by first appearance, then each batch's
     // vertices in insertion order (coarsest layer first, cleaning before decimation).
-    let base_triangles: Vec<[u32; 3]> = s.conn.triangles().map(|t| t.map(|v| s.ids[v as usize])).collect();
+    let base_triangles: Vec<[u32; 3]> = s
+        .conn
+        .triangles()
+        .map(|t| t.map(|v| s.ids[v as usize]))
+        .collect();
     let mut vertex_order = base_mesh::first_appearance_order(input_vertices, &base_triangles);
     let base_vertices = vertex_order.len();
     for layer in layers.iter().rev() {
@@ -156,12 +185,20 @@ fn write_stream(
         new_id[old as usize] = new as u32;
     }
     let base = BaseMesh {
-        positions: vertex_order[..base_vertices].iter().map(|&v| quantized[v as usize]).collect(),
-        colours: mesh
-            .colors
-            .as_ref()
-            .map(|c| vertex_order[..base_vertices].iter().map(|&v| c[v as usize]).collect()),
-        triangles: base_triangles.iter().map(|t| t.map(|v| new_id[v as usize])).collect(),
+        positions: vertex_order[..base_vertices]
+            .iter()
+            .map(|&v| quantized[v as usize])
+            .collect(),
+        colours: mesh.colors.as_ref().map(|c| {
+            vertex_order[..base_vertices]
+                .iter()
+                .map(|&v| c[v as usize])
+                .collect()
+        }),
+        triangles: base_triangles
+            .iter()
+            .map(|t| t.map(|v| new_id[v as usize]))
+            .collect(),
     };
     let base_payload = base_mesh::encode(&base);
     let mut base_chunk = Vec::new();
@@ -202,17 +239,30 @@ fn write_stream(
         chunk.extend_from_slice(&payload);
         vertices += added;
         faces += 2 * added;
-        levels.push(LevelInfo { vertices: vertices as u32, faces: faces as u32, bytes: chunk.len() as u32 });
+        levels.push(LevelInfo {
+            vertices: vertices as u32,
+            faces: faces as u32,
+            bytes: chunk.len() as u32,
+        });
         batches.push(chunk);
     }
-    let header = Header { version: VERSION, has_colour: mesh.colors.is_some(), quantization, levels };
+    let header = Header {
+        version: VERSION,
+        has_colour: mesh.colors.is_some(),
+        quantization,
+        levels,
+    };
     let mut bytes = Vec::new();
     header.write(&mut bytes);
     bytes.extend_from_slice(&base_chunk);
     for b in &batches {
         bytes.extend_from_slice(b);
     }
-    Encoded { bytes, vertex_order, header }
+    Encoded {
+        bytes,
+        vertex_order,
+        header,
+    }
 }
 
 fn write_pass(out: &mut Vec<u8>, pass: &PassOutput, new_id: &[u32]) {

@@ -144,9 +144,7 @@ impl<'a> Buffers<'a> {
                 let Some(base) = self.base else {
                     return Err(Error::input(
                         what,
-                        format!(
-                            "buffer {i} is in the external file {uri:?}: import from a path to read it"
-                        ),
+                        format!("buffer {i} is in the external file {uri:?}: import from a path to read it"),
                     ));
                 };
                 let rel = relative_uri_path(uri)
@@ -535,9 +533,7 @@ pub(super) fn read(
                     if v >= n as u64 {
                         return Err(Error::input(
                             what,
-                            format!(
-                                "{ctx}: triangle {k} has vertex index {v} out of range ({n} vertices)"
-                            ),
+                            format!("{ctx}: triangle {k} has vertex index {v} out of range ({n} vertices)"),
                         ));
                     }
                 }

@@ -108,7 +108,9 @@ pub extern "C" fn decoder_level(handle: u32) -> u32 {
 fn buffer(d: &Decoder, kind: u32) -> (usize, usize) {
     match kind {
         POSITIONS => (d.positions().as_ptr() as usize, d.positions().len()),
-        COLOURS => d.colours().map_or((0, 0), |c| (c.as_ptr() as usize, c.len())),
+        COLOURS => d
+            .colours()
+            .map_or((0, 0), |c| (c.as_ptr() as usize, c.len())),
         _ => (d.indices().as_ptr() as usize, d.indices().len()),
     }
 }

@@ -78,7 +78,10 @@ fn peak_rss_mib() -> f64 {
 
 pub fn run_one(args: BenchOneArgs) -> anyhow::Result<()> {
     let (mesh, _) = super::load_mesh(&args.input)?;
-    let options = EncodeOptions { quantization_bits: args.bits, ..EncodeOptions::default() };
+    let options = EncodeOptions {
+        quantization_bits: args.bits,
+        ..EncodeOptions::default()
+    };
     let mut encode_ms = Vec::new();
     let mut encoded = None;
     for _ in 0..args.runs.max(1) {
@@ -96,9 +99,15 @@ pub fn run_one(args: BenchOneArgs) -> anyhow::Result<()> {
     }
     let levels = breakdown(&encoded.bytes)?;
     let n = mesh.positions.len() as f64;
-    let per_vertex = |f: fn(&vitrine_codec::LevelBreakdown) -> u32| levels[1..].iter().map(f).sum::<u32>() as f64 * 8.0 / n;
+    let per_vertex = |f: fn(&vitrine_codec::LevelBreakdown) -> u32| {
+        levels[1..].iter().map(f).sum::<u32>() as f64 * 8.0 / n
+    };
     let result = BenchResult {
-        name: args.input.file_name().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default(),
+        name: args
+            .input
+            .file_name()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_default(),
         vertices: mesh.positions.len(),
         faces: mesh.triangles.len(),
         colour: mesh.colors.is_some(),
@@ -121,14 +130,19 @@ pub fn run_one(args: BenchOneArgs) -> anyhow::Result<()> {
 fn mesh_files(inputs: &[PathBuf]) -> anyhow::Result<Vec<PathBuf>> {
     let is_mesh = |p: &Path| {
         matches!(
-            p.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).as_deref(),
+            p.extension()
+                .and_then(|e| e.to_str())
+                .map(str::to_ascii_lowercase)
+                .as_deref(),
             Some("ply" | "obj" | "off" | "gltf" | "glb")
         )
     };
     let mut out = Vec::new();
     for input in inputs {
         if input.is_dir() {
-            let mut entries: Vec<PathBuf> = std::fs::read_dir(input)?.filter_map(|e| Some(e.ok()?.path())).collect();
+            let mut entries: Vec<PathBuf> = std::fs::read_dir(input)?
+                .filter_map(|e| Some(e.ok()?.path()))
+                .collect();
             entries.sort();
             for e in entries {
                 if e.is_dir() {
@@ -145,7 +159,11 @@ fn mesh_files(inputs: &[PathBuf]) -> anyhow::Result<Vec<PathBuf>> {
 }
 
 /// Draco's bits per vertex and decode speed per mesh file name.
-fn run_draco(script: &Path, files: &[PathBuf], bits: u8) -> anyhow::Result<HashMap<String, (f64, f64)>> {
+fn run_draco(
+    script: &Path,
+    files: &[PathBuf],
+    bits: u8,
+) -> anyhow::Result<HashMap<String, (f64, f64)>> {
     let out = Command::new("python3")
         .arg(script)
         .arg("--bits")
@@ -154,14 +172,26 @@ fn run_draco(script: &Path, files: &[PathBuf], bits: u8) -> anyhow::Result<HashM
         .output()
         .context("running python3 for Draco")?;
     if !out.status.success() {
-        bail!("Draco script failed: {}", String::from_utf8_lossy(&out.stderr));
+        bail!(
+            "Draco script failed: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
     }
     let mut map = HashMap::new();
     for line in String::from_utf8_lossy(&out.stdout).lines().skip(1) {
         let cols: Vec<&str> = line.split('\t').collect();
         if cols.len() >= 9 {
-            let name = Path::new(cols[0]).file_name().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
-            map.insert(name, (cols[5].parse().unwrap_or(f64::NAN), cols[8].parse().unwrap_or(f64::NAN)));
+            let name = Path::new(cols[0])
+                .file_name()
+                .map(|s| s.to_string_lossy().into_owned())
+                .unwrap_or_default();
+            map.insert(
+                name,
+                (
+                    cols[5].parse().unwrap_or(f64::NAN),
+                    cols[8].parse().unwrap_or(f64::NAN),
+                ),
+            );
         }
     }
     Ok(map)
@@ -176,7 +206,12 @@ pub fn run(args: BenchArgs) -> anyhow::Result<()> {
         let out = Command::new(&exe)
             .arg("bench-one")
             .arg(file)
-            .args(["--bits", &args.bits.to_string(), "--runs", &args.runs.to_string()])
+            .args([
+                "--bits",
+                &args.bits.to_string(),
+                "--runs",
+                &args.runs.to_string(),
+            ])
             .output()?;
         if !out.status.success() {
             eprintln!("  skipped: {}", String::from_utf8_lossy(&out.stderr).trim());
@@ -196,7 +231,12 @@ pub fn run(args: BenchArgs) -> anyhow::Result<()> {
     Ok(())
 }
 
-fn markdown(results: &[BenchResult], draco: Option<&HashMap<String, (f64, f64)>>, bits: u8, runs: usize) -> String {
+fn markdown(
+    results: &[BenchResult],
+    draco: Option<&HashMap<String, (f64, f64)>>,
+    bits: u8,
+    runs: usize,
+) -> String {
     let mut s = format!(
         "{bits}-bit quantization; speeds are the median of {runs} runs on one core; bits per vertex (b/v) over the final vertex count.\n\n"
     );
@@ -222,7 +262,15 @@ fn markdown(results: &[BenchResult], draco: Option<&HashMap<String, (f64, f64)>>
         let mv = |ms: f64| r.vertices as f64 / ms / 1e3;
         s += &format!(
             "| {} | {} | {} | {} | {:.2} | {:.2} | {:.2} | {:.2} | {:.2} |",
-            r.name, r.vertices, r.levels, r.base_vertices, r.connectivity_bpv, r.geometry_bpv, r.colour_bpv, r.base_bpv, r.total_bpv
+            r.name,
+            r.vertices,
+            r.levels,
+            r.base_vertices,
+            r.connectivity_bpv,
+            r.geometry_bpv,
+            r.colour_bpv,
+            r.base_bpv,
+            r.total_bpv
         );
         let peer = draco.and_then(|d| d.get(&r.name));
         if draco.is_some() {

@@ -18,12 +18,21 @@ pub struct DecodeArgs {
 }
 
 pub fn run(args: DecodeArgs) -> anyhow::Result<()> {
-    let bytes = std::fs::read(&args.input).with_context(|| format!("reading {}", args.input.display()))?;
-    let decoder = decode(&bytes, args.level, Limits::default()).with_context(|| format!("decoding {}", args.input.display()))?;
+    let bytes =
+        std::fs::read(&args.input).with_context(|| format!("reading {}", args.input.display()))?;
+    let decoder = decode(&bytes, args.level, Limits::default())
+        .with_context(|| format!("decoding {}", args.input.display()))?;
     let mesh = decoder.to_mesh();
-    let file = std::fs::File::create(&args.output).with_context(|| format!("creating {}", args.output.display()))?;
+    let file = std::fs::File::create(&args.output)
+        .with_context(|| format!("creating {}", args.output.display()))?;
     let mut w = BufWriter::new(file);
-    match args.output.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).as_deref() {
+    match args
+        .output
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase)
+        .as_deref()
+    {
         Some("ply") => write_ply(&mesh, &mut w)?,
         Some("obj") => write_obj(&mesh, &mut w)?,
         Some("glb") => write_glb(&mesh, &mut w)?,

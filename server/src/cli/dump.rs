@@ -14,15 +14,28 @@ pub struct DumpArgs {
 }
 
 pub fn run(args: DumpArgs) -> anyhow::Result<()> {
-    let bytes = std::fs::read(&args.stream).with_context(|| format!("reading {}", args.stream.display()))?;
+    let bytes = std::fs::read(&args.stream)
+        .with_context(|| format!("reading {}", args.stream.display()))?;
     let index = StreamIndex::parse(&bytes)?;
     std::fs::create_dir_all(&args.out_dir)?;
     let mut decoder = Decoder::new(&bytes[index.base.clone()], Limits::default())?;
     let write = |d: &Decoder| -> anyhow::Result<()> {
         let k = d.level();
         let path = |what: &str| args.out_dir.join(format!("level-{k}.{what}"));
-        std::fs::write(path("positions"), d.positions().iter().flat_map(|v| v.to_le_bytes()).collect::<Vec<u8>>())?;
-        std::fs::write(path("indices"), d.indices().iter().flat_map(|v| v.to_le_bytes()).collect::<Vec<u8>>())?;
+        std::fs::write(
+            path("positions"),
+            d.positions()
+                .iter()
+                .flat_map(|v| v.to_le_bytes())
+                .collect::<Vec<u8>>(),
+        )?;
+        std::fs::write(
+            path("indices"),
+            d.indices()
+                .iter()
+                .flat_map(|v| v.to_le_bytes())
+                .collect::<Vec<u8>>(),
+        )?;
         if let Some(c) = d.colours() {
             std::fs::write(path("colours"), c)?;
         }

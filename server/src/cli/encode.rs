@@ -41,7 +41,10 @@ impl EncodeArgs {
 }
 
 pub fn run(args: EncodeArgs) -> anyhow::Result<()> {
-    let output = args.output.clone().unwrap_or_else(|| args.input.with_extension("vtr"));
+    let output = args
+        .output
+        .clone()
+        .unwrap_or_else(|| args.input.with_extension("vtr"));
     let (mesh, report) = super::load_mesh(&args.input)?;
     if let Some(text) = super::describe_repair(&report) {
         eprintln!("repair: {text}");
@@ -49,9 +52,11 @@ pub fn run(args: EncodeArgs) -> anyhow::Result<()> {
     let n = mesh.positions.len() as u64;
     let bar = ProgressBar::new(n);
     bar.set_style(
-        ProgressStyle::with_template("{spinner} layer {msg} [{bar:40}] {pos}/{len} vertices removed")
-            .expect("valid template")
-            .progress_chars("=> "),
+        ProgressStyle::with_template(
+            "{spinner} layer {msg} [{bar:40}] {pos}/{len} vertices removed",
+        )
+        .expect("valid template")
+        .progress_chars("=> "),
     );
     let start = Instant::now();
     let encoded = encode_with_progress(&mesh, &args.options(), |p| {
@@ -60,7 +65,8 @@ pub fn run(args: EncodeArgs) -> anyhow::Result<()> {
     })?;
     bar.finish_and_clear();
     let elapsed = start.elapsed();
-    std::fs::write(&output, &encoded.bytes).with_context(|| format!("writing {}", output.display()))?;
+    std::fs::write(&output, &encoded.bytes)
+        .with_context(|| format!("writing {}", output.display()))?;
     let h = &encoded.header;
     eprintln!(
         "{}: {} vertices, {} faces → {} bytes ({:.2} bits/vertex), {} levels, base {} vertices, {:.2} s",

@@ -10,7 +10,8 @@ pub struct InspectArgs {
 }
 
 pub fn run(args: InspectArgs) -> anyhow::Result<()> {
-    let bytes = std::fs::read(&args.input).with_context(|| format!("reading {}", args.input.display()))?;
+    let bytes =
+        std::fs::read(&args.input).with_context(|| format!("reading {}", args.input.display()))?;
     let header = Header::parse(&bytes)?;
     let levels = breakdown(&bytes)?;
     let q = header.quantization;
@@ -20,13 +21,21 @@ pub fn run(args: InspectArgs) -> anyhow::Result<()> {
         bytes.len(),
         q.bits,
         q.step,
-        if header.has_colour { "per vertex" } else { "none" },
+        if header.has_colour {
+            "per vertex"
+        } else {
+            "none"
+        },
         header.batch_count()
     );
     println!("level  vertices     faces      bytes   conn b/v   geom b/v  colour b/v  total b/v");
     for (k, l) in levels.iter().enumerate() {
         // Bits per vertex *added* by this level, the figure AD01 reports per layer.
-        let added = if k == 0 { l.vertices } else { l.vertices - levels[k - 1].vertices } as f64;
+        let added = if k == 0 {
+            l.vertices
+        } else {
+            l.vertices - levels[k - 1].vertices
+        } as f64;
         let bpv = |bytes: u32| bytes as f64 * 8.0 / added;
         println!(
             "{k:5} {:9} {:9} {:10} {:10.2} {:10.2} {:11.2} {:10.2}",
@@ -40,7 +49,9 @@ pub fn run(args: InspectArgs) -> anyhow::Result<()> {
         );
     }
     let n = header.final_level().vertices as f64;
-    let sum = |f: fn(&vitrine_codec::LevelBreakdown) -> u32| levels[1..].iter().map(f).sum::<u32>() as f64 * 8.0 / n;
+    let sum = |f: fn(&vitrine_codec::LevelBreakdown) -> u32| {
+        levels[1..].iter().map(f).sum::<u32>() as f64 * 8.0 / n
+    };
     println!(
         "whole stream per final vertex: connectivity {:.2}, geometry {:.2}, colour {:.2}, base mesh {:.2}, total {:.2} bits",
         sum(|l| l.connectivity + l.overhead),

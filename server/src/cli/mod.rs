@@ -15,8 +15,10 @@ use vitrine_codec::IndexedMesh;
 
 /// Reads any supported mesh file and repairs it into an encodable manifold.
 pub fn load_mesh(path: &Path) -> anyhow::Result<(IndexedMesh, RepairReport)> {
-    let mesh = import_path(path, &ImportOptions::default()).with_context(|| format!("reading {}", path.display()))?;
-    prepare(mesh, &RepairOptions::default()).with_context(|| format!("repairing {}", path.display()))
+    let mesh = import_path(path, &ImportOptions::default())
+        .with_context(|| format!("reading {}", path.display()))?;
+    prepare(mesh, &RepairOptions::default())
+        .with_context(|| format!("repairing {}", path.display()))
 }
 
 /// Human summary of what repair changed, or `None` when nothing did.

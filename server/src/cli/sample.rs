@@ -63,8 +63,14 @@ pub fn generate(args: &SampleArgs) -> IndexedMesh {
 
 pub fn run(args: SampleArgs) -> anyhow::Result<()> {
     let mesh = generate(&args);
-    let file = std::fs::File::create(&args.output).with_context(|| format!("creating {}", args.output.display()))?;
+    let file = std::fs::File::create(&args.output)
+        .with_context(|| format!("creating {}", args.output.display()))?;
     vitrine_codec::export::write_ply(&mesh, &mut BufWriter::new(file))?;
-    eprintln!("{}: {} vertices, {} faces", args.output.display(), mesh.positions.len(), mesh.triangles.len());
+    eprintln!(
+        "{}: {} vertices, {} faces",
+        args.output.display(),
+        mesh.positions.len(),
+        mesh.triangles.len()
+    );
     Ok(())
 }

@@ -1,0 +1,15 @@
+#!/usr/bin/env bash
+# Every test of the project: formatting and lints, Rust unit/integration tests
+# (SQLite and PostgreSQL), the WebAssembly decoder against the native one in
+# Node, the viewer in headless Chromium, and a short fuzzing pass.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+bash scripts/setup.sh
+cargo fmt --all -- --check
+cargo clippy --workspace --all-targets -- -D warnings
+bash scripts/build.sh
+cargo test --workspace
+(cd web && npm run --silent typecheck && npm test && npm run test:e2e)
+if [ -x scripts/fuzz.sh ] || [ -f scripts/fuzz.sh ]; then
+    bash scripts/fuzz.sh "${FUZZ_SECONDS:-20}"
+fi
