@@ -53,46 +53,42 @@ impl Connectivity {
             }
             origin.extend_from_slice(t);
         }
-        // Outgoing half-edges per vertex in CSR form; a half-edge a → b finds
-        // its twin among b's outgoing ones. Linear time, unlike sorting edge keys.
-        let mut first = vec![0u32; vertex_count + 1];
-        for &v in &origin {
-            first[v as usize + 1] += 1;
-        }
-        for v in 0..vertex_count {
-            first[v + 1] += first[v];
-        }
-        let mut fill = first.clone();
-        // Half-edge id and target side by side, so the scans below stay in one cache line.
-        let mut outgoing = vec![(0u32, 0u32); origin.len()];
-        for (h, &v) in origin.iter().enumerate() {
-            outgoing[fill[v as usize] as usize] = (h as u32, origin[next(h as u32) as usize]);
-            fill[v as usize] += 1;
-        }
+        // Pair half-edges by undirected edge key with an LSD radix sort: it
+        // streams memory, where a hash map or per-vertex search would take a
+        // cache miss per half-edge on multi-million-vertex scans.
+        let mut keys: Vec<(u64, u32)> = (0..origin.len() as u32)
+            .map(|h| {
+                let (a, b) = (origin[h as usize], origin[next(h) as usize]);
+                (((a.min(b) as u64) << 32) | a.max(b) as u64, h)
+            })
+            .collect();
+        radix_sort(&mut keys, vertex_count as u64);
         let mut twin = vec![NONE; origin.len()];
-        for h in 0..origin.len() as u32 {
-            let (a, b) = (origin[h as usize], origin[next(h) as usize]);
-            let mut same = 0;
-            let mut found = NONE;
-            for &(_, t) in &outgoing[first[a as usize] as usize..first[a as usize + 1] as usize] {
-                same += u32::from(t == b);
+        let mut i = 0;
+        while i < keys.len() {
+            let mut j = i + 1;
+            while j < keys.len() && keys[j].0 == keys[i].0 {
+                j += 1;
             }
-            for &(g, t) in &outgoing[first[b as usize] as usize..first[b as usize + 1] as usize] {
-                if t == a {
-                    if found != NONE {
-                        return Err(non_manifold("shared by more than two faces", &origin, h));
+            match j - i {
+                1 => {}
+                2 => {
+                    let (h, g) = (keys[i].1, keys[i + 1].1);
+                    if origin[h as usize] == origin[g as usize] {
+                        return Err(non_manifold("inconsistently oriented", &origin, h));
                     }
-                    found = g;
+                    twin[h as usize] = g;
+                    twin[g as usize] = h;
+                }
+                _ => {
+                    return Err(non_manifold(
+                        "shared by more than two faces",
+                        &origin,
+                        keys[i].1,
+                    ))
                 }
             }
-            if same > 1 {
-                return Err(non_manifold(
-                    "inconsistently oriented or shared by more than two faces",
-                    &origin,
-                    h,
-                ));
-            }
-            twin[h as usize] = found;
+            i = j;
         }
         let mut out = vec![NONE; vertex_count];
         for (h, &v) in origin.iter().enumerate() {
@@ -203,6 +199,36 @@ impl Connectivity {
             .chunks_exact(3)
             .filter(|t| t[0] != NONE)
             .map(|t| [t[0], t[1], t[2]])
+    }
+}
+
+/// Sorts `(key, value)` pairs by key, where keys are `min << 32 | max` of
+/// two ids below `id_bound`. Stable, 11-bit digits, only the digits in use.
+fn radix_sort(items: &mut Vec<(u64, u32)>, id_bound: u64) {
+    const BITS: u32 = 11;
+    let id_bits = 64 - id_bound.max(1).leading_zeros();
+    let mut scratch = vec![(0u64, 0u32); items.len()];
+    for half in [0u32, 32] {
+        let mut shift = half;
+        while shift < half + id_bits {
+            let mut counts = [0usize; 1 << BITS];
+            for &(k, _) in items.iter() {
+                counts[((k >> shift) & ((1 << BITS) - 1)) as usize] += 1;
+            }
+            let mut sum = 0;
+            for c in counts.iter_mut() {
+                let n = *c;
+                *c = sum;
+                sum += n;
+            }
+            for &item in items.iter() {
+                let d = ((item.0 >> shift) & ((1 << BITS) - 1)) as usize;
+                scratch[counts[d]] = item;
+                counts[d] += 1;
+            }
+            std::mem::swap(items, &mut scratch);
+            shift += BITS;
+        }
     }
 }
 

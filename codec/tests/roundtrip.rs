@@ -161,3 +161,40 @@ fn geometric_guard_off_round_trips() {
         },
     );
 }
+
+/// Every real scan in `../shared/data/meshes` round-trips bit-exactly (skipped when absent).
+#[cfg(feature = "import")]
+#[test]
+fn shared_meshes_round_trip() {
+    use vitrine_codec::import::{import_path, ImportOptions};
+    use vitrine_codec::repair::{prepare, RepairOptions};
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/data/meshes");
+    if !dir.is_dir() {
+        eprintln!("skipped: {} is absent", dir.display());
+        return;
+    }
+    let mut files = Vec::new();
+    for entry in std::fs::read_dir(&dir).unwrap() {
+        let path = entry.unwrap().path();
+        if path.is_dir() {
+            for inner in std::fs::read_dir(&path).unwrap() {
+                files.push(inner.unwrap().path());
+            }
+        } else {
+            files.push(path);
+        }
+    }
+    let mut tested = 0;
+    for path in files {
+        let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
+        if !matches!(ext.as_str(), "ply" | "obj" | "off" | "gltf" | "glb") {
+            continue;
+        }
+        let mesh = import_path(&path, &ImportOptions::default()).unwrap();
+        let (mesh, _) = prepare(mesh, &RepairOptions::default()).unwrap();
+        let bytes = assert_round_trip(&mesh, &EncodeOptions::default());
+        eprintln!("{}: {} vertices, {} bytes", path.display(), mesh.positions.len(), bytes);
+        tested += 1;
+    }
+    assert!(tested >= 10, "expected the shared meshes, found {tested}");
+}

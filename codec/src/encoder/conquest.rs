@@ -396,23 +396,24 @@ impl Simplifier {
     }
 
     fn encode_vertex(&self, p: &Patch, s: &mut Streams) {
-        let polygon: Vec<[i32; 3]> = p.polygon[..p.valence]
-            .iter()
-            .map(|&v| self.positions[v as usize])
-            .collect();
-        PatchPrediction::new(&polygon).encode(
+        let d = p.valence;
+        let mut polygon = [[0i32; 3]; MAX_VALENCE];
+        for (q, &v) in polygon.iter_mut().zip(&p.polygon[..d]) {
+            *q = self.positions[v as usize];
+        }
+        PatchPrediction::new(&polygon[..d]).encode(
             self.positions[p.centre as usize],
             &mut s.models,
             &mut s.geom,
         );
         if let Some(colours) = &self.colours {
-            let border: Vec<[u8; 3]> = p.polygon[..p.valence]
-                .iter()
-                .map(|&v| colours[v as usize])
-                .collect();
+            let mut border = [[0u8; 3]; MAX_VALENCE];
+            for (c, &v) in border.iter_mut().zip(&p.polygon[..d]) {
+                *c = colours[v as usize];
+            }
             encode_colour(
                 colours[p.centre as usize],
-                predict_colour(&border),
+                predict_colour(&border[..d]),
                 &mut s.models,
                 &mut s.colour,
             );

@@ -114,6 +114,29 @@ fn gltf_error(e: gltf::Error, what: &'static str) -> Error {
     Error::input(what, e)
 }
 
+/// gltf-json 1.4's validation reads a primitive's `POSITION` accessor
+/// before checking that it exists, and panics on an index past the end of
+/// `accessors`: refuse such documents before validating them.
+fn check_attribute_accessors(root: &gltf::json::Root, what: &'static str) -> Result<()> {
+    for (m, mesh) in root.meshes.iter().enumerate() {
+        for (p, prim) in mesh.primitives.iter().enumerate() {
+            for index in prim.attributes.values() {
+                if index.value() >= root.accessors.len() {
+                    return Err(Error::input(
+                        what,
+                        format!(
+                            "invalid glTF: mesh {m} primitive {p} uses accessor {} but there are {}",
+                            index.value(),
+                            root.accessors.len()
+                        ),
+                    ));
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
 /// The buffers of a document, loaded on first use.
 struct Buffers<'a> {
     what: &'static str,
@@ -403,7 +426,10 @@ pub(super) fn read(
     if json.iter().all(|b| b.is_ascii_whitespace()) {
         return Err(Error::input(what, "is empty"));
     }
-    let doc = gltf::Gltf::from_slice(json).map_err(|e| gltf_error(e, what))?;
+    let root = gltf::json::Root::from_slice(json)
+        .map_err(|e| gltf_error(gltf::Error::Deserialize(e), what))?;
+    check_attribute_accessors(&root, what)?;
+    let doc = gltf::Document::from_json(root).map_err(|e| gltf_error(e, what))?;
     let mut buffers = Buffers {
         what,
         base,
