@@ -76,7 +76,7 @@ impl Givens {
 
 /// Round half away from zero with casts only (no libm), identical everywhere.
 #[inline]
-fn round(x: f64) -> i64 {
+pub(crate) fn round(x: f64) -> i64 {
     if x >= 0.0 {
         (x + 0.5) as i64
     } else {

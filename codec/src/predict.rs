@@ -2,7 +2,8 @@
 //! residuals are coded with. Encoder and decoder call the same functions.
 
 use crate::entropy::{BitModel, IntModel, RangeDecoder, RangeEncoder, SymbolModel};
-use crate::frenet::Frame;
+use crate::frenet::{round, Frame};
+use crate::halfedge::Connectivity;
 use crate::patch::{Tag, MAX_VALENCE};
 
 /// Context for a gate's code: the tags of its two vertices and of the
@@ -55,7 +56,47 @@ pub(crate) struct PatchPrediction {
     scale: usize,
 }
 
+/// Umbrella vector of a vertex in the coarse mesh: the sum of its
+/// neighbours minus `count` times itself, and the neighbour count. Exact
+/// integers, independent of the order neighbours are visited in.
+pub(crate) fn umbrella(conn: &Connectivity, positions: &[[i32; 3]], v: u32) -> ([i64; 3], i64) {
+    let p = positions[v as usize];
+    let mut sum = [0i64; 3];
+    let mut count = 0i64;
+    conn.for_each_outgoing(v, |h| {
+        let q = positions[conn.target(h) as usize];
+        for k in 0..3 {
+            sum[k] += (q[k] - p[k]) as i64;
+        }
+        count += 1;
+    });
+    (sum, count.max(1))
+}
+
+/// How far the fine surface bulges out of the border polygon, from the
+/// coarse mesh's curvature at the border vertices (in eighths of the mean
+/// umbrella vector; 3/8 measured best on the shared scans, 0.9 % smaller
+/// than none). Both sides see the same coarse mesh: the encoder after
+/// the pass, the decoder before undoing it.
+const CURVATURE_EIGHTHS: f64 = 3.0;
+
 impl PatchPrediction {
+    /// Barycentre corrected by the coarse mesh's curvature at the border.
+    pub(crate) fn with_curvature(polygon: &[[i32; 3]], umbrellas: &[([i64; 3], i64)]) -> Self {
+        let mut p = Self::new(polygon);
+        let mut mean = [0.0f64; 3];
+        for (sum, count) in umbrellas {
+            for (m, &s) in mean.iter_mut().zip(sum) {
+                *m += s as f64 / *count as f64;
+            }
+        }
+        let scale = CURVATURE_EIGHTHS / 8.0 / umbrellas.len() as f64;
+        for (x, m) in p.position.iter_mut().zip(mean) {
+            *x -= round(m * scale);
+        }
+        p
+    }
+
     pub(crate) fn new(polygon: &[[i32; 3]]) -> Self {
         let d = polygon.len() as i64;
         let mut sum = [0i64; 3];

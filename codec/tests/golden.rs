@@ -31,7 +31,9 @@ fn meshes() -> Vec<(&'static str, IndexedMesh)> {
 
 /// FNV-1a, 64 bits.
 fn fnv1a64(bytes: &[u8]) -> u64 {
-    bytes.iter().fold(0xcbf2_9ce4_8422_2325, |h, &b| (h ^ b as u64).wrapping_mul(0x0000_0100_0000_01b3))
+    bytes.iter().fold(0xcbf2_9ce4_8422_2325, |h, &b| {
+        (h ^ b as u64).wrapping_mul(0x0000_0100_0000_01b3)
+    })
 }
 
 fn golden_path() -> PathBuf {
@@ -69,12 +71,19 @@ fn encoder_output_matches_golden_values() {
         eprintln!("re-recorded {}", golden_path().display());
         return;
     }
-    let recorded = std::fs::read_to_string(golden_path()).expect("tests/golden.txt (record it with VITRINE_BLESS=1)");
+    let recorded = std::fs::read_to_string(golden_path())
+        .expect("tests/golden.txt (record it with VITRINE_BLESS=1)");
     let mut expected = Vec::new();
-    for line in recorded.lines().map(str::trim).filter(|l| !l.is_empty() && !l.starts_with('#')) {
+    for line in recorded
+        .lines()
+        .map(str::trim)
+        .filter(|l| !l.is_empty() && !l.starts_with('#'))
+    {
         let f: Vec<&str> = line.split_whitespace().collect();
         assert_eq!(f.len(), 3, "malformed golden.txt line {line:?}");
-        let len: usize = f[1].parse().unwrap_or_else(|_| panic!("bad length in {line:?}"));
+        let len: usize = f[1]
+            .parse()
+            .unwrap_or_else(|_| panic!("bad length in {line:?}"));
         let hash = u64::from_str_radix(f[2], 16).unwrap_or_else(|_| panic!("bad hash in {line:?}"));
         expected.push((f[0], len, hash));
     }
@@ -82,9 +91,9 @@ fn encoder_output_matches_golden_values() {
     for &(name, len, hash) in &found {
         match expected.iter().find(|e| e.0 == name) {
             None => diffs.push(format!("{name}: not in golden.txt")),
-            Some(&(_, l, h)) if (l, h) != (len, hash) => {
-                diffs.push(format!("{name}: recorded {l} bytes {h:016x}, now {len} bytes {hash:016x}"))
-            }
+            Some(&(_, l, h)) if (l, h) != (len, hash) => diffs.push(format!(
+                "{name}: recorded {l} bytes {h:016x}, now {len} bytes {hash:016x}"
+            )),
             Some(_) => {}
         }
     }

@@ -17,7 +17,9 @@ use std::sync::OnceLock;
 use std::time::{Duration, Instant};
 
 use vitrine_codec::samples::icosphere;
-use vitrine_codec::{decode, encode, Decoder, EncodeOptions, Error, Header, Limits, StreamIndex, MAGIC, VERSION};
+use vitrine_codec::{
+    decode, encode, Decoder, EncodeOptions, Error, Header, Limits, StreamIndex, MAGIC, VERSION,
+};
 
 // ---------------------------------------------------------------- helpers
 
@@ -25,14 +27,22 @@ use vitrine_codec::{decode, encode, Decoder, EncodeOptions, Error, Header, Limit
 /// base mesh and a few batches.
 fn sphere_stream() -> &'static [u8] {
     static S: OnceLock<Vec<u8>> = OnceLock::new();
-    S.get_or_init(|| encode(&icosphere(3), &EncodeOptions::default()).expect("encode").bytes)
+    S.get_or_init(|| {
+        encode(&icosphere(3), &EncodeOptions::default())
+            .expect("encode")
+            .bytes
+    })
 }
 
 /// Peak bytes a hostile input may make the decoder hold at once.
 const SMALL_PEAK: u64 = 4 << 20;
 
 /// Limits that trust the stream completely: only the input's own bytes bound the work.
-const NO_LIMITS: Limits = Limits { max_vertices: u32::MAX, max_faces: u32::MAX, max_batches: u32::MAX };
+const NO_LIMITS: Limits = Limits {
+    max_vertices: u32::MAX,
+    max_faces: u32::MAX,
+    max_batches: u32::MAX,
+};
 
 // Header layout (FORMAT.md): magic 0..4, version 4, flags 5, bits 6, reserved 7,
 // min 8..20, step 20..24, batch count 24..28, then 12 bytes per level.
@@ -125,7 +135,10 @@ fn err_of(r: vitrine_codec::Result<Decoder>) -> Error {
 #[track_caller]
 fn assert_stream_err(r: vitrine_codec::Result<Decoder>, needles: &[&str]) {
     let e = err_of(r);
-    assert!(matches!(e, Error::Input { what: "stream", .. }), "not a stream error: {e:?}");
+    assert!(
+        matches!(e, Error::Input { what: "stream", .. }),
+        "not a stream error: {e:?}"
+    );
     let s = e.to_string();
     for n in needles {
         assert!(s.contains(n), "error {s:?} does not mention {n:?}");
@@ -154,9 +167,16 @@ fn assert_consistent(d: &Decoder) {
         assert_eq!(c.len(), 3 * n);
     }
     let max = (1i32 << d.header().quantization.bits) - 1;
-    assert!(d.quantized_positions().iter().flatten().all(|&q| (0..=max).contains(&q)));
+    assert!(d
+        .quantized_positions()
+        .iter()
+        .flatten()
+        .all(|&q| (0..=max).contains(&q)));
     let level = d.header().levels[d.level()];
-    assert_eq!(n, level.vertices as usize, "vertex count disagrees with the level table");
+    assert_eq!(
+        n, level.vertices as usize,
+        "vertex count disagrees with the level table"
+    );
 }
 
 /// Every undirected edge has at most two faces, and each direction at most one.
@@ -169,9 +189,15 @@ fn manifold_violation(indices: &[u32]) -> Option<String> {
     if let Some(w) = directed.windows(2).find(|w| w[0] == w[1]) {
         return Some(format!("half-edge {:?} appears twice", w[0]));
     }
-    let mut undirected: Vec<(u32, u32)> = directed.iter().map(|&(a, b)| (a.min(b), a.max(b))).collect();
+    let mut undirected: Vec<(u32, u32)> = directed
+        .iter()
+        .map(|&(a, b)| (a.min(b), a.max(b)))
+        .collect();
     undirected.sort_unstable();
-    undirected.windows(3).find(|w| w[0] == w[2]).map(|w| format!("edge {:?} has more than two faces", w[0]))
+    undirected
+        .windows(3)
+        .find(|w| w[0] == w[2])
+        .map(|w| format!("edge {:?} has more than two faces", w[0]))
 }
 
 /// Runs `f`, turning a panic into a message instead of failing at once, so
@@ -206,7 +232,10 @@ fn wrong_magic_is_refused() {
         b[..4].copy_from_slice(&magic);
         assert_stream_err(decode(&b, None, Limits::default()), &["bad magic"]);
     }
-    assert_stream_err(decode(b"ply\nformat ascii 1.0\n", None, Limits::default()), &["bad magic"]);
+    assert_stream_err(
+        decode(b"ply\nformat ascii 1.0\n", None, Limits::default()),
+        &["bad magic"],
+    );
     assert_eq!(&s[..4], &MAGIC);
 }
 
@@ -215,7 +244,10 @@ fn unsupported_version_is_refused() {
     for v in [0, VERSION + 1, 0x7f, 0xff] {
         let mut b = sphere_stream().to_vec();
         b[AT_VERSION] = v;
-        assert_stream_err(decode(&b, None, Limits::default()), &["unsupported version", &v.to_string()]);
+        assert_stream_err(
+            decode(&b, None, Limits::default()),
+            &["unsupported version", &v.to_string()],
+        );
     }
 }
 
@@ -233,13 +265,22 @@ fn quantization_bits_out_of_range_are_refused() {
     for bits in [0, 1, 7, 17, 32, 255] {
         let mut b = sphere_stream().to_vec();
         b[AT_BITS] = bits;
-        assert_stream_err(decode(&b, None, Limits::default()), &[&format!("quantization of {bits} bits")]);
+        assert_stream_err(
+            decode(&b, None, Limits::default()),
+            &[&format!("quantization of {bits} bits")],
+        );
     }
 }
 
 #[test]
 fn non_finite_bounding_box_is_refused() {
-    let bad = [f32::NAN, -f32::NAN, f32::INFINITY, f32::NEG_INFINITY, f32::from_bits(0x7f80_0001)];
+    let bad = [
+        f32::NAN,
+        -f32::NAN,
+        f32::INFINITY,
+        f32::NEG_INFINITY,
+        f32::from_bits(0x7f80_0001),
+    ];
     for axis in 0..3 {
         for v in bad {
             let mut b = sphere_stream().to_vec();
@@ -262,26 +303,44 @@ fn level_table_claiming_billions_is_refused_at_once() {
     for batches in [4_000_000_000, u32::MAX, 1 << 28] {
         let mut b = s[..100].to_vec();
         put_u32(&mut b, AT_BATCHES, batches);
-        assert_stream_err(decode(&b, None, NO_LIMITS), &[&format!("declares {batches} batches")]);
+        assert_stream_err(
+            decode(&b, None, NO_LIMITS),
+            &[&format!("declares {batches} batches")],
+        );
         assert_stream_err(Decoder::new(&b, NO_LIMITS), &["truncated"]);
     }
     // A final level of 4e9 vertices or faces in a 100-byte file.
     let batch = chunk(b'L', 1, 0, 0, 0, &[]);
     let tiny = sphere_with_batch(4_000_000_000, 4_000_000_000, &batch);
     assert!(tiny.len() < 1024);
-    assert_limit(decode(&tiny, None, Limits::default()), "4000000000 vertices");
+    assert_limit(
+        decode(&tiny, None, Limits::default()),
+        "4000000000 vertices",
+    );
     let base_faces = get_u32(s, level_at(0) + 4);
     let fewer_faces = sphere_with_batch(4_000_000_000, base_faces, &batch);
-    assert_limit(decode(&fewer_faces, None, Limits::default()), "4000000000 vertices");
+    assert_limit(
+        decode(&fewer_faces, None, Limits::default()),
+        "4000000000 vertices",
+    );
     let many_faces = sphere_with_batch(get_u32(s, level_at(0)) + 1, 4_000_000_000, &batch);
-    assert_limit(decode(&many_faces, None, Limits::default()), "4000000000 faces");
+    assert_limit(
+        decode(&many_faces, None, Limits::default()),
+        "4000000000 faces",
+    );
     // Chunk sizes past the end of the input.
     let mut b = s.to_vec();
     put_u32(&mut b, level_at(1) + 8, u32::MAX);
-    assert_stream_err(decode(&b, None, Limits::default()), &["shorter than its level table"]);
+    assert_stream_err(
+        decode(&b, None, Limits::default()),
+        &["shorter than its level table"],
+    );
     let mut b = s.to_vec();
     put_u32(&mut b, level_at(0) + 8, u32::MAX);
-    assert_stream_err(decode(&b, None, Limits::default()), &["shorter than its level table"]);
+    assert_stream_err(
+        decode(&b, None, Limits::default()),
+        &["shorter than its level table"],
+    );
     assert!(t.elapsed() < Duration::from_secs(2), "{:?}", t.elapsed());
 }
 
@@ -289,7 +348,10 @@ fn level_table_claiming_billions_is_refused_at_once() {
 fn level_table_that_does_not_grow_is_refused() {
     let s = sphere_stream();
     let header = Header::parse(s).unwrap();
-    assert!(header.batch_count() >= 2, "the sample stream needs two batches");
+    assert!(
+        header.batch_count() >= 2,
+        "the sample stream needs two batches"
+    );
     for k in 1..=header.batch_count() {
         let prev = header.levels[k - 1];
         // Same vertex count as the level before.
@@ -312,22 +374,42 @@ fn limits_are_enforced() {
     let s = sphere_stream();
     let header = Header::parse(s).unwrap();
     let last = header.final_level();
-    let exact = Limits { max_vertices: last.vertices, max_faces: last.faces, max_batches: header.batch_count() as u32 };
+    let exact = Limits {
+        max_vertices: last.vertices,
+        max_faces: last.faces,
+        max_batches: header.batch_count() as u32,
+    };
     let d = decode(s, None, exact).unwrap();
     assert_consistent(&d);
     assert!(d.is_complete());
 
-    let fewer_vertices = Limits { max_vertices: last.vertices - 1, ..exact };
+    let fewer_vertices = Limits {
+        max_vertices: last.vertices - 1,
+        ..exact
+    };
     assert_limit(decode(s, None, fewer_vertices), "limits are");
-    let fewer_faces = Limits { max_faces: last.faces - 1, ..exact };
+    let fewer_faces = Limits {
+        max_faces: last.faces - 1,
+        ..exact
+    };
     assert_limit(decode(s, None, fewer_faces), "limits are");
-    let fewer_batches = Limits { max_batches: header.batch_count() as u32 - 1, ..exact };
+    let fewer_batches = Limits {
+        max_batches: header.batch_count() as u32 - 1,
+        ..exact
+    };
     assert_limit(decode(s, None, fewer_batches), "exceed the limit");
-    let nothing = Limits { max_vertices: 0, max_faces: 0, max_batches: 0 };
+    let nothing = Limits {
+        max_vertices: 0,
+        max_faces: 0,
+        max_batches: 0,
+    };
     assert!(matches!(decode(s, None, nothing), Err(Error::Limit(_))));
     // The same through the incremental API.
     let index = StreamIndex::parse(s).unwrap();
-    assert_limit(Decoder::new(&s[index.base.clone()], fewer_vertices), "limits are");
+    assert_limit(
+        Decoder::new(&s[index.base.clone()], fewer_vertices),
+        "limits are",
+    );
     // Decoding only the base level still checks the whole stream against the limits.
     assert_limit(decode(s, Some(0), fewer_vertices), "limits are");
 }
@@ -354,7 +436,10 @@ fn every_prefix_of_each_chunk_fails() {
     let s = sphere_stream();
     let index = StreamIndex::parse(s).unwrap();
     for len in 0..index.base.end {
-        assert!(Decoder::new(&s[..len], Limits::default()).is_err(), "base prefix {len}");
+        assert!(
+            Decoder::new(&s[..len], Limits::default()).is_err(),
+            "base prefix {len}"
+        );
     }
     let mut reference = Decoder::new(&s[index.base.clone()], Limits::default()).unwrap();
     for (k, range) in index.batches.iter().enumerate() {
@@ -363,8 +448,13 @@ fn every_prefix_of_each_chunk_fails() {
             // A fresh decoder at the right level for each attempt: a failed
             // batch leaves the decoder unspecified.
             let mut d = decode(s, Some(k), Limits::default()).unwrap();
-            let e = d.apply_batch(&batch[..len]).expect_err("truncated batch accepted");
-            assert!(e.to_string().contains("truncated"), "batch {k} cut at {len}: {e}");
+            let e = d
+                .apply_batch(&batch[..len])
+                .expect_err("truncated batch accepted");
+            assert!(
+                e.to_string().contains("truncated"),
+                "batch {k} cut at {len}: {e}"
+            );
         }
         reference.apply_batch(batch).unwrap();
     }
@@ -387,7 +477,10 @@ fn payloads_cut_short_with_consistent_lengths_fail() {
             let mut d = decode(s, Some(k), Limits::default()).unwrap();
             match no_panic(|| d.apply_batch(&short)) {
                 Ok(Err(_)) => {}
-                Ok(Ok(())) => failures.push(format!("batch {k} cut to {cut} of {} payload bytes decoded", payload.len())),
+                Ok(Ok(())) => failures.push(format!(
+                    "batch {k} cut to {cut} of {} payload bytes decoded",
+                    payload.len()
+                )),
                 Err(p) => failures.push(format!("batch {k} cut to {cut} bytes panicked: {p}")),
             }
         }
@@ -407,7 +500,11 @@ fn batches_applied_twice_out_of_order_or_from_another_stream_fail() {
     // Twice.
     let mut d = Decoder::new(base, Limits::default()).unwrap();
     d.apply_batch(batch(0)).unwrap();
-    assert!(d.apply_batch(batch(0)).unwrap_err().to_string().contains("batch for level 1 applied at level 1"));
+    assert!(d
+        .apply_batch(batch(0))
+        .unwrap_err()
+        .to_string()
+        .contains("batch for level 1 applied at level 1"));
 
     // Out of order: batch 2 first.
     let mut d = Decoder::new(base, Limits::default()).unwrap();
@@ -431,10 +528,17 @@ fn batches_applied_twice_out_of_order_or_from_another_stream_fail() {
     assert!(e.contains("expected a batch chunk"), "{e}");
     let mut wrong = base[..header_len].to_vec();
     wrong.extend_from_slice(batch(0));
-    assert_stream_err(Decoder::new(&wrong, Limits::default()), &["expected a base chunk"]);
+    assert_stream_err(
+        Decoder::new(&wrong, Limits::default()),
+        &["expected a base chunk"],
+    );
 
     // A batch from another stream: a torus has different counts.
-    let other = encode(&vitrine_codec::samples::torus(40, 16, 1.0, 0.4), &EncodeOptions::default()).unwrap();
+    let other = encode(
+        &vitrine_codec::samples::torus(40, 16, 1.0, 0.4),
+        &EncodeOptions::default(),
+    )
+    .unwrap();
     let oi = StreamIndex::parse(&other.bytes).unwrap();
     let mut d = Decoder::new(base, Limits::default()).unwrap();
     for r in &oi.batches {
@@ -443,7 +547,14 @@ fn batches_applied_twice_out_of_order_or_from_another_stream_fail() {
     // A batch from another stream of the same counts (the same sphere at a
     // different quantization, when that keeps the counts): nothing in the
     // format can tell the geometry apart, but the result must stay consistent.
-    let q10 = encode(&icosphere(3), &EncodeOptions { quantization_bits: 10, ..Default::default() }).unwrap();
+    let q10 = encode(
+        &icosphere(3),
+        &EncodeOptions {
+            quantization_bits: 10,
+            ..Default::default()
+        },
+    )
+    .unwrap();
     let qi = StreamIndex::parse(&q10.bytes).unwrap();
     let mut d = Decoder::new(base, Limits::default()).unwrap();
     for r in &qi.batches {
@@ -466,7 +577,11 @@ fn malformed_batch_payloads_are_refused() {
     // Chunk version.
     let mut b = real.to_vec();
     b[1] = VERSION + 1;
-    assert!(fresh().apply_batch(&b).unwrap_err().to_string().contains("chunk version mismatch"));
+    assert!(fresh()
+        .apply_batch(&b)
+        .unwrap_err()
+        .to_string()
+        .contains("chunk version mismatch"));
     // Counts that disagree with the level table.
     for (at, v) in [(4, n + 1), (8, after + 1), (12, faces + 1)] {
         let mut b = real.to_vec();
@@ -477,10 +592,19 @@ fn malformed_batch_payloads_are_refused() {
     // Payload length past the chunk.
     let mut b = real.to_vec();
     put_u32(&mut b, 16, u32::MAX);
-    assert!(fresh().apply_batch(&b).unwrap_err().to_string().contains("truncated"));
+    assert!(fresh()
+        .apply_batch(&b)
+        .unwrap_err()
+        .to_string()
+        .contains("truncated"));
 
     let batch_with = |payload: &[u8]| chunk(b'L', 1, n, after, faces, payload);
-    let apply = |payload: &[u8]| fresh().apply_batch(&batch_with(payload)).unwrap_err().to_string();
+    let apply = |payload: &[u8]| {
+        fresh()
+            .apply_batch(&batch_with(payload))
+            .unwrap_err()
+            .to_string()
+    };
     // A seed count far beyond the bytes present.
     let mut p = Vec::new();
     varint(&mut p, u32::MAX);
@@ -525,7 +649,13 @@ fn malformed_batch_payloads_are_refused() {
         stream_err(&p);
     }
     // Seeds naming vertices that do not exist yet, or no edge.
-    for bad in [[n, 0], [0, u32::MAX], [u32::MAX, u32::MAX], [0, 0], [seed[1], seed[0] + n]] {
+    for bad in [
+        [n, 0],
+        [0, u32::MAX],
+        [u32::MAX, u32::MAX],
+        [0, 0],
+        [seed[1], seed[0] + n],
+    ] {
         let mut p = pass(&[bad], after - n);
         p.extend(pass(&[], 0));
         stream_err(&p);
@@ -556,7 +686,10 @@ fn base_chunk_that_disagrees_with_the_level_table_is_refused() {
         let mut b = s.to_vec();
         let v = get_u32(&b, at + field);
         put_u32(&mut b, at + field, v + 1);
-        assert_stream_err(decode(&b, None, Limits::default()), &["base chunk disagrees"]);
+        assert_stream_err(
+            decode(&b, None, Limits::default()),
+            &["base chunk disagrees"],
+        );
     }
     // The table and the chunk agree on one vertex more than the faces use.
     let mut b = s.to_vec();
@@ -588,34 +721,52 @@ fn level_table_lying_about_faces_is_refused() {
     put_u32(&mut b, last + 12, faces + 1);
     match decode(&b, None, Limits::default()) {
         Err(_) => {}
-        Ok(d) => panic!("header says {} faces, decoder has {}", faces + 1, d.face_count()),
+        Ok(d) => panic!(
+            "header says {} faces, decoder has {}",
+            faces + 1,
+            d.face_count()
+        ),
     }
 }
 
 // ---------------------------------------------------------------- bit flips
 
-/// Flips every bit of the stream, one at a time: the decoder must return Err,
-/// or Ok with buffers that are still consistent.
+/// Flips bits of the stream one at a time: every bit of every batch, and
+/// three bits of every header and base byte. The decoder must return Err, or
+/// Ok with buffers that are still consistent. A flip in batch `k` is decoded
+/// through batch `k + 1` (the batch after a damaged one must cope with the
+/// state it left), which keeps the sweep to a few seconds.
 #[test]
 fn every_single_bit_flip_is_an_error_or_consistent() {
     let s = sphere_stream();
     let index = StreamIndex::parse(s).unwrap();
     let t = Instant::now();
-    let (mut oks, mut errs) = (0usize, 0usize);
+    let (mut flips, mut oks, mut errs) = (0usize, 0usize, 0usize);
     let mut failures = Vec::new();
     let mut not_manifold = Vec::new();
     let mut b = s.to_vec();
     for at in 0..s.len() {
-        for bit in 0..8 {
+        let batch = index.batches.iter().position(|r| r.contains(&at));
+        let (bits, levels): (&[u8], _) = match batch {
+            Some(k) => (&[0, 1, 2, 3, 4, 5, 6, 7], Some(k + 2)),
+            None => (&[0, 4, 7], None),
+        };
+        for &bit in bits {
+            flips += 1;
             b[at] ^= 1 << bit;
-            match no_panic(|| decode(&b, None, Limits::default()).map(|d| (no_panic(|| assert_consistent(&d)), d))) {
+            match no_panic(|| {
+                decode(&b, levels, Limits::default())
+                    .map(|d| (no_panic(|| assert_consistent(&d)), d))
+            }) {
                 Ok(Ok((Ok(()), d))) => {
                     oks += 1;
                     if let Some(v) = manifold_violation(d.indices()) {
                         not_manifold.push(format!("byte {at} bit {bit}: {v}"));
                     }
                 }
-                Ok(Ok((Err(p), _))) => failures.push(format!("byte {at} bit {bit}: inconsistent decoder: {p}")),
+                Ok(Ok((Err(p), _))) => {
+                    failures.push(format!("byte {at} bit {bit}: inconsistent decoder: {p}"))
+                }
                 Ok(Err(_)) => errs += 1,
                 Err(p) => failures.push(format!("byte {at} bit {bit}: panicked: {p}")),
             }
@@ -623,14 +774,17 @@ fn every_single_bit_flip_is_an_error_or_consistent() {
         }
     }
     eprintln!(
-        "{} bit flips over {} bytes ({} base, {} batches): {errs} errors, {oks} decoded, in {:?}",
-        8 * s.len(),
+        "{flips} bit flips over {} bytes ({} header and base, {} batches): {errs} errors, {oks} decoded, in {:?}",
         s.len(),
         index.base.len(),
         index.batches.len(),
         t.elapsed()
     );
-    assert!(failures.is_empty(), "{} failures: {failures:#?}", failures.len());
+    assert!(
+        failures.is_empty(),
+        "{} failures: {failures:#?}",
+        failures.len()
+    );
     // Not a requirement of the format (a flipped bit can make any other valid
     // stream); reported so that a change in it is noticed.
     if !not_manifold.is_empty() {
@@ -649,7 +803,8 @@ fn overwritten_batch_bytes_are_errors_or_consistent() {
         let batch = &s[range.clone()];
         // The chunk header and the first bytes of the payload, where the pass
         // counts and seeds live.
-        for at in (0..batch.len().min(CHUNK_HEADER + 24)).chain([batch.len() / 2, batch.len() - 1]) {
+        for at in (0..batch.len().min(CHUNK_HEADER + 24)).chain([batch.len() / 2, batch.len() - 1])
+        {
             for v in [0u8, 1, 2, 0x7f, 0x80, 0xfe, 0xff] {
                 let mut b = batch.to_vec();
                 if b[at] == v {
@@ -660,7 +815,8 @@ fn overwritten_batch_bytes_are_errors_or_consistent() {
                 match no_panic(|| d.apply_batch(&b)) {
                     Ok(Ok(())) => {
                         if let Err(p) = no_panic(|| assert_consistent(&d)) {
-                            failures.push(format!("batch {k} byte {at} = {v:#x}: inconsistent: {p}"));
+                            failures
+                                .push(format!("batch {k} byte {at} = {v:#x}: inconsistent: {p}"));
                         }
                     }
                     Ok(Err(_)) => {}
@@ -699,7 +855,11 @@ fn assert_small_peak<T>(what: &str, f: impl FnOnce() -> T) -> T {
     let t = Instant::now();
     let info = allocation_counter::measure(|| out = Some(f()));
     let took = t.elapsed();
-    assert!(info.bytes_max <= SMALL_PEAK, "{what}: peak allocation {} bytes", info.bytes_max);
+    assert!(
+        info.bytes_max <= SMALL_PEAK,
+        "{what}: peak allocation {} bytes",
+        info.bytes_max
+    );
     assert!(took < Duration::from_secs(2), "{what}: took {took:?}");
     out.unwrap()
 }
@@ -708,12 +868,18 @@ fn assert_small_peak<T>(what: &str, f: impl FnOnce() -> T) -> T {
 fn hostile_headers_do_not_allocate_what_they_claim() {
     let tiny = claims_four_billion();
     // Default limits: refused by the limit check.
-    let r = assert_small_peak("2^32 vertices, default limits", || decode(&tiny, None, Limits::default()));
+    let r = assert_small_peak("2^32 vertices, default limits", || {
+        decode(&tiny, None, Limits::default())
+    });
     assert_limit(r, "4294967295 vertices");
     // No limits at all: refused by the base mesh decoder, whose payload runs out.
-    let r = assert_small_peak("2^32 vertices, no limits", || decode(&tiny, None, NO_LIMITS));
+    let r = assert_small_peak("2^32 vertices, no limits", || {
+        decode(&tiny, None, NO_LIMITS)
+    });
     assert_stream_err(r, &["truncated entropy-coded payload"]);
-    let r = assert_small_peak("2^32 vertices, no limits, Decoder::new", || Decoder::new(&tiny, NO_LIMITS));
+    let r = assert_small_peak("2^32 vertices, no limits, Decoder::new", || {
+        Decoder::new(&tiny, NO_LIMITS)
+    });
     assert!(r.is_err());
 
     // The base at the default limits: 50 M vertices and 100 M faces in 64 bytes.
@@ -739,7 +905,12 @@ fn hostile_headers_do_not_allocate_what_they_claim() {
     let base_vertices = get_u32(sphere_stream(), level_at(0));
     let batch = chunk(b'L', 1, base_vertices, u32::MAX, u32::MAX, &[0xff; 8]);
     let b = sphere_with_batch(u32::MAX, u32::MAX, &batch);
-    assert!(assert_small_peak("2^32 vertices in a garbage batch", || decode(&b, None, NO_LIMITS)).is_err());
+    assert!(
+        assert_small_peak("2^32 vertices in a garbage batch", || decode(
+            &b, None, NO_LIMITS
+        ))
+        .is_err()
+    );
 }
 
 /// A ~200-byte batch whose passes parse and whose counts agree, claiming to
@@ -772,12 +943,17 @@ mod files {
     use vitrine_codec::{IndexedMesh, Quantization};
 
     fn small() -> ImportOptions {
-        ImportOptions { max_vertices: 1000, max_faces: 2000 }
+        ImportOptions {
+            max_vertices: 1000,
+            max_faces: 2000,
+        }
     }
 
     #[track_caller]
     fn assert_import_err(bytes: &[u8], format: MeshFormat, needles: &[&str]) {
-        let r = assert_small_peak("import", || import_bytes(bytes, format, &ImportOptions::default()));
+        let r = assert_small_peak("import", || {
+            import_bytes(bytes, format, &ImportOptions::default())
+        });
         let e = match r {
             Ok(m) => panic!("expected an error, got {} vertices", m.positions.len()),
             Err(e) => e.to_string(),
@@ -812,7 +988,11 @@ mod files {
             let b = [c[0], *c.get(1).unwrap_or(&0), *c.get(2).unwrap_or(&0)];
             let n = (b[0] as u32) << 16 | (b[1] as u32) << 8 | b[2] as u32;
             for k in 0..4 {
-                s.push(if k <= c.len() { T[(n >> (18 - 6 * k) & 63) as usize] as char } else { '=' });
+                s.push(if k <= c.len() {
+                    T[(n >> (18 - 6 * k) & 63) as usize] as char
+                } else {
+                    '='
+                });
             }
         }
         s
@@ -845,10 +1025,23 @@ mod files {
     #[test]
     fn gltf_triangle_fixture_imports() {
         let bin = triangle_bin(GOOD, [0, 1, 2]);
-        let m = import_bytes(&glb(&triangle_json(r#"{"byteLength":48}"#, 3), &bin), MeshFormat::Glb, &small()).unwrap();
+        let m = import_bytes(
+            &glb(&triangle_json(r#"{"byteLength":48}"#, 3), &bin),
+            MeshFormat::Glb,
+            &small(),
+        )
+        .unwrap();
         assert_eq!(m.triangles, vec![[0, 1, 2]]);
-        let uri = format!(r#"{{"byteLength":48,"uri":"data:application/octet-stream;base64,{}"}}"#, base64(&bin));
-        let m = import_bytes(triangle_json(&uri, 3).as_bytes(), MeshFormat::Gltf, &small()).unwrap();
+        let uri = format!(
+            r#"{{"byteLength":48,"uri":"data:application/octet-stream;base64,{}"}}"#,
+            base64(&bin)
+        );
+        let m = import_bytes(
+            triangle_json(&uri, 3).as_bytes(),
+            MeshFormat::Gltf,
+            &small(),
+        )
+        .unwrap();
         assert_eq!(m.positions, GOOD.to_vec());
     }
 
@@ -885,9 +1078,20 @@ mod files {
             let mut p = GOOD;
             p[1][2] = bad;
             let bin = triangle_bin(p, [0, 1, 2]);
-            assert_import_err(&glb(&triangle_json(r#"{"byteLength":48}"#, 3), &bin), Glb, &["vertex 1", "non-finite"]);
-            let uri = format!(r#"{{"byteLength":48,"uri":"data:application/octet-stream;base64,{}"}}"#, base64(&bin));
-            assert_import_err(triangle_json(&uri, 3).as_bytes(), Gltf, &["vertex 1", "non-finite"]);
+            assert_import_err(
+                &glb(&triangle_json(r#"{"byteLength":48}"#, 3), &bin),
+                Glb,
+                &["vertex 1", "non-finite"],
+            );
+            let uri = format!(
+                r#"{{"byteLength":48,"uri":"data:application/octet-stream;base64,{}"}}"#,
+                base64(&bin)
+            );
+            assert_import_err(
+                triangle_json(&uri, 3).as_bytes(),
+                Gltf,
+                &["vertex 1", "non-finite"],
+            );
         }
         // Finite in the file, infinite once a node's transform is applied.
         let bin = triangle_bin(GOOD, [0, 1, 2]);
@@ -896,7 +1100,10 @@ mod files {
             r#""scene":0,"scenes":[{"nodes":[0]}],"nodes":[{"mesh":0,"scale":[3e38,3e38,3e38]},{"mesh":0}],"meshes""#,
             1,
         );
-        let json = json.replace(r#""scale":[3e38,3e38,3e38]},{"mesh":0}"#, r#""scale":[3e38,3e38,3e38],"translation":[3e38,0,0]}"#);
+        let json = json.replace(
+            r#""scale":[3e38,3e38,3e38]},{"mesh":0}"#,
+            r#""scale":[3e38,3e38,3e38],"translation":[3e38,0,0]}"#,
+        );
         assert_import_err(&glb(&json, &bin), Glb, &["non-finite"]);
     }
 
@@ -909,9 +1116,21 @@ mod files {
                  element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 {idx}\n"
             )
         };
-        assert_import_err(ply("0 1 3").as_bytes(), Ply, &["face 0", "vertex index 3", "out of range"]);
-        assert_import_err(ply("0 1 -1").as_bytes(), Ply, &["face 0", "vertex index -1"]);
-        assert_import_err(ply("0 1 2147483647").as_bytes(), Ply, &["vertex index 2147483647"]);
+        assert_import_err(
+            ply("0 1 3").as_bytes(),
+            Ply,
+            &["face 0", "vertex index 3", "out of range"],
+        );
+        assert_import_err(
+            ply("0 1 -1").as_bytes(),
+            Ply,
+            &["face 0", "vertex index -1"],
+        );
+        assert_import_err(
+            ply("0 1 2147483647").as_bytes(),
+            Ply,
+            &["vertex index 2147483647"],
+        );
         // Indices as uint beyond i32.
         let mut b = b"ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\nproperty float y\n\
                       property float z\nelement face 1\nproperty list uchar uint vertex_indices\nend_header\n"
@@ -923,26 +1142,71 @@ mod files {
         }
         assert_import_err(&b, Ply, &["face 0", "out of range"]);
         // OBJ: past the end, zero, before the first, beyond u32.
-        assert_import_err(b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n", Obj, &["vertex index 4", "out of range"]);
-        assert_import_err(b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 0\n", Obj, &["vertex index 0"]);
-        assert_import_err(b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 -4\n", Obj, &["before the first vertex"]);
-        assert_import_err(b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 99999999999\n", Obj, &["out of range"]);
-        assert_import_err(b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 -99999999999\n", Obj, &["before the first vertex"]);
+        assert_import_err(
+            b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n",
+            Obj,
+            &["vertex index 4", "out of range"],
+        );
+        assert_import_err(
+            b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 0\n",
+            Obj,
+            &["vertex index 0"],
+        );
+        assert_import_err(
+            b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 -4\n",
+            Obj,
+            &["before the first vertex"],
+        );
+        assert_import_err(
+            b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 99999999999\n",
+            Obj,
+            &["out of range"],
+        );
+        assert_import_err(
+            b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 -99999999999\n",
+            Obj,
+            &["before the first vertex"],
+        );
         assert_import_err(
             b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 99999999999999999999999\n",
             Obj,
             &["bad vertex index"],
         );
         // OFF: past the end and negative.
-        assert_import_err(b"OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 3\n", Off, &["vertex index 3"]);
-        assert!(import_bytes(b"OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 -1\n", Off, &small()).is_err());
-        assert!(import_bytes(b"OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 4294967296\n", Off, &small()).is_err());
+        assert_import_err(
+            b"OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 3\n",
+            Off,
+            &["vertex index 3"],
+        );
+        assert!(import_bytes(
+            b"OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 -1\n",
+            Off,
+            &small()
+        )
+        .is_err());
+        assert!(import_bytes(
+            b"OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 4294967296\n",
+            Off,
+            &small()
+        )
+        .is_err());
         // glTF and GLB: one index past the positions, and u32::MAX.
         for bad in [3, u32::MAX] {
             let bin = triangle_bin(GOOD, [0, 1, bad]);
-            assert_import_err(&glb(&triangle_json(r#"{"byteLength":48}"#, 3), &bin), Glb, &["triangle 0", "out of range"]);
-            let uri = format!(r#"{{"byteLength":48,"uri":"data:application/octet-stream;base64,{}"}}"#, base64(&bin));
-            assert_import_err(triangle_json(&uri, 3).as_bytes(), Gltf, &["triangle 0", "out of range"]);
+            assert_import_err(
+                &glb(&triangle_json(r#"{"byteLength":48}"#, 3), &bin),
+                Glb,
+                &["triangle 0", "out of range"],
+            );
+            let uri = format!(
+                r#"{{"byteLength":48,"uri":"data:application/octet-stream;base64,{}"}}"#,
+                base64(&bin)
+            );
+            assert_import_err(
+                triangle_json(&uri, 3).as_bytes(),
+                Gltf,
+                &["triangle 0", "out of range"],
+            );
         }
         // An accessor claiming more positions than its buffer view holds.
         let bin = triangle_bin(GOOD, [0, 1, 2]);
@@ -977,16 +1241,36 @@ mod files {
                     property float z\nend_header\n0 0 0\n";
         assert!(import_bytes(huge.as_bytes(), Ply, &small()).is_err());
         // OFF declaring 4e9 faces and 4e9 vertices.
-        assert_import_err(b"OFF\n3 4000000000 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n", Off, &["4000000000 faces"]);
+        assert_import_err(
+            b"OFF\n3 4000000000 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n",
+            Off,
+            &["4000000000 faces"],
+        );
         assert_import_err(b"OFF 4000000000 1 0\n", Off, &["4000000000 vertices"]);
         // A polygon with four billion corners.
-        assert!(import_bytes(b"OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n4000000000 0 1 2\n", Off, &small()).is_err());
+        assert!(import_bytes(
+            b"OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n4000000000 0 1 2\n",
+            Off,
+            &small()
+        )
+        .is_err());
         // glTF: a buffer declaring 4 GB, an accessor of 4e9 elements with no data.
         let bin = triangle_bin(GOOD, [0, 1, 2]);
-        assert_import_err(&glb(&triangle_json(r#"{"byteLength":4000000000}"#, 3), &bin), Glb, &["truncated"]);
-        let no_view = triangle_json(r#"{"byteLength":48}"#, 3)
-            .replace(r#"{"bufferView":0,"componentType":5126,"count":3"#, r#"{"componentType":5126,"count":4000000000"#);
-        assert!(assert_small_peak("accessor without view", || import_bytes(&glb(&no_view, &bin), Glb, &ImportOptions::default())).is_err());
+        assert_import_err(
+            &glb(&triangle_json(r#"{"byteLength":4000000000}"#, 3), &bin),
+            Glb,
+            &["truncated"],
+        );
+        let no_view = triangle_json(r#"{"byteLength":48}"#, 3).replace(
+            r#"{"bufferView":0,"componentType":5126,"count":3"#,
+            r#"{"componentType":5126,"count":4000000000"#,
+        );
+        assert!(assert_small_peak("accessor without view", || import_bytes(
+            &glb(&no_view, &bin),
+            Glb,
+            &ImportOptions::default()
+        ))
+        .is_err());
         assert!(t.elapsed() < Duration::from_secs(3), "{:?}", t.elapsed());
     }
 
@@ -999,25 +1283,104 @@ mod files {
         let mut obj = b"v 0 0 0\n".to_vec();
         obj.extend_from_slice(&b"f 1 1 1\n".repeat(LINES));
         let t = Instant::now();
-        let info = allocation_counter::measure(|| match import_bytes(&obj, MeshFormat::Obj, &small()) {
-            Err(Error::Limit(m)) => assert!(m.contains("more than 2000 triangles"), "{m}"),
-            other => panic!("{:?}", other.map(|m| m.triangles.len())),
-        });
+        let info =
+            allocation_counter::measure(|| match import_bytes(&obj, MeshFormat::Obj, &small()) {
+                Err(Error::Limit(m)) => assert!(m.contains("more than 2000 triangles"), "{m}"),
+                other => panic!("{:?}", other.map(|m| m.triangles.len())),
+            });
         assert!(info.bytes_max < 1 << 20, "{}", info.bytes_max);
         assert!(t.elapsed() < Duration::from_secs(1), "{:?}", t.elapsed());
 
         let t = Instant::now();
         let mut mesh = None;
-        let info = allocation_counter::measure(|| mesh = Some(import_bytes(&obj, MeshFormat::Obj, &ImportOptions::default())));
+        let info = allocation_counter::measure(|| {
+            mesh = Some(import_bytes(
+                &obj,
+                MeshFormat::Obj,
+                &ImportOptions::default(),
+            ))
+        });
         let mesh = mesh.unwrap().unwrap();
         assert_eq!(mesh.triangles.len(), LINES);
-        assert!(info.bytes_max < 4 * obj.len() as u64, "{} bytes for a {}-byte file", info.bytes_max, obj.len());
-        eprintln!("10^7 OBJ faces: {:?}, peak {} MB", t.elapsed(), info.bytes_max >> 20);
+        assert!(
+            info.bytes_max < 4 * obj.len() as u64,
+            "{} bytes for a {}-byte file",
+            info.bytes_max,
+            obj.len()
+        );
+        eprintln!(
+            "10^7 OBJ faces: {:?}, peak {} MB",
+            t.elapsed(),
+            info.bytes_max >> 20
+        );
         assert!(t.elapsed() < Duration::from_secs(20), "{:?}", t.elapsed());
         // Every face is degenerate: repair leaves nothing to encode.
         drop(obj);
-        let e = prepare(mesh, &RepairOptions::default()).unwrap_err().to_string();
+        let e = prepare(mesh, &RepairOptions::default())
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("no triangles left"), "{e}");
+    }
+
+    /// Found by the `import_gltf` fuzz target: gltf-json's validation
+    /// indexed a primitive's POSITION accessor before checking it exists
+    /// (`gltf-json-1.4.1/src/mesh.rs:151`: index out of bounds).
+    #[test]
+    fn gltf_position_accessor_past_the_end_is_an_error() {
+        let json = br#"{"asset":{"version":"2.0"},"meshes":[{"primitives":[{"attributes":{"POSITION":0}}]}]}"#;
+        for format in [MeshFormat::Gltf, MeshFormat::Glb] {
+            let bytes = if format == MeshFormat::Glb {
+                glb(std::str::from_utf8(json).unwrap(), &[])
+            } else {
+                json.to_vec()
+            };
+            let e = no_panic(|| import_bytes(&bytes, format, &small()))
+                .unwrap_or_else(|p| panic!("{format:?} panicked: {p}"))
+                .unwrap_err()
+                .to_string();
+            assert!(
+                e.contains("accessor 0") && e.contains("mesh 0 primitive 0"),
+                "{e}"
+            );
+        }
+        let json = r#"{"asset":{"version":"2.0"},"accessors":[],"meshes":[{"primitives":[{"attributes":{"COLOR_0":7,"POSITION":0}}]}]}"#;
+        assert!(
+            no_panic(|| import_bytes(json.as_bytes(), MeshFormat::Gltf, &small()))
+                .unwrap()
+                .is_err()
+        );
+    }
+
+    /// Every input under `tests/corpus/<target>/` (crashes the fuzz targets
+    /// found, kept whole) goes through what its target calls: no panic.
+    #[test]
+    fn fuzz_crash_corpus_does_not_panic() {
+        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/corpus");
+        let mut seen = 0;
+        for (dir, format) in [
+            ("decode_stream", None),
+            ("import_ply", Some(MeshFormat::Ply)),
+            ("import_obj", Some(MeshFormat::Obj)),
+            ("import_off", Some(MeshFormat::Off)),
+            ("import_gltf", Some(MeshFormat::Gltf)),
+        ] {
+            let Ok(entries) = std::fs::read_dir(root.join(dir)) else {
+                continue;
+            };
+            for entry in entries {
+                let path = entry.unwrap().path();
+                let bytes = std::fs::read(&path).unwrap();
+                let outcome = match format {
+                    Some(f) => no_panic(|| import_bytes(&bytes, f, &small()).map(|_| ())),
+                    None => no_panic(|| decode(&bytes, None, Limits::default()).map(|_| ())),
+                };
+                if let Err(p) = outcome {
+                    panic!("{} panicked: {p}", path.display());
+                }
+                seen += 1;
+            }
+        }
+        assert!(seen > 0, "no corpus under {}", root.display());
     }
 
     fn canonical(t: [u32; 3]) -> [u32; 3] {
@@ -1034,24 +1397,40 @@ mod files {
             assert!(report.split_vertices > 0, "{report}");
         }
         // Without welding: the copies a split makes share their position.
-        let strict = RepairOptions { weld: false, split_non_manifold: false };
+        let strict = RepairOptions {
+            weld: false,
+            split_non_manifold: false,
+        };
         if let Err(e) = prepare(fixed.clone(), &strict) {
             panic!("a repaired mesh needs no more splitting: {e}");
         }
-        let options = EncodeOptions { min_base_vertices: 8, ..Default::default() };
+        let options = EncodeOptions {
+            min_base_vertices: 8,
+            ..Default::default()
+        };
         let encoded = encode(&fixed, &options).unwrap();
         let d = decode(&encoded.bytes, None, Limits::default()).unwrap();
         assert_consistent(&d);
         let q = Quantization::for_positions(&fixed.positions, options.quantization_bits).unwrap();
         let order = &encoded.vertex_order;
         for (i, &v) in order.iter().enumerate() {
-            assert_eq!(d.quantized_positions()[i], q.quantize(fixed.positions[v as usize]), "vertex {i}");
+            assert_eq!(
+                d.quantized_positions()[i],
+                q.quantize(fixed.positions[v as usize]),
+                "vertex {i}"
+            );
         }
         let mut expected: Vec<_> = fixed.triangles.iter().map(|&t| canonical(t)).collect();
         let mut got: Vec<_> = d
             .indices()
             .chunks_exact(3)
-            .map(|t| canonical([order[t[0] as usize], order[t[1] as usize], order[t[2] as usize]]))
+            .map(|t| {
+                canonical([
+                    order[t[0] as usize],
+                    order[t[1] as usize],
+                    order[t[2] as usize],
+                ])
+            })
             .collect();
         expected.sort_unstable();
         got.sort_unstable();
@@ -1070,10 +1449,15 @@ mod files {
         let mut m = a.clone();
         for p in &a.positions {
             let d: f32 = (0..3).map(|k| (p[k] - apex[k]) * apex[k]).sum();
-            m.positions.push(std::array::from_fn(|k| p[k] - 2.0 * d * apex[k]));
+            m.positions
+                .push(std::array::from_fn(|k| p[k] - 2.0 * d * apex[k]));
         }
         let map = |v: u32| if v == 0 { 0 } else { v + n };
-        m.triangles.extend(a.triangles.iter().map(|t| [map(t[0]), map(t[2]), map(t[1])]));
+        m.triangles.extend(
+            a.triangles
+                .iter()
+                .map(|t| [map(t[0]), map(t[2]), map(t[1])]),
+        );
         m = vitrine_codec::samples::compact(m);
         assert!(check_manifold(&m).is_err());
         assert_repairs_and_round_trips(m, true);
@@ -1087,13 +1471,21 @@ mod files {
         assert_repairs_and_round_trips(m, true);
 
         // Three cones (open, 8 sides each) sharing one apex vertex.
-        let mut m = IndexedMesh { positions: vec![[0.0; 3]], colors: None, triangles: Vec::new() };
+        let mut m = IndexedMesh {
+            positions: vec![[0.0; 3]],
+            colors: None,
+            triangles: Vec::new(),
+        };
         for c in 0..3u32 {
             let base = m.positions.len() as u32;
             let axis = c as f32 * 2.1;
             for i in 0..8u32 {
                 let a = i as f32 / 8.0 * std::f32::consts::TAU;
-                m.positions.push([axis.cos() + 0.3 * a.cos(), axis.sin() + 0.3 * a.sin(), 0.5 + 0.1 * c as f32]);
+                m.positions.push([
+                    axis.cos() + 0.3 * a.cos(),
+                    axis.sin() + 0.3 * a.sin(),
+                    0.5 + 0.1 * c as f32,
+                ]);
             }
             for i in 0..8u32 {
                 m.triangles.push([0, base + i, base + (i + 1) % 8]);

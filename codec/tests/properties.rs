@@ -10,7 +10,9 @@
 use proptest::prelude::*;
 use vitrine_codec::repair::{check_manifold, prepare, RepairOptions};
 use vitrine_codec::samples::{add_noise, compact, icosphere, plate_with_tunnels, torus};
-use vitrine_codec::{encode, BaseTarget, Decoder, EncodeOptions, IndexedMesh, Limits, Quantization, StreamIndex};
+use vitrine_codec::{
+    encode, BaseTarget, Decoder, EncodeOptions, IndexedMesh, Limits, Quantization, StreamIndex,
+};
 
 #[derive(Clone, Debug)]
 enum Shape {
@@ -49,25 +51,32 @@ fn case() -> impl Strategy<Value = Case> {
         prop_oneof![Just(0.0f32), 0.0f32..0.05],
         any::<bool>(),
         8u8..=16,
-        prop_oneof![(4u32..200).prop_map(BaseTarget::Vertices), (0.0f32..0.5).prop_map(BaseTarget::Fraction)],
+        prop_oneof![
+            (4u32..200).prop_map(BaseTarget::Vertices),
+            (0.0f32..0.5).prop_map(BaseTarget::Fraction)
+        ],
         prop_oneof![Just(4u32), 4u32..64],
         any::<bool>(),
     )
-        .prop_map(|(shape, drop, seed, noise, colour, bits, base, min_base, guard)| Case {
-            shape,
-            drop,
-            seed,
-            noise,
-            colour,
-            bits,
-            base,
-            min_base,
-            guard,
-        })
+        .prop_map(
+            |(shape, drop, seed, noise, colour, bits, base, min_base, guard)| Case {
+                shape,
+                drop,
+                seed,
+                noise,
+                colour,
+                bits,
+                base,
+                min_base,
+                guard,
+            },
+        )
 }
 
 fn next(state: &mut u64) -> u64 {
-    *state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+    *state = state
+        .wrapping_mul(6364136223846793005)
+        .wrapping_add(1442695040888963407);
     *state >> 33
 }
 
@@ -78,7 +87,8 @@ fn build(c: &Case) -> IndexedMesh {
         Shape::Plate(genus, cells) => plate_with_tunnels(genus, cells),
     };
     let mut state = c.seed;
-    mesh.triangles.retain(|_| next(&mut state) % 256 >= c.drop as u64);
+    mesh.triangles
+        .retain(|_| next(&mut state) % 256 >= c.drop as u64);
     let mut mesh = compact(mesh);
     add_noise(&mut mesh, c.noise, c.seed);
     if c.colour {
@@ -101,13 +111,18 @@ fn canonical(t: [u32; 3]) -> [u32; 3] {
 
 /// Each undirected edge on at most two faces, each half-edge on one.
 fn edge_manifold(indices: &[u32]) -> Result<(), String> {
-    let mut directed: Vec<(u32, u32)> =
-        indices.chunks_exact(3).flat_map(|t| [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])]).collect();
+    let mut directed: Vec<(u32, u32)> = indices
+        .chunks_exact(3)
+        .flat_map(|t| [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])])
+        .collect();
     directed.sort_unstable();
     if let Some(w) = directed.windows(2).find(|w| w[0] == w[1]) {
         return Err(format!("half-edge {:?} appears twice", w[0]));
     }
-    let mut undirected: Vec<(u32, u32)> = directed.iter().map(|&(a, b)| (a.min(b), a.max(b))).collect();
+    let mut undirected: Vec<(u32, u32)> = directed
+        .iter()
+        .map(|&(a, b)| (a.min(b), a.max(b)))
+        .collect();
     undirected.sort_unstable();
     match undirected.windows(3).find(|w| w[0] == w[2]) {
         Some(w) => Err(format!("edge {:?} has more than two faces", w[0])),
@@ -121,7 +136,11 @@ fn check(c: &Case) -> Result<(), TestCaseError> {
     let mesh = match prepare(soup, &RepairOptions::default()) {
         Ok((mesh, _)) => mesh,
         Err(e) => {
-            prop_assert!(e.to_string().contains("no triangles left"), "prepare: {}", e);
+            prop_assert!(
+                e.to_string().contains("no triangles left"),
+                "prepare: {}",
+                e
+            );
             return Ok(());
         }
     };
@@ -133,10 +152,12 @@ fn check(c: &Case) -> Result<(), TestCaseError> {
         geometric_guard: c.guard,
         ..Default::default()
     };
-    let encoded = encode(&mesh, &options).map_err(|e| TestCaseError::fail(format!("encode: {e}")))?;
+    let encoded =
+        encode(&mesh, &options).map_err(|e| TestCaseError::fail(format!("encode: {e}")))?;
 
     let bytes = &encoded.bytes;
-    let index = StreamIndex::parse(bytes).map_err(|e| TestCaseError::fail(format!("index: {e}")))?;
+    let index =
+        StreamIndex::parse(bytes).map_err(|e| TestCaseError::fail(format!("index: {e}")))?;
     let mut d = Decoder::new(&bytes[index.base.clone()], Limits::default())
         .map_err(|e| TestCaseError::fail(format!("base: {e}")))?;
     for k in 0..=index.batches.len() {
@@ -147,7 +168,11 @@ fn check(c: &Case) -> Result<(), TestCaseError> {
         let level = index.header.levels[k];
         prop_assert_eq!(d.vertex_count(), level.vertices as usize, "level {}", k);
         prop_assert_eq!(d.face_count(), level.faces as usize, "level {}", k);
-        prop_assert!(d.indices().iter().all(|&v| (v as usize) < d.vertex_count()), "level {}", k);
+        prop_assert!(
+            d.indices().iter().all(|&v| (v as usize) < d.vertex_count()),
+            "level {}",
+            k
+        );
         edge_manifold(d.indices()).map_err(|e| TestCaseError::fail(format!("level {k}: {e}")))?;
         check_manifold(&d.to_mesh()).map_err(|e| TestCaseError::fail(format!("level {k}: {e}")))?;
     }
@@ -158,13 +183,24 @@ fn check(c: &Case) -> Result<(), TestCaseError> {
     let order = &encoded.vertex_order;
     prop_assert_eq!(order.len(), mesh.positions.len());
     for (i, &v) in order.iter().enumerate() {
-        prop_assert_eq!(d.quantized_positions()[i], q.quantize(mesh.positions[v as usize]), "vertex {}", i);
+        prop_assert_eq!(
+            d.quantized_positions()[i],
+            q.quantize(mesh.positions[v as usize]),
+            "vertex {}",
+            i
+        );
     }
     let mut expected: Vec<[u32; 3]> = mesh.triangles.iter().map(|&t| canonical(t)).collect();
     let mut got: Vec<[u32; 3]> = d
         .indices()
         .chunks_exact(3)
-        .map(|t| canonical([order[t[0] as usize], order[t[1] as usize], order[t[2] as usize]]))
+        .map(|t| {
+            canonical([
+                order[t[0] as usize],
+                order[t[1] as usize],
+                order[t[2] as usize],
+            ])
+        })
         .collect();
     expected.sort_unstable();
     got.sort_unstable();
@@ -173,7 +209,12 @@ fn check(c: &Case) -> Result<(), TestCaseError> {
         Some(colours) => {
             let decoded = d.colours().expect("stream keeps colour");
             for (i, &v) in order.iter().enumerate() {
-                prop_assert_eq!(&decoded[3 * i..3 * i + 3], &colours[v as usize], "colour {}", i);
+                prop_assert_eq!(
+                    &decoded[3 * i..3 * i + 3],
+                    &colours[v as usize],
+                    "colour {}",
+                    i
+                );
             }
         }
         None => prop_assert!(d.colours().is_none()),

@@ -13,7 +13,9 @@ use vitrine_codec::{Decoder, StreamIndex};
 use vitrine_codec_fuzz::{check_decoder, sample_streams, LIMITS};
 
 fuzz_target!(|data: &[u8]| {
-    let Some((&selector, bytes)) = data.split_first() else { return };
+    let Some((&selector, bytes)) = data.split_first() else {
+        return;
+    };
     let streams = sample_streams();
     let stream = &streams[selector as usize % streams.len()];
     let index = StreamIndex::parse(stream).expect("sample stream");

@@ -11,8 +11,12 @@ fuzz_target!(|data: &[u8]| {
         assert!(d.is_complete());
     }
     // Batch by batch, checking every level reached.
-    let Ok(index) = StreamIndex::parse(data) else { return };
-    let Ok(mut d) = Decoder::new(&data[index.base.clone()], LIMITS) else { return };
+    let Ok(index) = StreamIndex::parse(data) else {
+        return;
+    };
+    let Ok(mut d) = Decoder::new(&data[index.base.clone()], LIMITS) else {
+        return;
+    };
     check_decoder(&d);
     for range in &index.batches {
         if d.apply_batch(&data[range.clone()]).is_err() {

@@ -6,7 +6,9 @@
 use arbitrary::Arbitrary;
 use libfuzzer_sys::fuzz_target;
 use vitrine_codec::repair::{check_manifold, prepare, RepairOptions};
-use vitrine_codec::{encode, BaseTarget, Decoder, EncodeOptions, IndexedMesh, Limits, Quantization, StreamIndex};
+use vitrine_codec::{
+    encode, BaseTarget, Decoder, EncodeOptions, IndexedMesh, Limits, Quantization, StreamIndex,
+};
 use vitrine_codec_fuzz::assert_edge_manifold;
 
 #[derive(Arbitrary, Debug)]
@@ -32,12 +34,27 @@ fuzz_target!(|soup: Soup| {
         return;
     }
     let mesh = IndexedMesh {
-        positions: soup.positions.iter().map(|p| p.map(|c| c as f32 / 16.0)).collect(),
-        colors: soup.colour.then(|| soup.positions.iter().map(|p| [p[1], p[2], p[0]]).collect()),
-        triangles: soup.triangles.iter().map(|t| t.map(|v| (v as usize % nv) as u32)).collect(),
+        positions: soup
+            .positions
+            .iter()
+            .map(|p| p.map(|c| c as f32 / 16.0))
+            .collect(),
+        colors: soup
+            .colour
+            .then(|| soup.positions.iter().map(|p| [p[1], p[2], p[0]]).collect()),
+        triangles: soup
+            .triangles
+            .iter()
+            .map(|t| t.map(|v| (v as usize % nv) as u32))
+            .collect(),
     };
-    let opts = RepairOptions { weld: soup.weld, split_non_manifold: true };
-    let Ok((mesh, _report)) = prepare(mesh, &opts) else { return };
+    let opts = RepairOptions {
+        weld: soup.weld,
+        split_non_manifold: true,
+    };
+    let Ok((mesh, _report)) = prepare(mesh, &opts) else {
+        return;
+    };
     if let Err(e) = check_manifold(&mesh) {
         panic!("prepare returned a mesh check_manifold refuses: {e}");
     }
@@ -55,7 +72,8 @@ fuzz_target!(|soup: Soup| {
     };
     let bytes = &encoded.bytes;
     let index = StreamIndex::parse(bytes).expect("own stream parses");
-    let mut d = Decoder::new(&bytes[index.base.clone()], Limits::default()).expect("own base decodes");
+    let mut d =
+        Decoder::new(&bytes[index.base.clone()], Limits::default()).expect("own base decodes");
     assert_edge_manifold(d.indices());
     for (k, range) in index.batches.iter().enumerate() {
         if let Err(e) = d.apply_batch(&bytes[range.clone()]) {
@@ -70,13 +88,23 @@ fuzz_target!(|soup: Soup| {
     let order = &encoded.vertex_order;
     assert_eq!(order.len(), mesh.positions.len());
     for (i, &v) in order.iter().enumerate() {
-        assert_eq!(d.quantized_positions()[i], q.quantize(mesh.positions[v as usize]), "vertex {i}");
+        assert_eq!(
+            d.quantized_positions()[i],
+            q.quantize(mesh.positions[v as usize]),
+            "vertex {i}"
+        );
     }
     let mut expected: Vec<_> = mesh.triangles.iter().map(|&t| canonical(t)).collect();
     let mut got: Vec<_> = d
         .indices()
         .chunks_exact(3)
-        .map(|t| canonical([order[t[0] as usize], order[t[1] as usize], order[t[2] as usize]]))
+        .map(|t| {
+            canonical([
+                order[t[0] as usize],
+                order[t[1] as usize],
+                order[t[2] as usize],
+            ])
+        })
         .collect();
     expected.sort_unstable();
     got.sort_unstable();
@@ -84,7 +112,11 @@ fuzz_target!(|soup: Soup| {
     if let Some(colours) = &mesh.colors {
         let decoded = d.colours().expect("stream keeps colour");
         for (i, &v) in order.iter().enumerate() {
-            assert_eq!(&decoded[3 * i..3 * i + 3], &colours[v as usize], "colour {i}");
+            assert_eq!(
+                &decoded[3 * i..3 * i + 3],
+                &colours[v as usize],
+                "colour {i}"
+            );
         }
     }
 });

@@ -9,10 +9,17 @@ use vitrine_codec::{encode, Decoder, EncodeOptions, IndexedMesh, Limits};
 
 /// Small budgets, so that a hostile input that is merely big is refused
 /// quickly and the fuzzer spends its time on malformed ones.
-pub const LIMITS: Limits = Limits { max_vertices: 1 << 16, max_faces: 1 << 17, max_batches: 64 };
+pub const LIMITS: Limits = Limits {
+    max_vertices: 1 << 16,
+    max_faces: 1 << 17,
+    max_batches: 64,
+};
 
 pub fn import_options() -> ImportOptions {
-    ImportOptions { max_vertices: 1 << 16, max_faces: 1 << 17 }
+    ImportOptions {
+        max_vertices: 1 << 16,
+        max_faces: 1 << 17,
+    }
 }
 
 /// Generated meshes to build valid streams from: one without colour, one with.
@@ -29,7 +36,10 @@ pub fn sample_streams() -> &'static [Vec<u8>] {
         sample_meshes()
             .iter()
             .map(|m| {
-                let options = EncodeOptions { min_base_vertices: 8, ..Default::default() };
+                let options = EncodeOptions {
+                    min_base_vertices: 8,
+                    ..Default::default()
+                };
                 encode(m, &options).expect("sample mesh encodes").bytes
             })
             .collect()
@@ -40,7 +50,10 @@ pub fn sample_streams() -> &'static [Vec<u8>] {
 pub fn check_decoder(d: &Decoder) {
     let n = d.vertex_count();
     assert_eq!(d.indices().len(), 3 * d.face_count());
-    assert!(d.indices().iter().all(|&i| (i as usize) < n), "index out of range");
+    assert!(
+        d.indices().iter().all(|&i| (i as usize) < n),
+        "index out of range"
+    );
     assert_eq!(d.positions().len(), 3 * n);
     assert_eq!(d.quantized_positions().len(), n);
     if let Some(c) = d.colours() {
@@ -65,13 +78,18 @@ pub fn check_import(m: &IndexedMesh) {
 
 /// Each undirected edge on at most two faces, each half-edge on one.
 pub fn assert_edge_manifold(indices: &[u32]) {
-    let mut directed: Vec<(u32, u32)> =
-        indices.chunks_exact(3).flat_map(|t| [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])]).collect();
+    let mut directed: Vec<(u32, u32)> = indices
+        .chunks_exact(3)
+        .flat_map(|t| [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])])
+        .collect();
     directed.sort_unstable();
     if let Some(w) = directed.windows(2).find(|w| w[0] == w[1]) {
         panic!("half-edge {:?} appears twice", w[0]);
     }
-    let mut undirected: Vec<(u32, u32)> = directed.iter().map(|&(a, b)| (a.min(b), a.max(b))).collect();
+    let mut undirected: Vec<(u32, u32)> = directed
+        .iter()
+        .map(|&(a, b)| (a.min(b), a.max(b)))
+        .collect();
     undirected.sort_unstable();
     if let Some(w) = undirected.windows(3).find(|w| w[0] == w[2]) {
         panic!("edge {:?} has more than two faces", w[0]);

@@ -16,7 +16,11 @@ fn base64(data: &[u8]) -> String {
         let b = [c[0], *c.get(1).unwrap_or(&0), *c.get(2).unwrap_or(&0)];
         let n = (b[0] as u32) << 16 | (b[1] as u32) << 8 | b[2] as u32;
         for k in 0..4 {
-            s.push(if k <= c.len() { T[(n >> (18 - 6 * k) & 63) as usize] as char } else { '=' });
+            s.push(if k <= c.len() {
+                T[(n >> (18 - 6 * k) & 63) as usize] as char
+            } else {
+                '='
+            });
         }
     }
     s
@@ -34,9 +38,23 @@ fn main() {
     for (i, s) in sample_streams().iter().enumerate() {
         write("decode_stream", &format!("sample-{i}"), s);
     }
-    let plate = encode(&plate_with_tunnels(1, 2), &EncodeOptions { min_base_vertices: 8, ..Default::default() }).unwrap();
+    let plate = encode(
+        &plate_with_tunnels(1, 2),
+        &EncodeOptions {
+            min_base_vertices: 8,
+            ..Default::default()
+        },
+    )
+    .unwrap();
     write("decode_stream", "plate", &plate.bytes);
-    let coarse = encode(&icosphere(1), &EncodeOptions { quantization_bits: 8, min_base_vertices: 4, ..Default::default() });
+    let coarse = encode(
+        &icosphere(1),
+        &EncodeOptions {
+            quantization_bits: 8,
+            min_base_vertices: 4,
+            ..Default::default()
+        },
+    );
     write("decode_stream", "coarse", &coarse.unwrap().bytes);
 
     // decode_batch: selector byte, then batch 1's payload or whole chunk.
@@ -65,13 +83,22 @@ fn main() {
         write("import_gltf", &format!("glb-{i}"), &b);
         // The same GLB as glTF JSON with its binary chunk in a data URI.
         let json_len = u32::from_le_bytes(b[12..16].try_into().unwrap()) as usize;
-        let json = std::str::from_utf8(&b[20..20 + json_len]).unwrap().trim_end();
+        let json = std::str::from_utf8(&b[20..20 + json_len])
+            .unwrap()
+            .trim_end();
         let bin = &b[20 + json_len + 8..];
-        let uri = format!("\"uri\":\"data:application/octet-stream;base64,{}\",", base64(bin));
+        let uri = format!(
+            "\"uri\":\"data:application/octet-stream;base64,{}\",",
+            base64(bin)
+        );
         let gltf = json.replacen("\"byteLength\"", &format!("{uri}\"byteLength\""), 1);
         write("import_gltf", &format!("json-{i}"), gltf.as_bytes());
         // OFF / COFF by hand.
-        let mut off = String::from(if m.colors.is_some() { "COFF\n" } else { "OFF\n" });
+        let mut off = String::from(if m.colors.is_some() {
+            "COFF\n"
+        } else {
+            "OFF\n"
+        });
         off += &format!("{} {} 0\n", m.positions.len(), m.triangles.len());
         for (v, p) in m.positions.iter().enumerate() {
             off += &format!("{} {} {}", p[0], p[1], p[2]);
@@ -99,5 +126,9 @@ fn main() {
         b"ply\nformat binary_big_endian 1.0\nelement vertex 0\nproperty double x\nproperty double y\nproperty double z\n\
           element tristrips 0\nproperty list int int vertex_indices\nend_header\n",
     );
-    write("import_obj", "polygons", b"v 0 0 0 1 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt 0 0\nf 1/1 2/1 3/1 4/1\nf -1 -2 -3\n");
+    write(
+        "import_obj",
+        "polygons",
+        b"v 0 0 0 1 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt 0 0\nf 1/1 2/1 3/1 4/1\nf -1 -2 -3\n",
+    );
 }

@@ -7,7 +7,9 @@ use super::Level;
 use crate::entropy::RangeDecoder;
 use crate::halfedge::{face, next, prev, NONE};
 use crate::patch::{pattern, Pattern, Tag, MAX_VALENCE, NO_TWIN};
-use crate::predict::{decode_colour, gate_context, predict_colour, PassModels, PatchPrediction};
+use crate::predict::{
+    decode_colour, gate_context, predict_colour, umbrella, PassModels, PatchPrediction,
+};
 use crate::{Error, Result};
 
 const FREE: u8 = 0;
@@ -26,6 +28,9 @@ pub(crate) struct Scratch {
     tag: Vec<Tag>,
     face_done: Vec<bool>,
     gates: VecDeque<u32>,
+    /// Patches found by the traversal, inserted once geometry is decoded.
+    pending: Vec<Region>,
+    decoded: Vec<([i32; 3], Option<[u8; 3]>)>,
 }
 
 pub(crate) struct PassInput<'a> {
@@ -59,6 +64,7 @@ impl Level {
         scratch.state.resize(n, FREE);
         scratch.tag.clear();
         scratch.tag.resize(n, Tag::None);
+        scratch.pending.clear();
         scratch.face_done.clear();
         scratch
             .face_done
@@ -89,13 +95,22 @@ impl Level {
                 self.process_gate(g, pass.kind, target, scratch, &mut s)?;
             }
         }
-        if self.vertex_count() != target {
+        if n + scratch.pending.len() != target {
             return Err(Error::stream(format!(
                 "pass inserted {} vertices, its header says {}",
-                self.vertex_count() - n,
+                scratch.pending.len(),
                 pass.inserted
             )));
         }
+        let mut decoded = std::mem::take(&mut scratch.decoded);
+        decoded.clear();
+        for r in &scratch.pending {
+            decoded.push(self.decode_vertex(r, &mut s)?);
+        }
+        for (r, &(position, colour)) in scratch.pending.iter().zip(&decoded) {
+            self.insert_vertex(r, position, colour);
+        }
+        scratch.decoded = decoded;
         s.conn.check_overrun()?;
         s.geom.check_overrun()?;
         s.colour.check_overrun()
@@ -143,14 +158,16 @@ impl Level {
             }
             return Ok(());
         }
-        if self.vertex_count() >= target {
+        if self.vertex_count() + scratch.pending.len() >= target {
             return Err(Error::stream(
                 "pass inserts more vertices than its header says",
             ));
         }
         let pat = pattern(valence, as_gate_tag(t0), as_gate_tag(t1));
         let region = self.find_patch(g, pat, scratch)?;
-        self.insert_vertex(&region, pat, scratch, s)
+        self.claim_patch(&region, pat, scratch);
+        scratch.pending.push(region);
+        Ok(())
     }
 
     /// Walks the `valence − 2` faces of the retriangulated patch from the gate.
@@ -161,6 +178,7 @@ impl Level {
             valence: pat.valence,
             polygon: [NONE; MAX_VALENCE],
             outer: [NONE; MAX_VALENCE],
+            boundary: [NONE; MAX_VALENCE],
             corner0: [NONE; MAX_VALENCE - 2],
         };
         let mut first = g;
@@ -190,6 +208,7 @@ impl Level {
                 let twin = pat.twin[corner];
                 if twin >= NO_TWIN {
                     r.outer[(twin - NO_TWIN) as usize] = c.twin[h as usize];
+                    r.boundary[(twin - NO_TWIN) as usize] = h;
                 } else {
                     let t2 = twin as usize / 3;
                     if r.corner0[t2] == NONE {
@@ -220,19 +239,34 @@ impl Level {
         Ok(r)
     }
 
-    fn insert_vertex(
-        &mut self,
-        r: &Region,
-        pat: &Pattern,
-        scratch: &mut Scratch,
-        s: &mut Streams,
-    ) -> Result<()> {
+    /// Phase 1 of a patch: conquer its faces and border as the encoder did,
+    /// without touching the mesh yet.
+    fn claim_patch(&self, r: &Region, pat: &Pattern, scratch: &mut Scratch) {
         let d = r.valence;
-        let mut polygon_q = [[0i32; 3]; MAX_VALENCE];
-        for (q, &v) in polygon_q.iter_mut().zip(&r.polygon[..d]) {
-            *q = self.positions_q[v as usize];
+        for &h in &r.corner0[..d - 2] {
+            scratch.face_done[face(h) as usize] = true;
         }
-        let position = PatchPrediction::new(&polygon_q[..d])
+        for i in 0..d {
+            conquer(scratch, r.polygon[i], pat.tags[i]);
+        }
+        for &o in &r.outer[1..d] {
+            if o != NONE {
+                scratch.gates.push_back(o);
+            }
+        }
+    }
+
+    /// Phase 2: the removed vertex's position and colour, predicted from the
+    /// coarse mesh (nothing inserted yet, exactly what the encoder saw).
+    fn decode_vertex(&self, r: &Region, s: &mut Streams) -> Result<([i32; 3], Option<[u8; 3]>)> {
+        let d = r.valence;
+        let mut polygon = [[0i32; 3]; MAX_VALENCE];
+        let mut umbrellas = [([0i64; 3], 0i64); MAX_VALENCE];
+        for i in 0..d {
+            polygon[i] = self.positions_q[r.polygon[i] as usize];
+            umbrellas[i] = umbrella(&self.conn, &self.positions_q, r.polygon[i]);
+        }
+        let position = PatchPrediction::with_curvature(&polygon[..d], &umbrellas[..d])
             .decode(self.quantization.max_value(), &mut s.models, &mut s.geom)
             .ok_or_else(|| Error::stream("decoded position outside the quantization range"))?;
         let colour = match &self.colours {
@@ -249,6 +283,18 @@ impl Level {
             }
             None => None,
         };
+        Ok((position, colour))
+    }
+
+    /// Phase 3: replace the patch's faces by the fan of the new vertex.
+    fn insert_vertex(&mut self, r: &Region, position: [i32; 3], colour: Option<[u8; 3]>) {
+        let d = r.valence;
+        // Read the outer half-edges now: neighbouring patches inserted since
+        // phase 1 have re-linked them.
+        let mut outer = [NONE; MAX_VALENCE];
+        for (o, &h) in outer.iter_mut().zip(&r.boundary[..d]) {
+            *o = self.conn.twin[h as usize];
+        }
         let v = self.push_vertex(position, colour);
         // Faces (v, p_i, p_i+1): reuse the patch's d − 2 slots, append two.
         let mut slots = [NONE; MAX_VALENCE];
@@ -265,7 +311,7 @@ impl Level {
             self.conn.origin[base as usize] = v;
             self.conn.origin[base as usize + 1] = a;
             self.conn.origin[base as usize + 2] = b;
-            let o = r.outer[i];
+            let o = outer[i];
             self.conn.twin[base as usize + 1] = o;
             if o != NONE {
                 self.conn.twin[o as usize] = base + 1;
@@ -277,23 +323,6 @@ impl Level {
             self.conn.out[a as usize] = base + 1;
         }
         self.conn.out[v as usize] = 3 * slots[0];
-        scratch
-            .face_done
-            .resize(self.conn.face_count_slots(), false);
-        for &slot in &slots[..d] {
-            scratch.face_done[slot as usize] = true;
-        }
-        scratch.state.push(CONQUERED);
-        scratch.tag.push(Tag::None);
-        for i in 0..d {
-            conquer(scratch, r.polygon[i], pat.tags[i]);
-        }
-        for &o in &r.outer[1..d] {
-            if o != NONE {
-                scratch.gates.push_back(o);
-            }
-        }
-        Ok(())
     }
 }
 
@@ -301,6 +330,8 @@ struct Region {
     valence: usize,
     polygon: [u32; MAX_VALENCE],
     outer: [u32; MAX_VALENCE],
+    /// The region's own half-edge on each border edge `p_i → p_i+1`.
+    boundary: [u32; MAX_VALENCE],
     /// Half-edge at corner 0 of each pattern triangle.
     corner0: [u32; MAX_VALENCE - 2],
 }

@@ -6,7 +6,9 @@ use std::collections::VecDeque;
 use crate::entropy::RangeEncoder;
 use crate::halfedge::{face, next, prev, Connectivity, NONE};
 use crate::patch::{pattern, Pattern, Tag, MAX_VALENCE, NO_TWIN};
-use crate::predict::{encode_colour, gate_context, predict_colour, PassModels, PatchPrediction};
+use crate::predict::{
+    encode_colour, gate_context, predict_colour, umbrella, PassModels, PatchPrediction,
+};
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) enum PassKind {
@@ -70,6 +72,8 @@ struct Patch {
 }
 
 struct Streams {
+    /// Removed vertices with their border polygons, coded once the pass is done.
+    patches: Vec<(u32, usize, [u32; MAX_VALENCE])>,
     conn: RangeEncoder,
     geom: RangeEncoder,
     colour: RangeEncoder,
@@ -111,6 +115,7 @@ impl Simplifier {
         self.face_done.clear();
         self.face_done.resize(self.conn.face_count_slots(), false);
         let mut streams = Streams {
+            patches: Vec::new(),
             conn: RangeEncoder::new(),
             geom: RangeEncoder::new(),
             colour: RangeEncoder::new(),
@@ -138,6 +143,12 @@ impl Simplifier {
             while let Some(g) = gates.pop_front() {
                 self.process_gate(g, kind, &mut gates, &mut streams, &mut out.removed);
             }
+        }
+        // Geometry after connectivity: predictions may use the whole coarse
+        // mesh, which is what the decoder has before it inserts anything.
+        let patches = std::mem::take(&mut streams.patches);
+        for (centre, valence, polygon) in patches {
+            self.encode_vertex(centre, &polygon[..valence], &mut streams);
         }
         for v in out.removed.iter_mut().chain(out.seeds.iter_mut().flatten()) {
             *v = self.ids[*v as usize];
@@ -270,7 +281,7 @@ impl Simplifier {
                     .encode_symbol(&mut s.models.valence[ctx], patch.valence - 2),
                 PassKind::Cleaning => s.conn.encode_bit(&mut s.models.cleaning[ctx], true),
             }
-            self.encode_vertex(&patch, s);
+            s.patches.push((patch.centre, patch.valence, patch.polygon));
             removed.push(patch.centre);
             self.remove(&patch, gates);
         } else {
@@ -395,25 +406,27 @@ impl Simplifier {
             })
     }
 
-    fn encode_vertex(&self, p: &Patch, s: &mut Streams) {
-        let d = p.valence;
+    fn encode_vertex(&self, centre: u32, border: &[u32], s: &mut Streams) {
+        let d = border.len();
         let mut polygon = [[0i32; 3]; MAX_VALENCE];
-        for (q, &v) in polygon.iter_mut().zip(&p.polygon[..d]) {
-            *q = self.positions[v as usize];
+        let mut umbrellas = [([0i64; 3], 0i64); MAX_VALENCE];
+        for i in 0..d {
+            polygon[i] = self.positions[border[i] as usize];
+            umbrellas[i] = umbrella(&self.conn, &self.positions, border[i]);
         }
-        PatchPrediction::new(&polygon[..d]).encode(
-            self.positions[p.centre as usize],
+        PatchPrediction::with_curvature(&polygon[..d], &umbrellas[..d]).encode(
+            self.positions[centre as usize],
             &mut s.models,
             &mut s.geom,
         );
         if let Some(colours) = &self.colours {
-            let mut border = [[0u8; 3]; MAX_VALENCE];
-            for (c, &v) in border.iter_mut().zip(&p.polygon[..d]) {
+            let mut colour = [[0u8; 3]; MAX_VALENCE];
+            for (c, &v) in colour.iter_mut().zip(border) {
                 *c = colours[v as usize];
             }
             encode_colour(
-                colours[p.centre as usize],
-                predict_colour(&border[..d]),
+                colours[centre as usize],
+                predict_colour(&colour[..d]),
                 &mut s.models,
                 &mut s.colour,
             );

@@ -1,0 +1,62 @@
+#!/usr/bin/env bash
+# Runs every fuzz target of vitrine-codec (codec/fuzz) for N seconds each.
+#
+#   scripts/fuzz.sh [SECONDS] [TARGET...]     default: 30 seconds, all targets
+#
+# Needs the nightly toolchain (rustup toolchain install nightly); installs
+# cargo-fuzz if it is missing. Corpora grow in codec/fuzz/corpus/<target>,
+# crashes land in codec/fuzz/artifacts/<target>; both are git-ignored. Turn a
+# crash into a regression test in codec/tests/hostile.rs. Exits non-zero if
+# any target found a crash.
+set -euo pipefail
+
+secs="${1:-30}"
+shift || true
+case "$secs" in
+    '' | *[!0-9]*) echo "usage: $0 [SECONDS] [TARGET...]" >&2; exit 2 ;;
+esac
+
+root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+cd "$root/codec/fuzz"
+
+if ! cargo +nightly --version >/dev/null 2>&1; then
+    echo "the nightly toolchain is missing: rustup toolchain install nightly" >&2
+    exit 1
+fi
+if ! cargo +nightly fuzz --version >/dev/null 2>&1; then
+    cargo install cargo-fuzz --locked
+fi
+
+all=(decode_stream decode_batch import_ply import_obj import_off import_gltf repair)
+if [ "$#" -gt 0 ]; then
+    targets=("$@")
+else
+    targets=("${all[@]}")
+fi
+
+# One build for every target (and the seed writer), with the same flags `run` uses.
+cargo +nightly fuzz build
+# Seeds from the current encoder and exporters, kept apart from the corpora.
+seeds="target/seeds"
+rm -rf "$seeds"
+"target/x86_64-unknown-linux-gnu/release/make_seeds" "$seeds"
+
+failed=()
+for t in "${targets[@]}"; do
+    mkdir -p "corpus/$t" "$seeds/$t"
+    echo "=== $t: ${secs}s"
+    if ! cargo +nightly fuzz run "$t" "corpus/$t" "$seeds/$t" -- \
+        -max_total_time="$secs" -rss_limit_mb=2048 -timeout=10 -print_final_stats=1 2>&1 |
+        tee "target/fuzz-$t.log" | grep -E '^(#[0-9]+\s+(INITED|DONE)|stat::number_of_executed_units|stat::average_exec_per_sec|stat::peak_rss_mb|==[0-9]+==|SUMMARY|Test unit written|thread .* panicked)'; then
+        :
+    fi
+    if grep -qE 'Test unit written|SUMMARY: |deadly signal' "target/fuzz-$t.log"; then
+        failed+=("$t")
+    fi
+done
+
+if [ "${#failed[@]}" -gt 0 ]; then
+    echo "crashes in: ${failed[*]} (inputs under codec/fuzz/artifacts/, logs under codec/fuzz/target/fuzz-*.log)" >&2
+    exit 1
+fi
+echo "all targets ran ${secs}s without a crash"

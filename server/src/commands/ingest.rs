@@ -1,0 +1,103 @@
+//! `vitrine ingest <mesh> --db … --slug … --title …`
+
+use crate::ingest::{ingest_mesh, IngestOptions, ModelMeta, SourceInfo};
+use crate::storage::{ConnectOptions, OnExisting};
+use anyhow::Context;
+use std::path::PathBuf;
+use std::time::Duration;
+use vitrine_codec::import::{import_path, ImportOptions};
+use vitrine_codec::repair::{prepare, RepairOptions};
+use vitrine_codec::EncodeOptions;
+
+#[derive(clap::Args, Clone, Debug)]
+pub struct IngestArgs {
+    /// Mesh file: PLY, OBJ, OFF, glTF or GLB.
+    pub mesh: PathBuf,
+    /// Database URL: `sqlite:vitrine.db` or `postgres://user@host/db`.
+    #[arg(long, env = "VITRINE_DB", default_value = "sqlite:vitrine.db")]
+    pub db: String,
+    /// URL name of the model: 1–64 of a-z, 0-9 and '-'.
+    #[arg(long)]
+    pub slug: String,
+    #[arg(long)]
+    pub title: String,
+    #[arg(long, default_value = "")]
+    pub description: String,
+    /// Audience policy: exhibition (public gets all but full resolution),
+    /// open (everyone gets everything) or researchers (token holders only).
+    #[arg(long, default_value = "exhibition")]
+    pub policy: String,
+    /// Level judged sufficient by a quality study (default: first level with
+    /// 20 % of the vertices). Load caps fall toward it.
+    #[arg(long)]
+    pub good_enough_level: Option<u32>,
+    /// If the slug exists, add a new version instead of refusing.
+    #[arg(long)]
+    pub new_version: bool,
+    /// Position quantization, 8–16 bits.
+    #[arg(long, default_value_t = 12)]
+    pub quantization_bits: u8,
+    /// Test hook: pause inside the transaction before committing.
+    #[arg(long, hide = true, env = "VITRINE_TEST_PAUSE_BEFORE_COMMIT_MS")]
+    pub pause_before_commit_ms: Option<u64>,
+}
+
+pub async fn run_ingest(args: IngestArgs) -> anyhow::Result<()> {
+    super::init_tracing();
+    let path = args.mesh.clone();
+    let (mesh, source) = tokio::task::spawn_blocking(move || -> anyhow::Result<_> {
+        let mesh = import_path(&path, &ImportOptions::default())
+            .with_context(|| format!("reading {}", path.display()))?;
+        let (vertices, faces) = (mesh.vertex_count() as u64, mesh.face_count() as u64);
+        let (mesh, report) =
+            prepare(mesh, &RepairOptions::default()).context("repairing the mesh")?;
+        let name = path
+            .file_name()
+            .map(|n| n.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        Ok((
+            mesh,
+            SourceInfo {
+                name,
+                vertices,
+                faces,
+                repair: Some(report.to_string()),
+            },
+        ))
+    })
+    .await??;
+    let storage = super::open_storage(&args.db, &ConnectOptions::default(), false).await?;
+    let meta = ModelMeta {
+        slug: args.slug,
+        title: args.title,
+        description: args.description,
+        policy: args.policy,
+        good_enough_level: args.good_enough_level,
+        on_existing: if args.new_version {
+            OnExisting::NewVersion
+        } else {
+            OnExisting::Refuse
+        },
+        source: Some(source),
+    };
+    let options = IngestOptions {
+        encode: EncodeOptions {
+            quantization_bits: args.quantization_bits,
+            ..EncodeOptions::default()
+        },
+        pause_before_commit: args.pause_before_commit_ms.map(Duration::from_millis),
+    };
+    let slug = meta.slug.clone();
+    let report = ingest_mesh(&*storage, mesh, meta, &options).await?;
+    println!(
+        "ingested {slug} version {} (compression {}): {} levels, {} → {} vertices, {} bytes, encoded in {:.1} s",
+        report.stored.version,
+        report.stored.compression_id,
+        report.levels,
+        report.base_vertices,
+        report.full_vertices,
+        report.stream_bytes,
+        report.encode_time.as_secs_f64(),
+    );
+    Ok(())
+}

@@ -1,0 +1,202 @@
+//! `vitrine serve --db … --listen …`: every setting a flag and a `VITRINE_*`
+//! variable; the defaults are those of [`ServiceConfig::default`] and
+//! [`ServeLimits::default`] (a test keeps them equal).
+
+use crate::serve::{serve, shutdown_signal, ServeLimits};
+use crate::service::cap::CapRules;
+use crate::service::load::LoadConfig;
+use crate::service::{app, AppState, CacheConfig, RequestLimits, ServiceConfig};
+use crate::storage::ConnectOptions;
+use std::net::SocketAddr;
+use std::path::PathBuf;
+use std::time::Duration;
+use tokio::net::TcpListener;
+
+#[derive(clap::Args, Clone, Debug)]
+pub struct ServeArgs {
+    /// Database URL: `sqlite:vitrine.db` or `postgres://user@host/db`.
+    #[arg(long, env = "VITRINE_DB", default_value = "sqlite:vitrine.db")]
+    pub db: String,
+    #[arg(long, env = "VITRINE_LISTEN", default_value = "127.0.0.1:8080")]
+    pub listen: SocketAddr,
+    /// Also serve /metrics, /healthz and /readyz on this address.
+    #[arg(long, env = "VITRINE_METRICS_LISTEN")]
+    pub metrics_listen: Option<SocketAddr>,
+    /// The viewer's build; a built-in page is served when it has no index.html.
+    #[arg(long, env = "VITRINE_WEB_DIR", default_value = "web/dist")]
+    pub web_dir: PathBuf,
+    /// Origins allowed by CORS (comma-separated); none given means any.
+    #[arg(
+        long = "cors-origin",
+        env = "VITRINE_CORS_ORIGINS",
+        value_delimiter = ','
+    )]
+    pub cors_origins: Vec<String>,
+
+    #[arg(long, env = "VITRINE_DB_MAX_CONNECTIONS", default_value_t = 16)]
+    pub db_max_connections: u32,
+    /// How long a query waits for a connection or lock before answering 503.
+    #[arg(long, env = "VITRINE_DB_TIMEOUT_MS", default_value_t = 3000)]
+    pub db_timeout_ms: u64,
+
+    /// Byte budget of the in-memory payload cache (0: off).
+    #[arg(long, env = "VITRINE_CACHE_BYTES", default_value_t = 256 << 20)]
+    pub cache_bytes: u64,
+    /// How long model records, policies and tokens are trusted before re-reading.
+    #[arg(long, env = "VITRINE_RECORD_TTL_MS", default_value_t = 10_000)]
+    pub record_ttl_ms: u64,
+
+    /// Vertex budget of phones.
+    #[arg(long, env = "VITRINE_PHONE_MAX_VERTICES", default_value_t = 300_000)]
+    pub phone_max_vertices: u32,
+    #[arg(long, env = "VITRINE_TABLET_MAX_VERTICES", default_value_t = 1_000_000)]
+    pub tablet_max_vertices: u32,
+    /// Good-enough level without a study: first level with this fraction of the vertices.
+    #[arg(long, env = "VITRINE_GOOD_ENOUGH_FRACTION", default_value_t = 0.2)]
+    pub good_enough_fraction: f64,
+
+    /// Load is high at this many data requests in flight…
+    #[arg(long, env = "VITRINE_LOAD_HIGH_INFLIGHT", default_value_t = 384)]
+    pub load_high_inflight: u64,
+    /// …and low again at this many (with the other signals low too).
+    #[arg(long, env = "VITRINE_LOAD_LOW_INFLIGHT", default_value_t = 128)]
+    pub load_low_inflight: u64,
+    /// Smoothed handler latency that counts as high load.
+    #[arg(long, env = "VITRINE_LOAD_HIGH_LATENCY_MS", default_value_t = 250)]
+    pub load_high_latency_ms: u64,
+    #[arg(long, env = "VITRINE_LOAD_LOW_LATENCY_MS", default_value_t = 50)]
+    pub load_low_latency_ms: u64,
+    /// Smoothed runtime queueing delay that counts as high load.
+    #[arg(long, env = "VITRINE_LOAD_HIGH_QUEUE_MS", default_value_t = 25)]
+    pub load_high_queue_ms: u64,
+    #[arg(long, env = "VITRINE_LOAD_LOW_QUEUE_MS", default_value_t = 5)]
+    pub load_low_queue_ms: u64,
+    #[arg(long, env = "VITRINE_LOAD_SAMPLE_MS", default_value_t = 250)]
+    pub load_sample_ms: u64,
+    /// Pressure steps from no load cap to the good-enough level.
+    #[arg(long, env = "VITRINE_LOAD_STEPS", default_value_t = 4)]
+    pub load_steps: u8,
+    /// Calm samples before pressure falls one step.
+    #[arg(long, env = "VITRINE_LOAD_COOLDOWN_SAMPLES", default_value_t = 8)]
+    pub load_cooldown_samples: u32,
+    /// `Retry-After` of load-capped answers.
+    #[arg(long, env = "VITRINE_LOAD_RETRY_AFTER_S", default_value_t = 10)]
+    pub load_retry_after_s: u64,
+
+    /// Longest a request may take before 504.
+    #[arg(long, env = "VITRINE_REQUEST_TIMEOUT_MS", default_value_t = 10_000)]
+    pub request_timeout_ms: u64,
+    /// Requests handled at once; more are shed with 503.
+    #[arg(long, env = "VITRINE_MAX_CONCURRENCY", default_value_t = 1024)]
+    pub max_concurrency: usize,
+    #[arg(long, env = "VITRINE_MAX_BODY_BYTES", default_value_t = 16 * 1024)]
+    pub max_body_bytes: usize,
+    #[arg(long, env = "VITRINE_MAX_HEADER_BYTES", default_value_t = 16 * 1024)]
+    pub max_header_bytes: usize,
+    #[arg(long, env = "VITRINE_SHUTDOWN_GRACE_MS", default_value_t = 10_000)]
+    pub shutdown_grace_ms: u64,
+}
+
+impl ServeArgs {
+    pub fn connect_options(&self) -> ConnectOptions {
+        ConnectOptions {
+            max_connections: self.db_max_connections,
+            acquire_timeout: Duration::from_millis(self.db_timeout_ms),
+            ..ConnectOptions::default()
+        }
+    }
+
+    pub fn service_config(&self) -> ServiceConfig {
+        let ms = Duration::from_millis;
+        ServiceConfig {
+            caps: CapRules {
+                phone_max_vertices: self.phone_max_vertices,
+                tablet_max_vertices: self.tablet_max_vertices,
+                good_enough_fraction: self.good_enough_fraction,
+            },
+            load: LoadConfig {
+                high_inflight: self.load_high_inflight,
+                low_inflight: self.load_low_inflight,
+                high_latency: ms(self.load_high_latency_ms),
+                low_latency: ms(self.load_low_latency_ms),
+                high_queue: ms(self.load_high_queue_ms),
+                low_queue: ms(self.load_low_queue_ms),
+                sample_every: ms(self.load_sample_ms),
+                steps: self.load_steps,
+                cooldown_samples: self.load_cooldown_samples,
+                retry_after: Duration::from_secs(self.load_retry_after_s),
+            },
+            cache: CacheConfig {
+                payload_bytes: self.cache_bytes,
+                record_ttl: ms(self.record_ttl_ms),
+                ..CacheConfig::default()
+            },
+            limits: RequestLimits {
+                timeout: ms(self.request_timeout_ms),
+                max_concurrency: self.max_concurrency,
+                max_body_bytes: self.max_body_bytes,
+                ..RequestLimits::default()
+            },
+            web_dir: self.web_dir.clone(),
+            cors_origins: self.cors_origins.clone(),
+        }
+    }
+
+    pub fn serve_limits(&self) -> ServeLimits {
+        ServeLimits {
+            max_header_bytes: self.max_header_bytes,
+            shutdown_grace: Duration::from_millis(self.shutdown_grace_ms),
+            ..ServeLimits::default()
+        }
+    }
+}
+
+/// Runs until Ctrl-C or SIGTERM. A database that is down at start-up is
+/// waited for; one that goes away later gives 503s until it is back.
+pub async fn run_serve(args: ServeArgs) -> anyhow::Result<()> {
+    super::init_tracing();
+    let storage = super::open_storage(&args.db, &args.connect_options(), true).await?;
+    let state = AppState::new(storage, args.service_config());
+    let _sampler = state.spawn_load_sampler();
+    let listener = TcpListener::bind(args.listen).await?;
+    tracing::info!(
+        addr = %listener.local_addr()?,
+        db = %super::redact(&args.db),
+        backend = state.storage().backend(),
+        "serving"
+    );
+    if let Some(addr) = args.metrics_listen {
+        let ops = TcpListener::bind(addr).await?;
+        let router = crate::service::ops_app(state.clone());
+        let limits = args.serve_limits();
+        tracing::info!(addr = %ops.local_addr()?, "serving metrics");
+        tokio::spawn(async move { serve(ops, router, limits, std::future::pending()).await });
+    }
+    serve(listener, app(state), args.serve_limits(), shutdown_signal()).await?;
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clap::Parser;
+
+    #[derive(Parser)]
+    struct Cli {
+        #[command(flatten)]
+        serve: ServeArgs,
+    }
+
+    #[test]
+    fn flag_defaults_match_library_defaults() {
+        let args = Cli::parse_from(["vitrine"]).serve;
+        assert_eq!(args.service_config(), ServiceConfig::default());
+        assert_eq!(args.serve_limits(), ServeLimits::default());
+        let c = args.connect_options();
+        let d = ConnectOptions::default();
+        assert_eq!(
+            (c.max_connections, c.acquire_timeout),
+            (d.max_connections, d.acquire_timeout)
+        );
+    }
+}

@@ -1,0 +1,240 @@
+//! JSON routes: the model list and a model's manifest.
+
+use super::cap::{good_enough_level, Audience, CapReason, DeviceClass, LevelCap};
+use super::error::AppError;
+use super::payload;
+use super::visitor::VisitorHints;
+use super::{AppState, Visitor};
+use crate::storage::{valid_slug, ModelRecord, ModelSummary};
+use axum::extract::{Path, State};
+use axum::http::{header, HeaderValue};
+use axum::response::{IntoResponse, Response};
+use axum::routing::{any, get};
+use axum::{Json, Router};
+use serde::Serialize;
+use std::sync::Arc;
+
+pub fn routes() -> Router<AppState> {
+    Router::new()
+        .route("/api/models", get(list))
+        .route("/api/models/{slug}", get(manifest))
+        .route("/api/compressions/{id}/base", get(payload::base))
+        .route(
+            "/api/compressions/{id}/batches/{iteration}",
+            get(payload::batch),
+        )
+        .route("/api/textures/{id}", get(payload::texture))
+        .route(
+            "/api/{*rest}",
+            any(|| async { AppError::NotFound("route") }),
+        )
+}
+
+#[derive(Serialize)]
+struct ModelList {
+    models: Vec<ListedModel>,
+}
+
+#[derive(Serialize)]
+struct ListedModel {
+    slug: String,
+    title: String,
+    version: u32,
+    levels: u32,
+    manifest_url: String,
+    page_url: String,
+}
+
+/// Models this visitor may see, from the cached list.
+pub async fn visible_models(
+    state: &AppState,
+    hints: &VisitorHints,
+) -> Result<Vec<ModelSummary>, AppError> {
+    let storage = state.storage();
+    let load = async { Ok(Arc::new(storage.list_models().await?)) };
+    let all =
+        super::cache::through(&state.caches().list, state.metrics(), "list", (), load).await?;
+    let mut visible = Vec::with_capacity(all.len());
+    for m in all.iter() {
+        // Tokens are checked only when a restricted model is in the list.
+        if m.public_access || state.visitor(hints, &m.slug).await?.audience == Audience::Researcher
+        {
+            visible.push(m.clone());
+        }
+    }
+    Ok(visible)
+}
+
+async fn list(State(state): State<AppState>, hints: VisitorHints) -> Result<Response, AppError> {
+    let models = visible_models(&state, &hints)
+        .await?
+        .into_iter()
+        .map(|m| ListedModel {
+            manifest_url: format!("/api/models/{}", m.slug),
+            page_url: format!("/m/{}", m.slug),
+            slug: m.slug,
+            title: m.title,
+            version: m.version,
+            levels: m.batch_count + 1,
+        })
+        .collect();
+    Ok(no_store(Json(ModelList { models })))
+}
+
+#[derive(Serialize)]
+struct Manifest<'a> {
+    slug: &'a str,
+    version: u32,
+    title: &'a str,
+    description: &'a str,
+    compression_id: i64,
+    quantization_bits: u8,
+    has_colour: bool,
+    /// Index of the full-resolution level (= number of batches).
+    last_level: u32,
+    good_enough_level: u32,
+    levels: Vec<ManifestLevel>,
+    textures: Vec<ManifestTexture<'a>>,
+    visitor: ManifestVisitor,
+    cap: ManifestCap,
+}
+
+#[derive(Serialize)]
+struct ManifestLevel {
+    level: u32,
+    vertices: u32,
+    faces: u32,
+    bytes: u64,
+    hausdorff: Option<f64>,
+    rmse: Option<f64>,
+    /// The payload that produces this level: the base for level 0.
+    url: String,
+    allowed: bool,
+}
+
+#[derive(Serialize)]
+struct ManifestTexture<'a> {
+    id: i64,
+    kind: &'a str,
+    media_type: &'a str,
+    bytes: u64,
+    url: String,
+}
+
+#[derive(Serialize)]
+struct ManifestVisitor {
+    audience: Audience,
+    device: DeviceClass,
+    /// `"query"` when `?device=` was given, else `"hints"`.
+    device_source: &'static str,
+}
+
+#[derive(Serialize)]
+struct ManifestCap {
+    level: u32,
+    reason: Option<CapReason>,
+    limits: LevelCap,
+    /// When the cap is set by load: when to ask again.
+    retry_after_s: Option<u64>,
+    load_pressure: u8,
+    load_steps: u8,
+}
+
+async fn manifest(
+    State(state): State<AppState>,
+    Path(slug): Path<String>,
+    hints: VisitorHints,
+) -> Result<Response, AppError> {
+    if !valid_slug(&slug) {
+        return Err(AppError::BadRequest(format!(
+            "{slug:?} is not a model slug"
+        )));
+    }
+    let record = state.record_by_slug(&slug).await?;
+    let visitor = state.visitor(&hints, &record.slug).await?;
+    state.ensure_visible(&record, &visitor)?;
+    let cap = state.level_cap(&record, &visitor);
+    Ok(no_store(Json(build_manifest(
+        &state, &record, &visitor, cap,
+    ))))
+}
+
+fn build_manifest<'a>(
+    state: &AppState,
+    record: &'a ModelRecord,
+    visitor: &Visitor,
+    cap: LevelCap,
+) -> Manifest<'a> {
+    let id = record.compression_id;
+    let pressure = state.load().pressure();
+    let levels = record
+        .levels
+        .iter()
+        .enumerate()
+        .map(|(k, l)| ManifestLevel {
+            level: k as u32,
+            vertices: l.vertices,
+            faces: l.faces,
+            bytes: l.bytes,
+            hausdorff: l.hausdorff,
+            rmse: l.rmse,
+            url: if k == 0 {
+                format!("/api/compressions/{id}/base")
+            } else {
+                format!("/api/compressions/{id}/batches/{k}")
+            },
+            allowed: k as u32 <= cap.level,
+        })
+        .collect();
+    let textures = record
+        .textures
+        .iter()
+        .map(|t| ManifestTexture {
+            id: t.id,
+            kind: &t.kind,
+            media_type: &t.media_type,
+            bytes: t.bytes,
+            url: format!("/api/textures/{}", t.id),
+        })
+        .collect();
+    Manifest {
+        slug: &record.slug,
+        version: record.version,
+        title: &record.title,
+        description: &record.description,
+        compression_id: id,
+        quantization_bits: record.quantization_bits,
+        has_colour: record.has_colour,
+        last_level: record.batch_count(),
+        good_enough_level: good_enough_level(record, &state.config().caps),
+        levels,
+        textures,
+        visitor: ManifestVisitor {
+            audience: visitor.audience,
+            device: visitor.device,
+            device_source: if visitor.device_explicit {
+                "query"
+            } else {
+                "hints"
+            },
+        },
+        cap: ManifestCap {
+            level: cap.level,
+            reason: cap.reason,
+            limits: cap,
+            retry_after_s: (cap.reason == Some(CapReason::Load))
+                .then(|| state.load().config().retry_after.as_secs().max(1)),
+            load_pressure: pressure.level,
+            load_steps: pressure.steps,
+        },
+    }
+}
+
+/// Manifests and lists depend on load and on the visitor: never cache them.
+fn no_store(body: impl IntoResponse) -> Response {
+    let mut response = body.into_response();
+    response
+        .headers_mut()
+        .insert(header::CACHE_CONTROL, HeaderValue::from_static("no-store"));
+    response
+}

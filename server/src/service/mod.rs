@@ -1,0 +1,262 @@
+//! The HTTP service: JSON manifests, binary payloads with strong ETags, level
+//! caps by audience, device and load, the viewer's static files, and
+//! health, readiness and metrics.
+//!
+//! [`app`] builds the router so tests can drive it in-process; [`crate::serve`]
+//! runs it on a listener.
+
+mod api;
+mod cache;
+pub mod cap;
+mod error;
+mod guard;
+mod layers;
+pub mod load;
+mod metrics;
+mod ops;
+mod payload;
+mod visitor;
+mod web;
+
+pub use cache::CacheConfig;
+pub use error::AppError;
+pub use layers::RequestLimits;
+pub use visitor::VisitorHints;
+
+use crate::storage::{sha256_hex, ModelRecord, Storage, TokenGrant};
+use axum::Router;
+use cache::{through, Caches};
+use cap::{Audience, CapRules, DeviceClass, LevelCap};
+use load::{LoadConfig, LoadMonitor};
+use metrics::Metrics;
+use std::path::PathBuf;
+use std::sync::Arc;
+use tokio::sync::Semaphore;
+
+/// Route templates, also the `route` label values of the request metrics.
+pub const ROUTES: &[&str] = &[
+    "/api/models",
+    "/api/models/{slug}",
+    "/api/compressions/{id}/base",
+    "/api/compressions/{id}/batches/{iteration}",
+    "/api/textures/{id}",
+    "/api/openapi.json",
+    "/api/{*rest}",
+    "/healthz",
+    "/readyz",
+    "/metrics",
+    "/",
+    "/m/{slug}",
+    "/embed/{slug}",
+];
+
+/// Everything the service can be told at start-up.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ServiceConfig {
+    pub caps: CapRules,
+    pub load: LoadConfig,
+    pub cache: CacheConfig,
+    pub limits: RequestLimits,
+    /// The viewer's build (`index.html` and assets); a minimal built-in page
+    /// is served when it has no `index.html`.
+    pub web_dir: PathBuf,
+    /// Origins allowed by CORS; empty means any.
+    pub cors_origins: Vec<String>,
+}
+
+impl Default for ServiceConfig {
+    fn default() -> Self {
+        ServiceConfig {
+            caps: CapRules::default(),
+            load: LoadConfig::default(),
+            cache: CacheConfig::default(),
+            limits: RequestLimits::default(),
+            web_dir: PathBuf::from("web/dist"),
+            cors_origins: Vec::new(),
+        }
+    }
+}
+
+/// A visitor once the token is checked.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Visitor {
+    pub audience: Audience,
+    pub device: DeviceClass,
+    pub device_explicit: bool,
+    pub grant: Option<TokenGrant>,
+}
+
+/// Shared by every request.
+#[derive(Clone)]
+pub struct AppState(Arc<Inner>);
+
+struct Inner {
+    storage: Arc<dyn Storage>,
+    config: ServiceConfig,
+    caches: Caches,
+    load: Arc<LoadMonitor>,
+    metrics: Metrics,
+    /// The global concurrency limit.
+    permits: Arc<Semaphore>,
+}
+
+impl AppState {
+    /// The load sampler is not started here: see [`AppState::spawn_load_sampler`].
+    pub fn new(storage: Arc<dyn Storage>, config: ServiceConfig) -> AppState {
+        AppState(Arc::new(Inner {
+            storage,
+            caches: Caches::new(&config.cache),
+            load: LoadMonitor::new(config.load.clone()),
+            metrics: Metrics::default(),
+            permits: Arc::new(Semaphore::new(config.limits.max_concurrency)),
+            config,
+        }))
+    }
+
+    /// Starts sampling load; the task ends when the state is dropped.
+    pub fn spawn_load_sampler(&self) -> tokio::task::JoinHandle<()> {
+        self.0.load.spawn_sampler()
+    }
+
+    pub fn storage(&self) -> &Arc<dyn Storage> {
+        &self.0.storage
+    }
+
+    pub fn config(&self) -> &ServiceConfig {
+        &self.0.config
+    }
+
+    pub fn load(&self) -> &Arc<LoadMonitor> {
+        &self.0.load
+    }
+
+    pub(crate) fn caches(&self) -> &Caches {
+        &self.0.caches
+    }
+
+    pub(crate) fn metrics(&self) -> &Metrics {
+        &self.0.metrics
+    }
+
+    pub(crate) fn permits(&self) -> &Arc<Semaphore> {
+        &self.0.permits
+    }
+
+    /// Forgets cached records, tokens and the model list, so that a new
+    /// ingest or policy change shows before the TTL runs out.
+    pub fn invalidate(&self) {
+        self.0.caches.invalidate();
+    }
+
+    pub async fn record_by_slug(&self, slug: &str) -> Result<Arc<ModelRecord>, AppError> {
+        let storage = self.storage();
+        let load = async { Ok(storage.model_by_slug(slug).await?.map(Arc::new)) };
+        let record = through(
+            &self.caches().by_slug,
+            self.metrics(),
+            "record",
+            slug.to_owned(),
+            load,
+        )
+        .await?;
+        record.ok_or(AppError::NotFound("model"))
+    }
+
+    pub async fn record_by_compression(&self, id: i64) -> Result<Arc<ModelRecord>, AppError> {
+        let storage = self.storage();
+        let load = async { Ok(storage.model_by_compression(id).await?.map(Arc::new)) };
+        let record = through(
+            &self.caches().by_compression,
+            self.metrics(),
+            "record",
+            id,
+            load,
+        )
+        .await?;
+        record.ok_or(AppError::NotFound("compression"))
+    }
+
+    /// Checks the token, if any, and decides the audience for model `slug`.
+    pub async fn visitor(&self, hints: &VisitorHints, slug: &str) -> Result<Visitor, AppError> {
+        let grant = match &hints.token {
+            None => None,
+            Some(token) => {
+                let digest = sha256_hex(token.as_bytes());
+                let storage = self.storage();
+                let load = async { storage.token_grant(&digest, crate::storage::now_ms()).await };
+                let grant = through(
+                    &self.caches().tokens,
+                    self.metrics(),
+                    "token",
+                    digest.clone(),
+                    load,
+                )
+                .await?;
+                Some(grant.ok_or(AppError::InvalidToken)?)
+            }
+        };
+        let researcher = grant.as_ref().is_some_and(|g| g.covers(slug));
+        Ok(Visitor {
+            audience: if researcher {
+                Audience::Researcher
+            } else {
+                Audience::Public
+            },
+            device: hints.device,
+            device_explicit: hints.device_explicit,
+            grant,
+        })
+    }
+
+    /// Restricted models do not exist for visitors without a token for them.
+    pub fn ensure_visible(&self, record: &ModelRecord, visitor: &Visitor) -> Result<(), AppError> {
+        if record.policy.public_access || visitor.audience == Audience::Researcher {
+            Ok(())
+        } else {
+            Err(AppError::NotFound("model"))
+        }
+    }
+
+    pub fn level_cap(&self, record: &ModelRecord, visitor: &Visitor) -> LevelCap {
+        let pressure = self.load().pressure();
+        cap::level_cap(
+            record,
+            visitor.audience,
+            visitor.device,
+            pressure,
+            &self.config().caps,
+        )
+    }
+
+    /// `(slug, load cap, good-enough level)` of every cached model.
+    fn current_load_caps(&self) -> Vec<(String, u32, u32)> {
+        let pressure = self.load().pressure();
+        let rules = &self.config().caps;
+        self.caches()
+            .cached_records()
+            .iter()
+            .map(|r| {
+                (
+                    r.slug.clone(),
+                    cap::load_cap(r, pressure, rules),
+                    cap::good_enough_level(r, rules),
+                )
+            })
+            .collect()
+    }
+}
+
+/// The whole service as one router.
+pub fn app(state: AppState) -> Router {
+    let router = Router::new()
+        .merge(api::routes())
+        .merge(web::routes(state.config()))
+        .merge(ops::routes());
+    layers::apply(router, &state).with_state(state)
+}
+
+/// Only `/healthz`, `/readyz`, `/metrics` and the OpenAPI description, for a
+/// separate metrics listener.
+pub fn ops_app(state: AppState) -> Router {
+    layers::apply(ops::routes(), &state).with_state(state)
+}

@@ -1,0 +1,89 @@
+//! The inserts of one ingest, shared by both backends.
+
+/// The inserts of one ingest, run on an open transaction `$tx`.
+macro_rules! stage_body {
+    ($tx:ident, $model:ident, $classify:expr) => {{
+        use $crate::storage::sql::*;
+        use $crate::storage::{now_ms, sha256_hex, OnExisting, StoredModel};
+        let c = $classify;
+        let policy_id: Option<i64> =
+            sqlx::query_scalar(POLICY_ID).bind($model.policy.clone()).fetch_optional(&mut *$tx).await.map_err(c)?;
+        let policy_id =
+            policy_id.ok_or_else(|| StorageError::Unknown(format!("no audience policy named {:?}", $model.policy)))?;
+        let latest: Option<i64> =
+            sqlx::query_scalar(MAX_VERSION).bind($model.slug.clone()).fetch_one(&mut *$tx).await.map_err(c)?;
+        if latest.is_some() && $model.on_existing == OnExisting::Refuse {
+            return Err(StorageError::Conflict(format!(
+                "model {:?} already exists (version {}); ingest with --new-version to add a version",
+                $model.slug,
+                latest.unwrap_or(0)
+            )));
+        }
+        let version = latest.unwrap_or(0) + 1;
+        let now = now_ms();
+        let conflict = |e: sqlx::Error| match &e {
+            sqlx::Error::Database(d) if d.is_unique_violation() => {
+                StorageError::Conflict(format!("another ingest of {:?} committed first; retry", $model.slug))
+            }
+            _ => c(e),
+        };
+        let model_id: i64 = sqlx::query_scalar(INSERT_MODEL)
+            .bind($model.slug.clone())
+            .bind(version)
+            .bind($model.title.clone())
+            .bind($model.description.clone())
+            .bind(policy_id)
+            .bind($model.good_enough_level.map(i64::from))
+            .bind($model.source_name.clone())
+            .bind($model.source_vertices as i64)
+            .bind($model.source_faces as i64)
+            .bind(now)
+            .fetch_one(&mut *$tx)
+            .await
+            .map_err(conflict)?;
+        let comp = &$model.compression;
+        let last = comp.batches.last().unwrap_or(&comp.base);
+        let compression_id: i64 = sqlx::query_scalar(INSERT_COMPRESSION)
+            .bind(model_id)
+            .bind(i64::from(comp.codec_version))
+            .bind(comp.options.clone())
+            .bind(comp.stats.clone())
+            .bind(i64::from(comp.quantization_bits))
+            .bind(comp.has_colour)
+            .bind(comp.batches.len() as i64)
+            .bind(i64::from(last.vertices))
+            .bind(i64::from(last.faces))
+            .bind(comp.stream_bytes as i64)
+            .bind(comp.encode_ms as i64)
+            .bind(now)
+            .fetch_one(&mut *$tx)
+            .await
+            .map_err(c)?;
+        sqlx::query(INSERT_BASE)
+            .bind(compression_id)
+            .bind(i64::from(comp.base.vertices))
+            .bind(i64::from(comp.base.faces))
+            .bind(comp.base.bytes.len() as i64)
+            .bind(sha256_hex(&comp.base.bytes))
+            .bind(comp.base.bytes.as_slice())
+            .execute(&mut *$tx)
+            .await
+            .map_err(c)?;
+        for (k, batch) in comp.batches.iter().enumerate() {
+            sqlx::query(INSERT_BATCH)
+                .bind(compression_id)
+                .bind(k as i64 + 1)
+                .bind(i64::from(batch.vertices))
+                .bind(i64::from(batch.faces))
+                .bind(batch.bytes.len() as i64)
+                .bind(sha256_hex(&batch.bytes))
+                .bind(batch.bytes.as_slice())
+                .execute(&mut *$tx)
+                .await
+                .map_err(c)?;
+        }
+        StoredModel { model_id, compression_id, version: narrow(version, "model.version")? }
+    }};
+}
+
+pub(super) use stage_body;

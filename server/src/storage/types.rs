@@ -1,0 +1,176 @@
+//! Rows as the service sees them.
+
+use serde::Serialize;
+
+/// Who may fetch how much of a model (table `audience_policy`).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct AudiencePolicy {
+    pub name: String,
+    /// Visitors without a token may see the model at all.
+    pub public_access: bool,
+    /// The public may reach the highest level with at most this fraction of
+    /// the full level's vertices.
+    pub public_max_vertex_fraction: f64,
+    pub public_full_resolution: bool,
+    pub token_full_resolution: bool,
+}
+
+/// Counts after one level; level 0 is the base mesh.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct LevelRecord {
+    pub vertices: u32,
+    pub faces: u32,
+    /// Size of the payload that produces this level.
+    pub bytes: u64,
+    /// Hex SHA-256 of that payload: its strong ETag.
+    pub sha256: String,
+    pub hausdorff: Option<f64>,
+    pub rmse: Option<f64>,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct TextureRef {
+    pub id: i64,
+    /// `"cell"` or `"colour"`.
+    pub kind: String,
+    pub media_type: String,
+    pub bytes: u64,
+}
+
+/// A visible model version and the compression the service serves for it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ModelRecord {
+    pub model_id: i64,
+    pub slug: String,
+    pub version: u32,
+    pub title: String,
+    pub description: String,
+    pub policy: AudiencePolicy,
+    /// Set by the quality study; `None` means the 20 % rule.
+    pub good_enough_level: Option<u32>,
+    pub created_at_ms: i64,
+    pub compression_id: i64,
+    pub quantization_bits: u8,
+    pub has_colour: bool,
+    /// `levels[0]` is the base mesh, `levels[k]` the mesh after batch `k`.
+    pub levels: Vec<LevelRecord>,
+    pub textures: Vec<TextureRef>,
+}
+
+impl ModelRecord {
+    /// Number of refinement batches (= index of the full-resolution level).
+    pub fn batch_count(&self) -> u32 {
+        self.levels.len().saturating_sub(1) as u32
+    }
+}
+
+/// One line of the model list.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct ModelSummary {
+    pub slug: String,
+    pub title: String,
+    pub version: u32,
+    #[serde(skip)]
+    pub public_access: bool,
+    pub batch_count: u32,
+    pub created_at_ms: i64,
+}
+
+/// A texture and the model whose mapping uses it (a public one, if any).
+#[derive(Clone, Debug)]
+pub struct TexturePayload {
+    pub media_type: String,
+    pub sha256: String,
+    pub bytes: Vec<u8>,
+    pub model_slug: String,
+    pub public_access: bool,
+}
+
+/// A live researcher token.
+#[derive(Clone, Debug, PartialEq)]
+pub struct TokenGrant {
+    pub id: i64,
+    pub label: String,
+    /// `None`: every model.
+    pub model_slug: Option<String>,
+}
+
+impl TokenGrant {
+    pub fn covers(&self, slug: &str) -> bool {
+        self.model_slug.as_deref().is_none_or(|s| s == slug)
+    }
+}
+
+#[derive(Clone, Debug)]
+pub struct NewToken {
+    pub token_sha256: String,
+    pub label: String,
+    pub model_slug: Option<String>,
+    pub expires_at_ms: Option<i64>,
+}
+
+/// What to do when the slug already has a version.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum OnExisting {
+    Refuse,
+    NewVersion,
+}
+
+/// A payload that produces one level.
+#[derive(Clone, Debug)]
+pub struct NewLevel {
+    pub vertices: u32,
+    pub faces: u32,
+    pub bytes: Vec<u8>,
+}
+
+/// Everything one ingest writes.
+#[derive(Clone, Debug)]
+pub struct NewModel {
+    pub slug: String,
+    pub title: String,
+    pub description: String,
+    /// Name of an `audience_policy` row.
+    pub policy: String,
+    pub good_enough_level: Option<u32>,
+    pub on_existing: OnExisting,
+    pub source_name: Option<String>,
+    pub source_vertices: u64,
+    pub source_faces: u64,
+    pub compression: NewCompression,
+}
+
+#[derive(Clone, Debug)]
+pub struct NewCompression {
+    pub codec_version: u8,
+    /// Encoder options as JSON.
+    pub options: String,
+    /// Statistics as JSON (bits per vertex, timings, repair report).
+    pub stats: String,
+    pub quantization_bits: u8,
+    pub has_colour: bool,
+    pub stream_bytes: u64,
+    pub encode_ms: u64,
+    /// Header plus base chunk.
+    pub base: NewLevel,
+    pub batches: Vec<NewLevel>,
+}
+
+/// Ids of a written model version.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct StoredModel {
+    pub model_id: i64,
+    pub compression_id: i64,
+    pub version: u32,
+}
+
+/// Slugs are URL path segments: 1–64 of `a-z`, `0-9` and `-`, not starting or
+/// ending with `-`.
+pub fn valid_slug(slug: &str) -> bool {
+    (1..=64).contains(&slug.len())
+        && slug
+            .bytes()
+            .all(|b| b.is_ascii_lowercase() || b.is_ascii_digit() || b == b'-')
+        && !slug.starts_with('-')
+        && !slug.ends_with('-')
+}

@@ -1,0 +1,70 @@
+//! Service tests. The shared suite runs on SQLite and on PostgreSQL
+//! (`VITRINE_TEST_POSTGRES`, default `postgres://postgres@127.0.0.1:5432/postgres`;
+//! skipped with a note when unreachable, a failure when `CI` is set).
+
+mod caps;
+mod harness;
+mod http;
+mod kill;
+mod proxy;
+mod slow;
+mod story;
+
+use harness::{Backend, TestDb};
+use std::future::Future;
+
+async fn on(
+    backend: Backend,
+    test: impl FnOnce(TestDb) -> std::pin::Pin<Box<dyn Future<Output = ()> + Send>>,
+) {
+    if let Some(db) = TestDb::new(backend).await {
+        test(db).await;
+    }
+}
+
+macro_rules! on_both_backends {
+    ($($module:ident :: $name:ident),* $(,)?) => {
+        mod sqlite {
+            $(
+                #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+                async fn $name() {
+                    super::on(super::Backend::Sqlite, |db| Box::pin(crate::$module::$name(db))).await;
+                }
+            )*
+        }
+        mod postgres {
+            $(
+                #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+                async fn $name() {
+                    super::on(super::Backend::Postgres, |db| Box::pin(crate::$module::$name(db))).await;
+                }
+            )*
+        }
+    };
+}
+
+on_both_backends!(
+    story::storage_round_trip,
+    story::manifest_and_payloads_match_codec,
+    story::etags_and_not_modified,
+    caps::caps_by_audience_and_device,
+    caps::load_caps_fall_and_recover,
+    caps::bad_ids_and_slugs,
+    http::end_to_end,
+    http::load_cap_under_real_load,
+    http::database_outage_and_recovery,
+    http::shedding_and_body_limit,
+    http::graceful_shutdown,
+    kill::killed_ingest_leaves_nothing,
+);
+
+#[test]
+fn openapi_describes_every_route() {
+    let spec: serde_json::Value = serde_json::from_str(include_str!("../../openapi.json")).unwrap();
+    for route in vitrine::service::ROUTES.iter().filter(|r| !r.contains('*')) {
+        assert!(
+            spec["paths"].get(*route).is_some(),
+            "{route} is missing from openapi.json"
+        );
+    }
+}

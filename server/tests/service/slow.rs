@@ -1,0 +1,58 @@
+//! A storage decorator that makes payload reads slow.
+
+use async_trait::async_trait;
+use std::sync::Arc;
+use std::time::Duration;
+use vitrine::storage::{
+    ModelRecord, ModelSummary, NewModel, NewToken, Result, StagedModel, Storage, TexturePayload,
+    TokenGrant,
+};
+
+/// Storage whose payload reads take `delay`: concurrent batch requests then
+/// pile up in flight as they would behind a slow disk.
+pub struct SlowStorage {
+    pub inner: Arc<dyn Storage>,
+    pub delay: Duration,
+}
+
+#[async_trait]
+impl Storage for SlowStorage {
+    fn backend(&self) -> &'static str {
+        self.inner.backend()
+    }
+    async fn migrate(&self) -> Result<()> {
+        self.inner.migrate().await
+    }
+    async fn ping(&self) -> Result<()> {
+        self.inner.ping().await
+    }
+    async fn list_models(&self) -> Result<Vec<ModelSummary>> {
+        self.inner.list_models().await
+    }
+    async fn model_by_slug(&self, slug: &str) -> Result<Option<ModelRecord>> {
+        self.inner.model_by_slug(slug).await
+    }
+    async fn model_by_compression(&self, id: i64) -> Result<Option<ModelRecord>> {
+        self.inner.model_by_compression(id).await
+    }
+    async fn base_payload(&self, id: i64) -> Result<Option<Vec<u8>>> {
+        tokio::time::sleep(self.delay).await;
+        self.inner.base_payload(id).await
+    }
+    async fn batch_payload(&self, id: i64, iteration: u32) -> Result<Option<Vec<u8>>> {
+        tokio::time::sleep(self.delay).await;
+        self.inner.batch_payload(id, iteration).await
+    }
+    async fn texture(&self, id: i64) -> Result<Option<TexturePayload>> {
+        self.inner.texture(id).await
+    }
+    async fn token_grant(&self, sha256: &str, now_ms: i64) -> Result<Option<TokenGrant>> {
+        self.inner.token_grant(sha256, now_ms).await
+    }
+    async fn insert_token(&self, token: &NewToken) -> Result<i64> {
+        self.inner.insert_token(token).await
+    }
+    async fn stage_model(&self, model: &NewModel) -> Result<Box<dyn StagedModel>> {
+        self.inner.stage_model(model).await
+    }
+}
