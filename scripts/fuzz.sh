@@ -3,8 +3,8 @@
 #
 #   scripts/fuzz.sh [SECONDS] [TARGET...]     default: 30 seconds, all targets
 #
-# Needs the nightly toolchain (rustup toolchain install nightly); installs
-# cargo-fuzz if it is missing. Corpora grow in codec/fuzz/corpus/<target>,
+# Needs the nightly toolchain (rustup toolchain install nightly; without it
+# the script skips, see below); installs cargo-fuzz if it is missing. Corpora grow in codec/fuzz/corpus/<target>,
 # crashes land in codec/fuzz/artifacts/<target>; both are git-ignored. Turn a
 # crash into a regression test in codec/tests/hostile.rs. Exits non-zero if
 # any target found a crash.
@@ -19,12 +19,18 @@ esac
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 cd "$root/codec/fuzz"
 
-if ! cargo +nightly --version >/dev/null 2>&1; then
-    echo "the nightly toolchain is missing: rustup toolchain install nightly" >&2
-    exit 1
-fi
+# cargo-fuzz needs nightly. A machine without it (or without a way to get
+# cargo-fuzz) skips fuzzing with a notice rather than failing the whole test
+# run; FUZZ_REQUIRED=1 makes that an error.
+skip() {
+    echo "fuzzing SKIPPED: $1" >&2
+    [ "${FUZZ_REQUIRED:-0}" = 1 ] && exit 1
+    exit 0
+}
+cargo +nightly --version >/dev/null 2>&1 ||
+    skip "no nightly toolchain (rustup toolchain install nightly)"
 if ! cargo +nightly fuzz --version >/dev/null 2>&1; then
-    cargo install cargo-fuzz --locked
+    cargo install cargo-fuzz --locked || skip "cargo-fuzz could not be installed"
 fi
 
 all=(decode_stream decode_batch import_ply import_obj import_off import_gltf repair)

@@ -114,6 +114,13 @@ impl Header {
             if pair[1].vertices <= pair[0].vertices || pair[1].faces < pair[0].faces {
                 return Err(Error::stream("level table does not grow"));
             }
+            // A refinement adds two faces per vertex.
+            let added = (pair[1].vertices - pair[0].vertices) as u64;
+            if (pair[1].faces - pair[0].faces) as u64 != 2 * added {
+                return Err(Error::stream(
+                    "level table adds faces other than two per vertex",
+                ));
+            }
         }
         Ok(Header {
             version,

@@ -56,21 +56,27 @@ pub(crate) struct PatchPrediction {
     scale: usize,
 }
 
-/// Umbrella vector of a vertex in the coarse mesh: the sum of its
-/// neighbours minus `count` times itself, and the neighbour count. Exact
-/// integers, independent of the order neighbours are visited in.
-pub(crate) fn umbrella(conn: &Connectivity, positions: &[[i32; 3]], v: u32) -> ([i64; 3], i64) {
-    let p = positions[v as usize];
-    let mut sum = [0i64; 3];
-    let mut count = 0i64;
-    conn.for_each_outgoing(v, |h| {
-        let q = positions[conn.target(h) as usize];
-        for k in 0..3 {
-            sum[k] += (q[k] - p[k]) as i64;
+/// Umbrella vectors of every vertex of the coarse mesh: the sum of
+/// `neighbour − vertex` over its outgoing edges, and their count. One
+/// sequential sweep over the faces; exact integers, so the encoder (after a
+/// pass) and the decoder (before undoing it) get the same values whatever
+/// their face order.
+pub(crate) fn umbrellas(conn: &Connectivity, positions: &[[i32; 3]], out: &mut Vec<[i32; 4]>) {
+    out.clear();
+    out.resize(positions.len(), [0; 4]);
+    for t in conn.origin.chunks_exact(3) {
+        if t[0] == crate::halfedge::NONE {
+            continue;
         }
-        count += 1;
-    });
-    (sum, count.max(1))
+        for k in 0..3 {
+            let (a, b) = (t[k] as usize, t[(k + 1) % 3] as usize);
+            let u = &mut out[a];
+            for c in 0..3 {
+                u[c] += positions[b][c] - positions[a][c];
+            }
+            u[3] += 1;
+        }
+    }
 }
 
 /// How far the fine surface bulges out of the border polygon, from the
@@ -82,12 +88,12 @@ const CURVATURE_EIGHTHS: f64 = 3.0;
 
 impl PatchPrediction {
     /// Barycentre corrected by the coarse mesh's curvature at the border.
-    pub(crate) fn with_curvature(polygon: &[[i32; 3]], umbrellas: &[([i64; 3], i64)]) -> Self {
+    pub(crate) fn with_curvature(polygon: &[[i32; 3]], umbrellas: &[[i32; 4]]) -> Self {
         let mut p = Self::new(polygon);
         let mut mean = [0.0f64; 3];
-        for (sum, count) in umbrellas {
-            for (m, &s) in mean.iter_mut().zip(sum) {
-                *m += s as f64 / *count as f64;
+        for u in umbrellas {
+            for (m, &s) in mean.iter_mut().zip(&u[..3]) {
+                *m += s as f64 / u[3].max(1) as f64;
             }
         }
         let scale = CURVATURE_EIGHTHS / 8.0 / umbrellas.len() as f64;

@@ -313,20 +313,23 @@ fn level_table_claiming_billions_is_refused_at_once() {
     let batch = chunk(b'L', 1, 0, 0, 0, &[]);
     let tiny = sphere_with_batch(4_000_000_000, 4_000_000_000, &batch);
     assert!(tiny.len() < 1024);
-    assert_limit(
-        decode(&tiny, None, Limits::default()),
-        "4000000000 vertices",
-    );
+    // Two faces per added vertex is a format invariant: this table breaks it.
+    assert_stream_err(decode(&tiny, None, Limits::default()), &["two per vertex"]);
+    // A consistent table claiming 60 M vertices exceeds the default limits.
+    let base = StreamIndex::parse(sphere_stream()).unwrap().header.levels[0];
+    let (v, f) = (60_000_000u32, base.faces + 2 * (60_000_000 - base.vertices));
+    let tiny = sphere_with_batch(v, f, &batch);
+    assert_limit(decode(&tiny, None, Limits::default()), "60000000 vertices");
     let base_faces = get_u32(s, level_at(0) + 4);
     let fewer_faces = sphere_with_batch(4_000_000_000, base_faces, &batch);
-    assert_limit(
+    assert_stream_err(
         decode(&fewer_faces, None, Limits::default()),
-        "4000000000 vertices",
+        &["two per vertex"],
     );
     let many_faces = sphere_with_batch(get_u32(s, level_at(0)) + 1, 4_000_000_000, &batch);
-    assert_limit(
+    assert_stream_err(
         decode(&many_faces, None, Limits::default()),
-        "4000000000 faces",
+        &["two per vertex"],
     );
     // Chunk sizes past the end of the input.
     let mut b = s.to_vec();
@@ -696,7 +699,8 @@ fn base_chunk_that_disagrees_with_the_level_table_is_refused() {
     let v = get_u32(&b, level_at(0));
     put_u32(&mut b, level_at(0), v + 1);
     put_u32(&mut b, at + 8, v + 1);
-    assert_stream_err(decode(&b, None, Limits::default()), &["base mesh"]);
+    // Caught by the level table's two-faces-per-vertex rule before the base is decoded.
+    assert_stream_err(decode(&b, None, Limits::default()), &["level table"]);
     // One face fewer than coded.
     let mut b = s.to_vec();
     let faces = get_u32(&b, level_at(0) + 4);
@@ -709,7 +713,6 @@ fn base_chunk_that_disagrees_with_the_level_table_is_refused() {
 /// (each inserted vertex adds exactly two faces) must not decode as if it
 /// were right: a viewer sizes buffers from the table.
 #[test]
-#[ignore = "accepted: reported to lead (decoder does not check a batch's resulting face count)"]
 fn level_table_lying_about_faces_is_refused() {
     let s = sphere_stream();
     let index = StreamIndex::parse(s).unwrap();
@@ -918,7 +921,6 @@ fn hostile_headers_do_not_allocate_what_they_claim() {
 /// must not reserve buffers for 50 M vertices (≈ 3.6 GB) before it has
 /// decoded a single one.
 #[test]
-#[ignore = "over-allocates: reported to lead (Decoder::apply_batch reserves from the batch's claimed count)"]
 fn batch_claiming_millions_of_vertices_does_not_allocate_them() {
     let limits = Limits::default();
     let s = sphere_stream();

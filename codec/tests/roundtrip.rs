@@ -186,14 +186,23 @@ fn shared_meshes_round_trip() {
     }
     let mut tested = 0;
     for path in files {
-        let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
+        let ext = path
+            .extension()
+            .and_then(|e| e.to_str())
+            .unwrap_or("")
+            .to_ascii_lowercase();
         if !matches!(ext.as_str(), "ply" | "obj" | "off" | "gltf" | "glb") {
             continue;
         }
         let mesh = import_path(&path, &ImportOptions::default()).unwrap();
         let (mesh, _) = prepare(mesh, &RepairOptions::default()).unwrap();
         let bytes = assert_round_trip(&mesh, &EncodeOptions::default());
-        eprintln!("{}: {} vertices, {} bytes", path.display(), mesh.positions.len(), bytes);
+        eprintln!(
+            "{}: {} vertices, {} bytes",
+            path.display(),
+            mesh.positions.len(),
+            bytes
+        );
         tested += 1;
     }
     assert!(tested >= 10, "expected the shared meshes, found {tested}");

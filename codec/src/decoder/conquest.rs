@@ -8,7 +8,7 @@ use crate::entropy::RangeDecoder;
 use crate::halfedge::{face, next, prev, NONE};
 use crate::patch::{pattern, Pattern, Tag, MAX_VALENCE, NO_TWIN};
 use crate::predict::{
-    decode_colour, gate_context, predict_colour, umbrella, PassModels, PatchPrediction,
+    decode_colour, gate_context, predict_colour, umbrellas, PassModels, PatchPrediction,
 };
 use crate::{Error, Result};
 
@@ -31,6 +31,7 @@ pub(crate) struct Scratch {
     /// Patches found by the traversal, inserted once geometry is decoded.
     pending: Vec<Region>,
     decoded: Vec<([i32; 3], Option<[u8; 3]>)>,
+    umbrellas: Vec<[i32; 4]>,
 }
 
 pub(crate) struct PassInput<'a> {
@@ -104,8 +105,9 @@ impl Level {
         }
         let mut decoded = std::mem::take(&mut scratch.decoded);
         decoded.clear();
+        umbrellas(&self.conn, &self.positions_q, &mut scratch.umbrellas);
         for r in &scratch.pending {
-            decoded.push(self.decode_vertex(r, &mut s)?);
+            decoded.push(self.decode_vertex(r, &scratch.umbrellas, &mut s)?);
         }
         for (r, &(position, colour)) in scratch.pending.iter().zip(&decoded) {
             self.insert_vertex(r, position, colour);
@@ -258,13 +260,18 @@ impl Level {
 
     /// Phase 2: the removed vertex's position and colour, predicted from the
     /// coarse mesh (nothing inserted yet, exactly what the encoder saw).
-    fn decode_vertex(&self, r: &Region, s: &mut Streams) -> Result<([i32; 3], Option<[u8; 3]>)> {
+    fn decode_vertex(
+        &self,
+        r: &Region,
+        umbrella_of: &[[i32; 4]],
+        s: &mut Streams,
+    ) -> Result<([i32; 3], Option<[u8; 3]>)> {
         let d = r.valence;
         let mut polygon = [[0i32; 3]; MAX_VALENCE];
-        let mut umbrellas = [([0i64; 3], 0i64); MAX_VALENCE];
+        let mut umbrellas = [[0i32; 4]; MAX_VALENCE];
         for i in 0..d {
             polygon[i] = self.positions_q[r.polygon[i] as usize];
-            umbrellas[i] = umbrella(&self.conn, &self.positions_q, r.polygon[i]);
+            umbrellas[i] = umbrella_of[r.polygon[i] as usize];
         }
         let position = PatchPrediction::with_curvature(&polygon[..d], &umbrellas[..d])
             .decode(self.quantization.max_value(), &mut s.models, &mut s.geom)

@@ -173,7 +173,14 @@ impl Decoder {
                 "passes insert a different number of vertices than the batch",
             ));
         }
-        let grow = added as usize;
+        // Each inserted vertex adds exactly two faces (AD01 patches are discs).
+        if info.faces as u64 != self.face_count() as u64 + 2 * added {
+            return Err(Error::stream(
+                "level table's face count disagrees with the batch",
+            ));
+        }
+        // Reserve no more than the payload could possibly describe (a bit per vertex).
+        let grow = (added as usize).min(payload.len().saturating_mul(8));
         self.level.positions_q.reserve(grow);
         self.level.positions.reserve(grow);
         self.level.conn.origin.reserve(6 * grow);

@@ -7,7 +7,7 @@ use crate::entropy::RangeEncoder;
 use crate::halfedge::{face, next, prev, Connectivity, NONE};
 use crate::patch::{pattern, Pattern, Tag, MAX_VALENCE, NO_TWIN};
 use crate::predict::{
-    encode_colour, gate_context, predict_colour, umbrella, PassModels, PatchPrediction,
+    encode_colour, gate_context, predict_colour, umbrellas, PassModels, PatchPrediction,
 };
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -59,6 +59,7 @@ pub(crate) struct Simplifier {
     state: Vec<u8>,
     tag: Vec<Tag>,
     face_done: Vec<bool>,
+    umbrellas: Vec<[i32; 4]>,
 }
 
 /// A removable vertex and the patch around it.
@@ -100,6 +101,7 @@ impl Simplifier {
             state: vec![FREE; n],
             tag: vec![Tag::None; n],
             face_done: Vec::new(),
+            umbrellas: Vec::new(),
         }
     }
 
@@ -147,9 +149,14 @@ impl Simplifier {
         // Geometry after connectivity: predictions may use the whole coarse
         // mesh, which is what the decoder has before it inserts anything.
         let patches = std::mem::take(&mut streams.patches);
-        for (centre, valence, polygon) in patches {
-            self.encode_vertex(centre, &polygon[..valence], &mut streams);
+        let mut umbrella_of = std::mem::take(&mut self.umbrellas);
+        if !patches.is_empty() {
+            umbrellas(&self.conn, &self.positions, &mut umbrella_of);
         }
+        for (centre, valence, polygon) in patches {
+            self.encode_vertex(centre, &polygon[..valence], &umbrella_of, &mut streams);
+        }
+        self.umbrellas = umbrella_of;
         for v in out.removed.iter_mut().chain(out.seeds.iter_mut().flatten()) {
             *v = self.ids[*v as usize];
         }
@@ -406,13 +413,19 @@ impl Simplifier {
             })
     }
 
-    fn encode_vertex(&self, centre: u32, border: &[u32], s: &mut Streams) {
+    fn encode_vertex(
+        &self,
+        centre: u32,
+        border: &[u32],
+        umbrella_of: &[[i32; 4]],
+        s: &mut Streams,
+    ) {
         let d = border.len();
         let mut polygon = [[0i32; 3]; MAX_VALENCE];
-        let mut umbrellas = [([0i64; 3], 0i64); MAX_VALENCE];
+        let mut umbrellas = [[0i32; 4]; MAX_VALENCE];
         for i in 0..d {
             polygon[i] = self.positions[border[i] as usize];
-            umbrellas[i] = umbrella(&self.conn, &self.positions, border[i]);
+            umbrellas[i] = umbrella_of[border[i] as usize];
         }
         PatchPrediction::with_curvature(&polygon[..d], &umbrellas[..d]).encode(
             self.positions[centre as usize],

@@ -276,7 +276,9 @@ fn markdown(
         if draco.is_some() {
             match peer {
                 // Draco codes positions only: compare without our colour bits.
-                Some((bpv, _)) => s += &format!(" {bpv:.2} | {:.3} |", (r.total_bpv - r.colour_bpv) / bpv),
+                Some((bpv, _)) => {
+                    s += &format!(" {bpv:.2} | {:.3} |", (r.total_bpv - r.colour_bpv) / bpv)
+                }
                 None => s += " – | – |",
             }
         }
