@@ -1,3 +1,4 @@
+// @ts-check
 // Node tests of the WebAssembly decoder against streams written by the Rust
 // encoder: every level's buffers must equal the native decoder's, byte for byte.
 import { test } from 'node:test';
@@ -17,7 +18,11 @@ async function codec() {
   return VitrineCodec.instantiate(readFileSync(wasmPath));
 }
 
-/** Encodes a generated sample with the Rust CLI and dumps native levels. */
+/**
+ * Encodes a generated sample with the Rust CLI and dumps native levels.
+ * @param {string} kind
+ * @param {string[]} [extra]
+ */
 function fixture(kind, extra = []) {
   const dir = mkdtempSync(join(tmpdir(), `vitrine-${kind}-`));
   const mesh = join(dir, 'mesh.ply');
@@ -28,11 +33,12 @@ function fixture(kind, extra = []) {
   return { dir, stream: new Uint8Array(readFileSync(stream)) };
 }
 
+/** @param {ArrayBufferView} view */
 function bytesOf(view) {
   return Buffer.from(view.buffer, view.byteOffset, view.byteLength);
 }
 
-for (const [kind, extra] of [['torus', ['--colour', '--noise', '0.003']], ['plate', []], ['sphere', ['--noise', '0.002']]]) {
+for (const [kind, extra] of /** @type {Array<[string, string[]]>} */ ([['torus', ['--colour', '--noise', '0.003']], ['plate', []], ['sphere', ['--noise', '0.002']]])) {
   test(`wasm decodes ${kind} exactly like the native decoder`, async () => {
     assert.ok(existsSync(wasmPath), `build the wasm first: ${wasmPath}`);
     const { dir, stream } = fixture(kind, extra);
@@ -44,11 +50,11 @@ for (const [kind, extra] of [['torus', ['--colour', '--noise', '0.003']], ['plat
       if (k > 0) decoder.apply(batches[k - 1]);
       const level = decoder.level();
       assert.equal(level.level, k);
-      const native = (what) => readFileSync(join(dir, 'native', `level-${k}.${what}`));
+      const native = (/** @type {string} */ what) => readFileSync(join(dir, 'native', `level-${k}.${what}`));
       assert.ok(bytesOf(level.positions).equals(native('positions')), `positions at level ${k}`);
       assert.ok(bytesOf(level.indices).equals(native('indices')), `indices at level ${k}`);
       if (extra.includes('--colour')) {
-        assert.ok(bytesOf(level.colours).equals(native('colours')), `colours at level ${k}`);
+        assert.ok(level.colours && bytesOf(level.colours).equals(native('colours')), `colours at level ${k}`);
       } else {
         assert.equal(level.colours, null);
       }

@@ -1,0 +1,189 @@
+// @ts-check
+// Viewer benchmarks in headless Chromium with WebGL2 on SwiftShader (a CPU
+// renderer: frame times are not a GPU's), against the real `vitrine serve`
+// with a ~1 M-vertex coloured torus:
+// - time to first frame (base mesh drawn), from navigation start, on loopback
+//   and with DevTools network emulation at 10 Mbit/s;
+// - time to the last level, and time spent in the WASM decoder (all levels)
+//   and in normals / edges, both inside the worker;
+// - longest main-thread task of the page's renderer, from a DevTools trace
+//   (RunTask events), during reconstruction (from the base mesh on screen to
+//   the last level on screen) and over the whole load (start-up included),
+//   and PerformanceObserver 'longtask' entries.
+// Two browser set-ups: the test flags (`--disable-gpu`: the compositor works
+// in software and reads every WebGL frame back on the main thread, waiting
+// for SwiftShader to finish drawing it), and the same without `--disable-gpu`
+// (compositing on SwiftShader too: frames reach the screen as textures, as
+// with any real GPU).
+//   node bench/viewer-bench.mjs [--kilo-vertices 1000] [--runs 3]
+import { loadavg } from 'node:os';
+import { parseArgs } from 'node:util';
+import { launch } from '../test/support/browser.mjs';
+import { startService } from '../test/support/service.mjs';
+
+const { values } = parseArgs({
+  options: { 'kilo-vertices': { type: 'string', default: '1000' }, runs: { type: 'string', default: '3' } },
+});
+const kilo = Number(values['kilo-vertices']);
+const runs = Number(values.runs);
+const MBIT = 1_000_000 / 8;
+
+const t0 = performance.now();
+const service = await startService({
+  models: [{ slug: 'torus', title: 'Torus', kind: 'torus', kiloVertices: kilo, colour: true, policy: 'open' }],
+});
+console.error(`ingested the ${kilo}k-vertex torus in ${((performance.now() - t0) / 1000).toFixed(1)} s`);
+const manifest = await (await fetch(`${service.url}/api/models/torus`)).json();
+const totalBytes = manifest.levels.reduce((/** @type {number} */ s, /** @type {any} */ l) => s + l.bytes, 0);
+/** @type {Awaited<ReturnType<typeof launch>> | undefined} */
+let browser;
+/**
+ * One cold load (no HTTP cache) of a page, traced.
+ * @param {string} path
+ * @param {number | null} mbits emulated bandwidth, null for loopback
+ */
+async function load(path, mbits) {
+  const { context } = /** @type {NonNullable<typeof browser>} */ (browser);
+  const page = await context.newPage();
+  const cdp = await context.newCDPSession(page);
+  await cdp.send('Network.enable');
+  await cdp.send('Network.setCacheDisabled', { cacheDisabled: true });
+  if (mbits) {
+    await cdp.send('Network.emulateNetworkConditions', {
+      offline: false,
+      latency: 20,
+      downloadThroughput: mbits * MBIT,
+      uploadThroughput: mbits * MBIT,
+    });
+  }
+  // The page says when it is done through the console, so no DevTools
+  // evaluation (which runs on the main thread) falls inside the trace.
+  await page.addInitScript(() => {
+    const w = /** @type {any} */ (window);
+    w.__longtasks = [];
+    new PerformanceObserver((list) => w.__longtasks.push(...list.getEntries().map((e) => e.duration))).observe({
+      type: 'longtask',
+      buffered: true,
+    });
+    document.addEventListener('vitrine-level', () => {
+      const status = /** @type {any} */ (document.querySelector('vitrine-viewer'))?.viewer?.state.status;
+      if (status === 'complete' || status === 'capped') console.debug('vitrine:settled');
+    });
+  });
+  /** @type {any[]} */
+  const events = [];
+  cdp.on('Tracing.dataCollected', (e) => events.push(...e.value));
+  const traced = new Promise((resolve) => cdp.once('Tracing.tracingComplete', resolve));
+  await cdp.send('Tracing.start', {
+    categories: 'devtools.timeline,disabled-by-default-devtools.timeline,toplevel,blink.user_timing',
+    transferMode: 'ReportEvents',
+  });
+  const settled = page.waitForEvent('console', { predicate: (m) => m.text() === 'vitrine:settled', timeout: 600_000 });
+  await page.goto(`${service.url}${path}`, { waitUntil: 'commit' });
+  await settled;
+  const state = await page.evaluate(() => /** @type {any} */ (document.querySelector('vitrine-viewer')).viewer.state);
+  const longtasks = await page.evaluate(() => /** @type {any} */ (window).__longtasks);
+  await cdp.send('Tracing.end');
+  await traced;
+  await page.close();
+  if (state.status !== 'complete') throw new Error(`viewer ended as ${state.status}: ${state.message}`);
+  return { state, longtasks, ...longestTasks(events, manifest.last_level) };
+}
+
+/**
+ * Longest top-level tasks on the main thread of the page's renderer (not
+ * Chromium's own pages), in ms: over the whole trace, and between the marks
+ * the first `vitrine:level-k` mark and `vitrine:level-{last}` (the viewer
+ * marks each level when it is first drawn).
+ * @param {any[]} events
+ * @param {number} last
+ */
+function longestTasks(events, last) {
+  const committed = events.find((e) => e.args?.data?.processId && String(e.args.data.url).startsWith(service.url));
+  const pid = committed?.args.data.processId;
+  const tid = events.find((e) => e.pid === pid && e.name === 'thread_name' && e.args?.name === 'CrRendererMain')?.tid;
+  const marks = events.filter((e) => e.pid === pid && String(e.name).startsWith('vitrine:level-'));
+  const from = Math.min(...marks.map((e) => e.ts));
+  const to = marks.find((e) => e.name === `vitrine:level-${last}`)?.ts;
+  if (pid === undefined || tid === undefined || to === undefined) throw new Error('the trace lacks the page or its marks');
+  let all = 0;
+  let during = 0;
+  let script = 0;
+  for (const e of events) {
+    if (e.ph !== 'X' || e.pid !== pid || e.tid !== tid) continue;
+    const inWindow = e.ts + e.dur >= from && e.ts <= to;
+    // The viewer's own code: script run from a task (frame callback, worker
+    // message, resize observer), GL calls and their waits included.
+    if (e.name === 'FunctionCall' && inWindow) script = Math.max(script, e.dur / 1000);
+    if (e.name !== 'RunTask' && e.name !== 'ThreadControllerImpl::RunTask') continue;
+    all = Math.max(all, e.dur / 1000);
+    if (inWindow) during = Math.max(during, e.dur / 1000);
+  }
+  return { longestMs: all, longestDuringMs: during, longestScriptMs: script };
+}
+
+/** @param {number[]} xs */
+const median = (xs) => [...xs].sort((a, b) => a - b)[Math.floor(xs.length / 2)];
+/** @param {number} ms */
+const s = (ms) => `${(ms / 1000).toFixed(2)} s`;
+
+/** @type {Array<[string, string, number | null, boolean]>} */
+const scenarios = [
+  ['progressive, loopback', '/embed/torus', null, false],
+  ['progressive, 10 Mbit/s', '/embed/torus', 10, false],
+  [`direct to level ${manifest.last_level}, loopback`, `/embed/torus?level=${manifest.last_level}`, null, false],
+  ['progressive, loopback, GPU compositing', '/embed/torus', null, true],
+  ['progressive, 10 Mbit/s, GPU compositing', '/embed/torus', 10, true],
+];
+console.log(`Model: torus, ${manifest.levels.at(-1).vertices.toLocaleString('en')} vertices, ${manifest.levels.length} levels, ` +
+  `base ${manifest.levels[0].vertices.toLocaleString('en')} vertices / ${manifest.levels[0].bytes.toLocaleString('en')} bytes, ` +
+  `all payloads ${totalBytes.toLocaleString('en')} bytes. Median of ${runs} cold loads each (longest tasks: worst run).\n`);
+console.log('| scenario | first frame | last level shown | WASM decode, all levels | normals + edges | longest main-thread task during reconstruction | of which the viewer\'s script | longest over the whole load | long tasks > 50 ms |');
+console.log('|---|---|---|---|---|---|---|---|---|');
+let version = '';
+/** Every scenario, one browser per compositing mode. */
+async function measure() {
+  for (const gpu of [false, true]) {
+    browser = await launch({ width: 1024, height: 768, gpuCompositing: gpu });
+    version = (await browser.context.browser()?.version()) ?? version;
+    for (const [name, path, mbits, compositing] of scenarios) {
+      if (compositing === gpu) await scenario(name, path, mbits);
+    }
+    await browser.close();
+  }
+}
+
+/**
+ * @param {string} name
+ * @param {string} path
+ * @param {number | null} mbits
+ */
+async function scenario(name, path, mbits) {
+  /** @type {any[]} */
+  const results = [];
+  for (let i = 0; i < runs; i++) results.push(await load(path, mbits));
+  const pick = (/** @type {(r: any) => number} */ f) => median(results.map(f));
+  const worst = (/** @type {(r: any) => number} */ f) => Math.max(...results.map(f));
+  const last = manifest.last_level;
+  console.log(
+    `| ${name} | ${s(pick((r) => r.state.firstFrameMs))} | ${s(pick((r) => r.state.shownAtMs[last]))} | ` +
+      `${s(pick((r) => r.state.decodeMs))} | ${s(pick((r) => r.state.deriveMs))} | ` +
+      `${worst((r) => r.longestDuringMs).toFixed(0)} ms | ${worst((r) => r.longestScriptMs).toFixed(0)} ms | ` +
+      `${worst((r) => r.longestMs).toFixed(0)} ms | ${worst((r) => r.longtasks.length)} |`,
+  );
+  for (const r of results) {
+    const { longestMs, longestDuringMs, longestScriptMs, longtasks } = r;
+    console.error(name, JSON.stringify({ ...r.state, longestMs, longestDuringMs, longestScriptMs, longtasks }));
+  }
+}
+
+try {
+  await measure();
+} finally {
+  await browser?.close().catch(() => {});
+  await service.stop();
+}
+console.log(
+  `\nChromium ${version} headless, WebGL2 on SwiftShader (--use-angle=swiftshader), 1024×768, ` +
+    `${process.platform} ${process.arch}, load average ${loadavg().map((l) => l.toFixed(1)).join(' ')}.`,
+);

@@ -1,0 +1,34 @@
+// Builds web/dist from web/src and the WebAssembly decoder:
+//   node build.mjs            (expects the wasm to be built, see README)
+//   VITRINE_WASM=path node build.mjs
+// esbuild bundles three entries: app.js (the pages), vitrine.js (the
+// <vitrine-viewer> element for other sites) and worker.js (a classic worker,
+// so another origin can start it from a blob URL).
+import { build } from 'esbuild';
+import { copyFileSync, existsSync, mkdirSync, rmSync, statSync } from 'node:fs';
+import { dirname, join } from 'node:path';
+import { fileURLToPath } from 'node:url';
+
+const web = dirname(fileURLToPath(import.meta.url));
+const src = join(web, 'src');
+const dist = join(web, 'dist');
+const wasm =
+  process.env.VITRINE_WASM ?? join(web, '..', 'target', 'wasm32-unknown-unknown', 'wasm', 'vitrine_wasm.wasm');
+
+if (!existsSync(wasm)) {
+  console.error(`missing ${wasm}: run cargo build -p vitrine-wasm --target wasm32-unknown-unknown --profile wasm`);
+  process.exit(1);
+}
+rmSync(dist, { recursive: true, force: true });
+mkdirSync(dist, { recursive: true });
+
+/** @type {import('esbuild').BuildOptions} */
+const common = { bundle: true, minify: true, sourcemap: true, target: ['chrome111', 'firefox113', 'safari16.4'], logLevel: 'warning' };
+await build({ ...common, entryPoints: { app: join(src, 'app.js'), vitrine: join(src, 'element.js') }, format: 'esm', outdir: dist });
+await build({ ...common, entryPoints: { worker: join(src, 'worker.js') }, format: 'iife', outdir: dist });
+for (const file of ['index.html', 'style.css']) copyFileSync(join(src, file), join(dist, file));
+copyFileSync(wasm, join(dist, 'vitrine_wasm.wasm'));
+
+for (const file of ['app.js', 'vitrine.js', 'worker.js', 'vitrine_wasm.wasm']) {
+  console.log(`dist/${file.padEnd(18)} ${(statSync(join(dist, file)).size / 1024).toFixed(1)} KB`);
+}

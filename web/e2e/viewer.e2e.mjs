@@ -1,0 +1,458 @@
+// @ts-check
+// End-to-end: the real `vitrine serve` with a generated, ingested model, and
+// the built viewer in headless Chromium (WebGL2 on SwiftShader).
+import { after, before, test } from 'node:test';
+import assert from 'node:assert/strict';
+import { readFileSync } from 'node:fs';
+import { createServer } from 'node:http';
+import { launch } from '../test/support/browser.mjs';
+import { startService } from '../test/support/service.mjs';
+import { wasmPath } from '../test/support/fixtures.mjs';
+import { compareImages, foreground, rasterize } from '../test/support/raster.mjs';
+import { VitrineCodec } from '../src/codec.js';
+import { OrbitCamera } from '../src/camera.js';
+import { vertexNormals } from '../src/geometry.js';
+
+/** @typedef {import('playwright-core').Page} Page */
+/** @typedef {import('../src/viewer.js').ViewerState} ViewerState */
+
+const WIDTH = 640;
+const HEIGHT = 480;
+/** Phone budget for the capped case: a few levels of the 30 k-vertex torus. */
+const PHONE_MAX_VERTICES = 3000;
+
+/** @type {Awaited<ReturnType<typeof startService>>} */
+let service;
+/** @type {Awaited<ReturnType<typeof launch>>} */
+let browser;
+/** @type {any} */
+let manifest;
+
+before(async () => {
+  service = await startService({
+    models: [
+      {
+        slug: 'torus',
+        title: 'Torus',
+        description: 'A generated torus with a painted pattern.',
+        kind: 'torus',
+        kiloVertices: 30,
+        colour: true,
+        policy: 'open',
+      },
+    ],
+    serveArgs: ['--phone-max-vertices', String(PHONE_MAX_VERTICES)],
+  });
+  browser = await launch({ width: WIDTH, height: HEIGHT, hasTouch: true });
+  manifest = await (await fetch(`${service.url}/api/models/torus`)).json();
+  assert.ok(manifest.last_level >= 4, 'the test model has several levels');
+});
+
+after(async () => {
+  await browser?.close();
+  await service?.stop();
+});
+
+/** @param {string} path */
+async function open(path) {
+  const page = await browser.context.newPage();
+  /** @type {string[]} */
+  const problems = [];
+  page.on('pageerror', (e) => problems.push(e.message));
+  await page.goto(`${service.url}${path}`);
+  return { page, problems };
+}
+
+/**
+ * @param {Page} page
+ * @param {string} condition JS expression over `s` (the viewer's state)
+ * @param {number} [timeout]
+ */
+async function until(page, condition, timeout = 30_000) {
+  await page.waitForFunction(
+    (body) => {
+      const s = /** @type {any} */ (document.querySelector('vitrine-viewer'))?.viewer?.state;
+      return s ? new Function('s', `return (${body});`)(s) : false;
+    },
+    condition,
+    { timeout, polling: 50 },
+  );
+  return state(page);
+}
+
+/** @param {Page} page @returns {Promise<ViewerState>} */
+function state(page) {
+  return page.evaluate(() => /** @type {any} */ (document.querySelector('vitrine-viewer')).viewer.state);
+}
+
+/**
+ * The canvas's pixels (RGBA, bottom-up), drawn and read in one task.
+ * @param {Page} page
+ */
+async function capture(page) {
+  const { width, height, data } = await page.evaluate(() => {
+    const { width, height, rgba } = /** @type {any} */ (document.querySelector('vitrine-viewer')).viewer.renderer.capture();
+    let binary = '';
+    for (let i = 0; i < rgba.length; i += 0x8000) binary += String.fromCharCode(...rgba.subarray(i, i + 0x8000));
+    return { width, height, data: btoa(binary) };
+  });
+  return { width, height, rgba: new Uint8Array(Buffer.from(data, 'base64')) };
+}
+
+/** @param {Page} page */
+function camera(page) {
+  return page.evaluate(() => {
+    const c = /** @type {any} */ (document.querySelector('vitrine-viewer')).viewer.camera;
+    return { state: structuredClone(c.state), radius: c.radius };
+  });
+}
+
+/** @param {Page} page @param {string} selector */
+function shadowText(page, selector) {
+  return page.evaluate(
+    (s) => /** @type {HTMLElement} */ (document.querySelector('vitrine-viewer')?.shadowRoot?.querySelector(s)).innerText,
+    selector,
+  );
+}
+
+/** @param {Page} page @param {string} selector */
+function shadowHidden(page, selector) {
+  return page.evaluate(
+    (s) => /** @type {HTMLElement} */ (document.querySelector('vitrine-viewer')?.shadowRoot?.querySelector(s)).hidden,
+    selector,
+  );
+}
+
+/**
+ * Fraction of foreground pixels inside a box given in fractions of the image.
+ * @param {{ width: number, height: number, rgba: Uint8Array }} image
+ * @param {[number, number, number, number]} box x0, y0, x1, y1 in 0..1
+ */
+function coverage(image, box) {
+  const mask = foreground(image.rgba);
+  let hit = 0;
+  let all = 0;
+  for (let y = Math.floor(box[1] * image.height); y < box[3] * image.height; y++) {
+    for (let x = Math.floor(box[0] * image.width); x < box[2] * image.width; x++) {
+      all++;
+      hit += mask[y * image.width + x];
+    }
+  }
+  return hit / all;
+}
+
+/** The last level, decoded in Node from what the service serves. */
+async function finalLevelFromService() {
+  const codec = await VitrineCodec.instantiate(readFileSync(wasmPath));
+  const bytes = async (/** @type {string} */ url) =>
+    new Uint8Array(await (await fetch(`${service.url}${url}`)).arrayBuffer());
+  const decoder = codec.decoder(await bytes(manifest.levels[0].url));
+  const base = decoder.level();
+  for (const level of manifest.levels.slice(1)) decoder.apply(await bytes(level.url));
+  const last = decoder.level();
+  decoder.free();
+  return { base, last };
+}
+
+test('the gallery lists the model with a link to its page', async () => {
+  const { page, problems } = await open('/');
+  const link = page.locator('a[href="/m/torus"]');
+  await link.waitFor();
+  assert.match(await link.innerText(), /Torus/);
+  assert.deepEqual(problems, []);
+  await page.close();
+});
+
+test('the base mesh is drawn at once, before any batch arrives', async () => {
+  const page = await browser.context.newPage();
+  /** @type {Array<() => void>} */
+  const held = [];
+  await page.route('**/batches/**', (route) => held.push(() => void route.continue()));
+  await page.goto(`${service.url}/embed/torus`);
+  const s = await until(page, 's.shownLevel === 0 && 0 in s.shownAtMs');
+  assert.equal(s.decodedLevel, 0);
+  const image = await capture(page);
+  assert.equal(image.width, WIDTH);
+  // The model sits in the middle with a margin all round.
+  assert.ok(coverage(image, [0.3, 0.3, 0.7, 0.7]) > 0.2, 'model pixels in the middle');
+  assert.equal(coverage(image, [0, 0, 1, 0.04]), 0, 'empty top rows');
+  assert.equal(coverage(image, [0, 0.96, 1, 1]), 0, 'empty bottom rows');
+  assert.match(await shadowText(page, '.progress'), new RegExp(`^Level 0 of ${manifest.last_level} · ${manifest.levels[0].vertices} vertices`));
+  for (const release of held) release();
+  await page.unroute('**/batches/**');
+  await until(page, `s.status === 'complete'`);
+  await page.close();
+});
+
+test('refines to level n of n; the image matches a direct load and a CPU reference', async (t) => {
+  const { page, problems } = await open('/embed/torus');
+  /** @type {string[]} */
+  const batches = [];
+  page.on('request', (r) => r.url().includes('/batches/') && batches.push(r.url()));
+  const n = manifest.last_level;
+  const s = await until(page, `s.status === 'complete'`);
+  assert.equal(s.shownLevel, n);
+  assert.equal(s.vertices, manifest.levels[n].vertices);
+  assert.match(await shadowText(page, '.progress'), new RegExp(`^Level ${n} of ${n} · `));
+  const progressive = await capture(page);
+  const view = await camera(page);
+
+  const direct = await open(`/embed/torus?level=${n}`);
+  await until(direct.page, `s.status === 'complete'`);
+  const once = await capture(direct.page);
+  const same = compareImages(progressive.rgba, once.rgba);
+  assert.ok(same.iou > 0.999 && same.meanDiff < 0.5, `progressive vs direct: ${JSON.stringify(same)}`);
+
+  const { base, last } = await finalLevelFromService();
+  const reference = new OrbitCamera({ min: [0, 0, 0], max: [1, 1, 1] });
+  reference.radius = view.radius;
+  reference.state = view.state;
+  const cpu = rasterize({
+    positions: last.positions,
+    normals: vertexNormals(last.positions, last.indices),
+    colours: last.colours,
+    indices: last.indices,
+    view: reference.view(),
+    projection: reference.projection(WIDTH / HEIGHT),
+    width: WIDTH,
+    height: HEIGHT,
+  });
+  const score = compareImages(progressive.rgba, cpu);
+  t.diagnostic(`progressive vs direct ${JSON.stringify(same)}; vs CPU reference ${JSON.stringify(score)}`);
+  assert.ok(score.iou > 0.98, `silhouette vs CPU reference: ${JSON.stringify(score)}`);
+  assert.ok(score.meanDiff < 2 && score.badFraction < 0.01, `shading vs CPU reference: ${JSON.stringify(score)}`);
+  assert.ok(base.vertices < last.vertices);
+  assert.deepEqual(problems, []);
+  await page.close();
+  await direct.page.close();
+});
+
+test('a phone stops at its cap, says so, and fetches nothing above it', async () => {
+  const capped = await (await fetch(`${service.url}/api/models/torus?device=phone`)).json();
+  const cap = capped.cap.level;
+  assert.ok(cap > 0 && cap < manifest.last_level, `cap ${cap}`);
+  const page = await browser.context.newPage();
+  /** @type {number[]} */
+  const requested = [];
+  page.on('request', (r) => {
+    const m = r.url().match(/\/batches\/(\d+)/);
+    if (m) requested.push(Number(m[1]));
+  });
+  await page.goto(`${service.url}/m/torus?device=phone`);
+  const s = await until(page, `s.status === 'capped'`);
+  assert.equal(s.shownLevel, cap);
+  const notice = await shadowText(page, '.notice');
+  assert.equal(notice, `Refinement limited to level ${cap} of ${manifest.last_level}: that is the most detail sent to a phone.`);
+  assert.equal(await shadowHidden(page, '.notice'), false);
+  await page.waitForTimeout(300);
+  assert.ok(Math.max(...requested) <= cap, `requested ${requested}`);
+  await page.close();
+});
+
+test('a load cap is retried and refinement resumes when it rises', async () => {
+  const page = await browser.context.newPage();
+  let manifests = 0;
+  await page.route('**/api/models/torus*', async (route) => {
+    manifests++;
+    const response = await route.fetch();
+    const body = await response.json();
+    if (manifests === 1) {
+      body.cap = { ...body.cap, level: 2, reason: 'load', retry_after_s: 1 };
+    }
+    await route.fulfill({ response, json: body });
+  });
+  await page.goto(`${service.url}/m/torus`);
+  const capped = await until(page, `s.status === 'capped'`);
+  assert.equal(capped.shownLevel, 2);
+  assert.match(await shadowText(page, '.notice'), /^Refinement limited to level 2 of \d+: the server is busy; trying again every 1 s\.$/);
+  const done = await until(page, `s.status === 'complete'`, 15_000);
+  assert.equal(done.shownLevel, manifest.last_level);
+  assert.equal(await shadowHidden(page, '.notice'), true);
+  assert.ok(manifests >= 2);
+  await page.close();
+});
+
+test('touch: one finger turns, a pinch zooms, two fingers pan', async () => {
+  const { page } = await open('/embed/torus');
+  await until(page, `s.status === 'complete'`);
+  const cdp = await browser.context.newCDPSession(page);
+  /**
+   * @param {'touchStart' | 'touchMove' | 'touchEnd'} type
+   * @param {Array<[number, number]>} points
+   */
+  const touch = (type, points) =>
+    cdp.send('Input.dispatchTouchEvent', {
+      type,
+      touchPoints: points.map(([x, y], id) => ({ x, y, id, radiusX: 5, radiusY: 5, force: 1 })),
+    });
+  /** @param {Array<[number, number]>} from @param {Array<[number, number]>} to */
+  const gesture = async (from, to) => {
+    await touch('touchStart', from);
+    for (let step = 1; step <= 8; step++) {
+      const t = step / 8;
+      await touch('touchMove', from.map(([x, y], i) => [x + (to[i][0] - x) * t, y + (to[i][1] - y) * t]));
+    }
+    await touch('touchEnd', []);
+  };
+  const before = await camera(page);
+  const image = await capture(page);
+  await gesture([[320, 240]], [[420, 260]]);
+  const turned = await camera(page);
+  assert.ok(Math.abs(turned.state.yaw - before.state.yaw) > 0.3, `yaw ${before.state.yaw} → ${turned.state.yaw}`);
+  assert.ok(Math.abs(turned.state.pitch - before.state.pitch) > 0.05, 'pitch');
+  assert.equal(turned.state.distance, before.state.distance);
+  const after = await capture(page);
+  assert.ok(compareImages(image.rgba, after.rgba).meanDiff > 3, 'the picture changed');
+
+  await gesture([[270, 240], [370, 240]], [[170, 240], [470, 240]]);
+  const zoomed = await camera(page);
+  assert.ok(zoomed.state.distance < 0.5 * turned.state.distance, `distance ${turned.state.distance} → ${zoomed.state.distance}`);
+  assert.equal(zoomed.state.yaw, turned.state.yaw);
+
+  await gesture([[270, 200], [370, 200]], [[270, 300], [370, 300]]);
+  const panned = await camera(page);
+  const moved = Math.hypot(...panned.state.target.map((/** @type {number} */ v, /** @type {number} */ k) => v - zoomed.state.target[k]));
+  assert.ok(moved > 0.05 * panned.radius, `target moved ${moved}`);
+  assert.ok(Math.abs(panned.state.distance - zoomed.state.distance) < 0.01 * zoomed.state.distance);
+  await page.close();
+});
+
+test('a damaged batch becomes a visible message, and retry recovers', async () => {
+  const page = await browser.context.newPage();
+  await page.route('**/batches/3*', async (route) => {
+    const response = await route.fetch();
+    const body = await response.body();
+    for (let i = 16; i < body.length; i += 3) body[i] ^= 0x5a;
+    await route.fulfill({ response, body });
+  });
+  await page.goto(`${service.url}/m/torus`);
+  const s = await until(page, `s.status === 'error'`);
+  assert.equal(s.shownLevel, 2);
+  assert.equal(await shadowHidden(page, '.error'), false);
+  assert.match(await shadowText(page, '.error p'), /^Could not show this model: could not decode level 3: the stream is damaged/);
+  const image = await capture(page);
+  assert.ok(coverage(image, [0.3, 0.3, 0.7, 0.7]) > 0.2, 'level 2 is still on screen');
+  await page.unroute('**/batches/3*');
+  await page.evaluate(() =>
+    /** @type {HTMLElement} */ (document.querySelector('vitrine-viewer')?.shadowRoot?.querySelector('[data-action="retry"]')).click(),
+  );
+  await until(page, `s.status === 'complete'`);
+  assert.equal(await shadowHidden(page, '.error'), true);
+  await page.close();
+});
+
+test('a failed download becomes a visible message', async () => {
+  const page = await browser.context.newPage();
+  await page.route('**/batches/2*', (route) => route.abort('connectionreset'));
+  await page.goto(`${service.url}/m/torus`);
+  const s = await until(page, `s.status === 'error'`);
+  assert.equal(s.shownLevel, 1);
+  assert.match(await shadowText(page, '.error p'), /^Could not show this model: a download failed: could not fetch the batch 2/);
+  await page.close();
+});
+
+test('a browser without WebGL2 gets a message, not a blank box', async () => {
+  const page = await browser.context.newPage();
+  await page.addInitScript(() => {
+    const original = HTMLCanvasElement.prototype.getContext;
+    /** @type {any} */ (HTMLCanvasElement.prototype).getContext = function (/** @type {string} */ type, /** @type {any} */ options) {
+      return type === 'webgl2' ? null : original.call(this, type, options);
+    };
+  });
+  await page.goto(`${service.url}/m/torus`);
+  await until(page, `s.status === 'error'`);
+  assert.match(await shadowText(page, '.error p'), /no WebGL2/);
+  await page.close();
+});
+
+test('a lost WebGL context is restored with the model', async () => {
+  const { page } = await open('/embed/torus');
+  await until(page, `s.status === 'complete'`);
+  const before = await capture(page);
+  await page.evaluate(() => {
+    const canvas = /** @type {HTMLCanvasElement} */ (document.querySelector('vitrine-viewer')?.shadowRoot?.querySelector('canvas'));
+    const ext = /** @type {any} */ (canvas.getContext('webgl2'))?.getExtension('WEBGL_lose_context');
+    /** @type {any} */ (window).loseContext = ext;
+    ext.loseContext();
+  });
+  await page.waitForFunction(() => /** @type {any} */ (document.querySelector('vitrine-viewer')).viewer.renderer.lost);
+  await page.evaluate(() => /** @type {any} */ (window).loseContext.restoreContext());
+  await page.waitForFunction(() => {
+    const r = /** @type {any} */ (document.querySelector('vitrine-viewer')).viewer.renderer;
+    return !r.lost && r.current && r.current.uploads.length === 0 && !r.pending;
+  });
+  const restored = await capture(page);
+  const score = compareImages(before.rgba, restored.rgba);
+  assert.ok(score.iou > 0.999 && score.meanDiff < 0.5, JSON.stringify(score));
+  await page.close();
+});
+
+test('keyboard: W toggles the wireframe, arrows turn, R resets', async () => {
+  const { page } = await open('/m/torus');
+  await until(page, `s.status === 'complete'`);
+  const canvas = page.locator('vitrine-viewer canvas');
+  await canvas.focus();
+  const shaded = await capture(page);
+  await page.keyboard.press('w');
+  await page.waitForFunction(() => {
+    const r = /** @type {any} */ (document.querySelector('vitrine-viewer')).viewer.renderer;
+    return r.current?.edgeBuffer && r.current.uploads.length === 0;
+  });
+  const wired = await capture(page);
+  assert.equal(await page.locator('vitrine-viewer button[data-action="wireframe"]').getAttribute('aria-pressed'), 'true');
+  assert.ok(compareImages(shaded.rgba, wired.rgba).meanDiff > 5, 'wire lines drawn');
+  const home = await camera(page);
+  await page.keyboard.press('ArrowLeft');
+  await page.keyboard.press('Shift+ArrowUp');
+  await page.keyboard.press('-');
+  const moved = await camera(page);
+  assert.notEqual(moved.state.yaw, home.state.yaw);
+  assert.notDeepEqual(moved.state.target, home.state.target);
+  assert.ok(moved.state.distance > home.state.distance);
+  await page.keyboard.press('r');
+  assert.deepEqual((await camera(page)).state, home.state);
+  await page.close();
+});
+
+test('the drawing buffer follows devicePixelRatio and resizes', async () => {
+  const page = await browser.context.newPage();
+  const cdp = await browser.context.newCDPSession(page);
+  await cdp.send('Emulation.setDeviceMetricsOverride', { width: 500, height: 400, deviceScaleFactor: 2, mobile: false });
+  await page.goto(`${service.url}/embed/torus`);
+  await until(page, `s.status === 'complete'`);
+  const size = () =>
+    page.evaluate(() => {
+      const c = /** @type {HTMLCanvasElement} */ (document.querySelector('vitrine-viewer')?.shadowRoot?.querySelector('canvas'));
+      return [c.width, c.height, c.clientWidth, c.clientHeight];
+    });
+  let [w, h, cw, ch] = await size();
+  assert.deepEqual([w, h], [2 * cw, 2 * ch]);
+  await cdp.send('Emulation.setDeviceMetricsOverride', { width: 400, height: 300, deviceScaleFactor: 2, mobile: false });
+  await page.waitForFunction(() => /** @type {HTMLCanvasElement} */ (document.querySelector('vitrine-viewer')?.shadowRoot?.querySelector('canvas')).width === 800);
+  [w, h, cw, ch] = await size();
+  assert.deepEqual([w, h, cw, ch], [800, 600, 400, 300]);
+  await page.close();
+});
+
+test('the model page offers an iframe snippet; the element works on another site', async () => {
+  const { page } = await open('/m/torus');
+  const snippets = await page.locator('.embed pre').allInnerTexts();
+  assert.match(snippets[0], new RegExp(`<iframe src="${service.url}/embed/torus"`));
+  assert.match(snippets[1], /<vitrine-viewer src=/);
+  await page.close();
+
+  // A museum page on another origin (another loopback port, so Chromium's
+  // local-network rules do not apply) pastes the element: the service's CORS
+  // headers and the blob-URL worker make it work.
+  const html = `<!doctype html><body style="margin:0"><script type="module" src="${service.url}/vitrine.js"></script>
+<vitrine-viewer src="${service.url}/m/torus" style="width:400px;height:300px"></vitrine-viewer></body>`;
+  const site = createServer((_, response) => response.writeHead(200, { 'content-type': 'text/html' }).end(html));
+  await new Promise((resolve) => site.listen(0, '127.0.0.1', () => resolve(undefined)));
+  const origin = `http://127.0.0.1:${/** @type {import('node:net').AddressInfo} */ (site.address()).port}`;
+  const museum = await browser.context.newPage();
+  await museum.goto(`${origin}/collection`);
+  const s = await until(museum, `s.status === 'complete'`);
+  assert.equal(s.shownLevel, manifest.last_level);
+  await museum.close();
+  site.close();
+});

@@ -1,0 +1,140 @@
+// @ts-check
+/**
+ * Mouse, touch and keyboard for the orbit camera, on Pointer Events so one
+ * code path serves mouse, pen and fingers:
+ * - one pointer (left button, one finger): rotate;
+ * - right or middle button, or shift + left: pan;
+ * - two fingers: pinch to zoom, move together to pan;
+ * - wheel: zoom;
+ * - keys (when the canvas has focus): arrows rotate, shift + arrows pan,
+ *   + / - zoom, R reset, W wireframe, F fullscreen.
+ */
+
+const KEY_STEP_PX = 40;
+const KEY_ZOOM = 1.15;
+const WHEEL_ZOOM_PER_PX = 0.0015;
+
+/**
+ * @typedef {object} ControlActions
+ * @property {() => import('./camera.js').OrbitCamera | null} camera
+ * @property {() => void} changed the camera moved
+ * @property {() => void} reset
+ * @property {() => void} toggleWireframe
+ * @property {() => void} toggleFullscreen
+ */
+
+export class OrbitControls {
+  /** @type {Map<number, { x: number, y: number }>} */
+  #pointers = new Map();
+  /** @type {{ distance: number, x: number, y: number } | null} */
+  #pinch = null;
+  #panning = false;
+
+  /**
+   * @param {HTMLCanvasElement} canvas
+   * @param {ControlActions} actions
+   */
+  constructor(canvas, actions) {
+    this.canvas = canvas;
+    this.actions = actions;
+    canvas.style.touchAction = 'none';
+    canvas.tabIndex = 0;
+    canvas.addEventListener('pointerdown', (e) => this.#down(e));
+    canvas.addEventListener('pointermove', (e) => this.#move(e));
+    for (const type of ['pointerup', 'pointercancel', 'lostpointercapture']) {
+      canvas.addEventListener(type, (e) => this.#up(/** @type {PointerEvent} */ (e)));
+    }
+    canvas.addEventListener('wheel', (e) => this.#wheel(e), { passive: false });
+    canvas.addEventListener('contextmenu', (e) => e.preventDefault());
+    canvas.addEventListener('keydown', (e) => this.#key(e));
+  }
+
+  /** @param {PointerEvent} e */
+  #down(e) {
+    this.canvas.focus({ preventScroll: true });
+    // Capture can fail for synthetic events; moves still arrive on the canvas.
+    try {
+      this.canvas.setPointerCapture(e.pointerId);
+    } catch {}
+    this.#pointers.set(e.pointerId, { x: e.clientX, y: e.clientY });
+    this.#panning = e.pointerType === 'mouse' && (e.button === 1 || e.button === 2 || e.shiftKey);
+    this.#pinch = this.#pointers.size === 2 ? this.#twoFingers() : null;
+    e.preventDefault();
+  }
+
+  /** @param {PointerEvent} e */
+  #move(e) {
+    const last = this.#pointers.get(e.pointerId);
+    const camera = this.actions.camera();
+    if (!last || !camera) return;
+    const height = this.canvas.clientHeight || 1;
+    if (this.#pointers.size === 1) {
+      const dx = e.clientX - last.x;
+      const dy = e.clientY - last.y;
+      if (this.#panning) camera.pan(dx, dy, height);
+      else camera.rotate(dx, dy, height);
+    }
+    this.#pointers.set(e.pointerId, { x: e.clientX, y: e.clientY });
+    if (this.#pointers.size === 2 && this.#pinch) {
+      const now = this.#twoFingers();
+      if (now.distance > 0 && this.#pinch.distance > 0) camera.zoom(this.#pinch.distance / now.distance);
+      camera.pan(now.x - this.#pinch.x, now.y - this.#pinch.y, height);
+      this.#pinch = now;
+    }
+    this.actions.changed();
+  }
+
+  /** @param {PointerEvent} e */
+  #up(e) {
+    if (!this.#pointers.delete(e.pointerId)) return;
+    // Lifting one of two fingers continues as a one-finger rotation from here.
+    this.#pinch = this.#pointers.size === 2 ? this.#twoFingers() : null;
+  }
+
+  #twoFingers() {
+    const [a, b] = [...this.#pointers.values()];
+    return { distance: Math.hypot(a.x - b.x, a.y - b.y), x: (a.x + b.x) / 2, y: (a.y + b.y) / 2 };
+  }
+
+  /** @param {WheelEvent} e */
+  #wheel(e) {
+    const camera = this.actions.camera();
+    if (!camera) return;
+    e.preventDefault();
+    const pixels = e.deltaMode === 1 ? e.deltaY * 16 : e.deltaMode === 2 ? e.deltaY * 400 : e.deltaY;
+    camera.zoom(Math.exp(pixels * WHEEL_ZOOM_PER_PX));
+    this.actions.changed();
+  }
+
+  /** @param {KeyboardEvent} e */
+  #key(e) {
+    if (e.ctrlKey || e.metaKey || e.altKey) return;
+    const camera = this.actions.camera();
+    const height = this.canvas.clientHeight || 1;
+    const arrows = { ArrowLeft: [-1, 0], ArrowRight: [1, 0], ArrowUp: [0, -1], ArrowDown: [0, 1] };
+    const arrow = arrows[/** @type {keyof typeof arrows} */ (e.key)];
+    if (arrow && camera) {
+      const [dx, dy] = arrow.map((s) => s * KEY_STEP_PX);
+      if (e.shiftKey) camera.pan(dx, dy, height);
+      else camera.rotate(dx, dy, height);
+    } else if ((e.key === '+' || e.key === '=') && camera) {
+      camera.zoom(1 / KEY_ZOOM);
+    } else if (e.key === '-' && camera) {
+      camera.zoom(KEY_ZOOM);
+    } else if (e.key === 'r' || e.key === 'R' || e.key === 'Home') {
+      this.actions.reset();
+    } else if (e.key === 'w' || e.key === 'W') {
+      this.actions.toggleWireframe();
+      e.preventDefault();
+      return;
+    } else if (e.key === 'f' || e.key === 'F') {
+      this.actions.toggleFullscreen();
+      e.preventDefault();
+      return;
+    } else {
+      return;
+    }
+    e.preventDefault();
+    this.actions.changed();
+  }
+}

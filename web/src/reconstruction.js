@@ -1,0 +1,310 @@
+// @ts-check
+/**
+ * Progressive reconstruction (thesis §6.4): the base mesh, then refinement
+ * batches in order, m_i = decode(m_{i-1}, d_{i-1}), up to the visitor's level
+ * cap. Batch k+1 is requested as soon as batch k has arrived, so the network
+ * works while the decoder does. Runs inside the decode worker; it has no DOM
+ * or worker dependency so Node tests drive it with a fake `fetch`.
+ */
+
+import { DecodeError } from './codec.js';
+import { bounds, edgeIndices, vertexNormals } from './geometry.js';
+
+/**
+ * @typedef {object} LoadRequest
+ * @property {string} baseUrl absolute URL of header + base mesh
+ * @property {string[]} batchUrls absolute URLs; batchUrls[k - 1] produces level k
+ * @property {number} upTo the highest level to reach now (the visitor's cap)
+ * @property {'each' | 'last'} show post every level, or only the last one reached
+ * @property {number} [showFrom] with `each`, post levels from this one on (a retry
+ *   does not step back through levels already on screen)
+ * @property {boolean} wireframe also build the edge list of each posted level
+ * @property {Record<string, string>} [headers] sent with every request
+ */
+
+/**
+ * @typedef {object} LevelMessage
+ * @property {'level'} type
+ * @property {number} level
+ * @property {number} vertices
+ * @property {number} faces
+ * @property {Float32Array} positions
+ * @property {Int16Array} normals normalised int16 x, y, z
+ * @property {Uint8Array | null} colours
+ * @property {Uint32Array} indices
+ * @property {Uint32Array | null} edges
+ * @property {import('./geometry.js').Bounds} baseBounds bounds of the base mesh: the
+ *   camera frames these, so the view does not shift when a level or a direct
+ *   load of the last level arrives
+ * @property {number} received payload bytes received so far
+ * @property {number} decodeMs time in the WASM decoder so far (apply + copy out)
+ * @property {number} deriveMs time computing normals and edges so far
+ */
+
+/**
+ * @typedef {{ type: 'progress', received: number }
+ *   | { type: 'edges', level: number, edges: Uint32Array }
+ *   | { type: 'capped', level: number, status: number, reason: string | null, retryAfterS: number | null }
+ *   | { type: 'error', kind: 'network' | 'decode', level: number, message: string }
+ *   | { type: 'done', level: number }} StatusMessage
+ * `capped`: the server refused the next batch (the cap fell since the
+ * manifest was read); `done`: `upTo` is reached and nothing is pending.
+ */
+
+/** @typedef {LevelMessage | StatusMessage} WorkerMessage */
+
+/** @typedef {(message: WorkerMessage, transfer: Transferable[]) => void} Post */
+
+/** @typedef {{ bytes: Uint8Array } | { capped: { status: number, reason: string | null, retryAfterS: number | null } }} Fetched */
+
+/** Thrown for transport failures and unexpected HTTP answers. */
+export class NetworkError extends Error {}
+
+const PROGRESS_EVERY_MS = 100;
+
+export class Reconstruction {
+  /** @type {import('./codec.js').StreamDecoder | null} */
+  #decoder = null;
+  /** @type {Map<number, Promise<Fetched>>} */
+  #inFlight = new Map();
+  /** @type {(() => void) | null} */
+  #wake = null;
+  #abort = new AbortController();
+  #cancelled = false;
+  #received = 0;
+  #decodeMs = 0;
+  #deriveMs = 0;
+  #lastProgress = 0;
+  /** @type {import('./geometry.js').Bounds} */
+  #baseBounds = { min: [0, 0, 0], max: [0, 0, 0] };
+  /** Levels applied so far; -1 before the base mesh. */
+  level = -1;
+
+  /**
+   * @param {import('./codec.js').VitrineCodec} codec
+   * @param {LoadRequest} request
+   * @param {Post} post
+   * @param {typeof fetch} [fetchImpl]
+   */
+  constructor(codec, request, post, fetchImpl = (input, init) => fetch(input, init)) {
+    this.codec = codec;
+    this.request = { ...request };
+    this.post = post;
+    this.fetchImpl = fetchImpl;
+  }
+
+  /**
+   * Raises (or lowers) the level to reach; resumes a waiting run.
+   * @param {number} upTo
+   */
+  extend(upTo) {
+    this.request.upTo = Math.min(upTo, this.request.batchUrls.length);
+    this.#wake?.();
+  }
+
+  /** @param {boolean} on */
+  setWireframe(on) {
+    this.request.wireframe = on;
+    if (on && this.#decoder && this.level >= 0) {
+      const t0 = performance.now();
+      const { indices, vertices } = this.#decoder.level();
+      const edges = edgeIndices(indices, vertices);
+      this.#deriveMs += performance.now() - t0;
+      this.post({ type: 'edges', level: this.level, edges }, [edges.buffer]);
+    }
+  }
+
+  cancel() {
+    this.#cancelled = true;
+    this.#abort.abort();
+    this.#wake?.();
+    this.#decoder?.free();
+    this.#decoder = null;
+  }
+
+  /** Runs until cancelled or failed; errors are posted, never thrown. */
+  async run() {
+    try {
+      await this.#run();
+    } catch (error) {
+      if (this.#cancelled) return;
+      const kind = error instanceof NetworkError ? 'network' : 'decode';
+      this.post({ type: 'error', kind, level: this.level, message: describe(error) }, []);
+    }
+  }
+
+  async #run() {
+    const base = await this.#fetch(0, this.request.baseUrl);
+    if (this.#cancelled) return;
+    if (!('bytes' in base)) throw new NetworkError('the server refused the base mesh');
+    const t0 = performance.now();
+    this.#decoder = this.codec.decoder(base.bytes);
+    this.#decodeMs += performance.now() - t0;
+    this.#baseBounds = bounds(this.#decoder.level().positions);
+    this.level = 0;
+    if (this.#shows(0)) this.#postLevel();
+    while (!this.#cancelled) {
+      if (this.level >= this.request.upTo) {
+        this.post({ type: 'done', level: this.level }, []);
+        await new Promise((resolve) => (this.#wake = () => resolve(undefined)));
+        this.#wake = null;
+        continue;
+      }
+      await this.#step(this.level + 1);
+    }
+  }
+
+  /**
+   * Fetches (or takes the prefetched) batch k, prefetches k + 1, decodes k.
+   * @param {number} k
+   */
+  async #step(k) {
+    const fetched = await this.#batch(k);
+    if (this.#cancelled) return;
+    if (!('bytes' in fetched)) {
+      this.#inFlight.delete(k);
+      const posted = this.#shows(this.level);
+      this.request.upTo = this.level;
+      if (!posted) this.#postLevel();
+      this.post({ type: 'capped', level: this.level, ...fetched.capped }, []);
+      return;
+    }
+    if (k + 1 <= this.request.upTo) void this.#batch(k + 1);
+    const decoder = /** @type {import('./codec.js').StreamDecoder} */ (this.#decoder);
+    const t0 = performance.now();
+    decoder.apply(fetched.bytes);
+    this.#decodeMs += performance.now() - t0;
+    this.#inFlight.delete(k);
+    this.level = k;
+    if (this.#shows(k)) this.#postLevel();
+  }
+
+  /** @param {number} level */
+  #shows(level) {
+    const { show, showFrom = 0, upTo } = this.request;
+    return level === upTo || (show === 'each' && level >= showFrom);
+  }
+
+  /** @param {number} k */
+  #batch(k) {
+    let pending = this.#inFlight.get(k);
+    if (!pending) {
+      pending = this.#fetch(k, this.request.batchUrls[k - 1]);
+      // A prefetch that fails is reported when it is awaited, not before.
+      pending.catch(() => {});
+      this.#inFlight.set(k, pending);
+    }
+    return pending;
+  }
+
+  #postLevel() {
+    const decoder = /** @type {import('./codec.js').StreamDecoder} */ (this.#decoder);
+    const t0 = performance.now();
+    const level = decoder.level();
+    const t1 = performance.now();
+    const normals = vertexNormals(level.positions, level.indices);
+    const edges = this.request.wireframe ? edgeIndices(level.indices, level.vertices) : null;
+    this.#decodeMs += t1 - t0;
+    this.#deriveMs += performance.now() - t1;
+    /** @type {Transferable[]} */
+    const transfer = [level.positions.buffer, normals.buffer, level.indices.buffer];
+    if (level.colours) transfer.push(level.colours.buffer);
+    if (edges) transfer.push(edges.buffer);
+    this.post(
+      {
+        type: 'level',
+        level: level.level,
+        vertices: level.vertices,
+        faces: level.indices.length / 3,
+        positions: level.positions,
+        normals,
+        colours: level.colours,
+        indices: level.indices,
+        edges,
+        baseBounds: this.#baseBounds,
+        received: this.#received,
+        decodeMs: this.#decodeMs,
+        deriveMs: this.#deriveMs,
+      },
+      transfer,
+    );
+  }
+
+  /**
+   * The whole body of one payload, reporting bytes as they arrive. A level
+   * cap answer (403/429 with `"error": "level_capped"`) is a result, not an
+   * error.
+   * @param {number} level
+   * @param {string} url
+   * @returns {Promise<Fetched>}
+   */
+  async #fetch(level, url) {
+    const what = level === 0 ? 'base mesh' : `batch ${level}`;
+    /** @type {Response} */
+    let response;
+    try {
+      response = await this.fetchImpl(url, { headers: this.request.headers, signal: this.#abort.signal });
+    } catch (error) {
+      throw new NetworkError(`could not fetch the ${what}: ${describe(error)}`);
+    }
+    if (response.status === 403 || response.status === 429) {
+      const body = await response.json().catch(() => ({}));
+      if (body && body.error === 'level_capped') {
+        const header = Number(response.headers.get('retry-after'));
+        const retryAfterS = body.retry_after_s ?? (Number.isFinite(header) && header > 0 ? header : null);
+        return { capped: { status: response.status, reason: body.reason ?? null, retryAfterS } };
+      }
+    }
+    if (!response.ok) throw new NetworkError(`the server answered ${response.status} for the ${what}`);
+    try {
+      return { bytes: await this.#readBody(response) };
+    } catch (error) {
+      throw new NetworkError(`the ${what} was cut off: ${describe(error)}`);
+    }
+  }
+
+  /** @param {Response} response */
+  async #readBody(response) {
+    if (!response.body) {
+      const bytes = new Uint8Array(await response.arrayBuffer());
+      this.#count(bytes.length);
+      return bytes;
+    }
+    const reader = response.body.getReader();
+    /** @type {Uint8Array[]} */
+    const chunks = [];
+    let length = 0;
+    for (;;) {
+      const { done, value } = await reader.read();
+      if (done) break;
+      chunks.push(value);
+      length += value.length;
+      this.#count(value.length);
+    }
+    if (chunks.length === 1) return chunks[0];
+    const bytes = new Uint8Array(length);
+    let at = 0;
+    for (const chunk of chunks) {
+      bytes.set(chunk, at);
+      at += chunk.length;
+    }
+    return bytes;
+  }
+
+  /** @param {number} bytes */
+  #count(bytes) {
+    this.#received += bytes;
+    const now = performance.now();
+    if (now - this.#lastProgress >= PROGRESS_EVERY_MS) {
+      this.#lastProgress = now;
+      this.post({ type: 'progress', received: this.#received }, []);
+    }
+  }
+}
+
+/** @param {unknown} error */
+function describe(error) {
+  if (error instanceof DecodeError) return `the stream is damaged (${error.message})`;
+  if (error instanceof WebAssembly.RuntimeError) return `the decoder stopped (${error.message})`;
+  return error instanceof Error ? error.message : String(error);
+}

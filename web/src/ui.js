@@ -1,0 +1,170 @@
+// @ts-check
+/**
+ * The viewer's chrome inside a shadow root (so a museum site's CSS cannot
+ * reach it): canvas sized to device pixels, progress line, cap notice, error
+ * overlay with retry, title panel, and the reset / wireframe / fullscreen
+ * buttons.
+ */
+
+/** Device pixels per CSS pixel, capped: beyond 2 a tablet pays 2.25× the fill for little gain. */
+const MAX_PIXEL_RATIO = 2;
+
+export const STYLE = `
+:host { display: block; position: relative; min-height: 240px; background: #212329; color: #eceff4;
+  font: 14px/1.4 system-ui, -apple-system, "Segoe UI", sans-serif; overflow: hidden; }
+.stage { position: absolute; inset: 0; }
+canvas { display: block; width: 100%; height: 100%; outline: none; cursor: grab; }
+canvas:active { cursor: grabbing; }
+canvas:focus-visible { box-shadow: inset 0 0 0 2px #88c0d0; }
+.pill { background: rgba(20, 22, 26, 0.72); border-radius: 6px; padding: 6px 10px; }
+.panel { position: absolute; top: 10px; left: 10px; max-width: min(26rem, 60%); }
+.panel h1 { font-size: 16px; margin: 0; font-weight: 600; }
+.panel p { margin: 4px 0 0; color: #cfd5de; }
+.panel:empty, [hidden] { display: none !important; }
+.tools { position: absolute; top: 10px; right: 10px; display: flex; gap: 6px; }
+button { font: inherit; color: inherit; background: rgba(20, 22, 26, 0.72); border: 1px solid #4c566a;
+  border-radius: 6px; min-height: 36px; padding: 4px 12px; cursor: pointer; }
+button:hover { background: rgba(59, 66, 82, 0.9); }
+button[aria-pressed="true"] { background: #5e81ac; border-color: #81a1c1; }
+.status { position: absolute; left: 10px; bottom: 12px; right: 10px; display: flex; flex-direction: column;
+  align-items: flex-start; gap: 6px; pointer-events: none; }
+.notice { background: rgba(94, 72, 20, 0.88); border: 1px solid #ebcb8b; }
+.bar { position: absolute; left: 0; bottom: 0; height: 3px; background: #88c0d0; transition: width 0.3s; }
+.error { position: absolute; inset: 0; display: grid; place-items: center; background: rgba(20, 22, 26, 0.6); }
+.error div { background: #3b2226; border: 1px solid #bf616a; border-radius: 8px; padding: 16px 20px;
+  max-width: min(32rem, 85%); }
+.error p { margin: 0 0 12px; }
+:host([chrome="minimal"]) .panel p { display: none; }
+:host([chrome="minimal"]) button.optional { display: none; }
+`;
+
+export class ViewerUi {
+  onReset = () => {};
+  onWireframe = () => {};
+  onRetry = () => {};
+  onResize = () => {};
+
+  /**
+   * @param {HTMLElement} host
+   * @param {ShadowRoot} shadow
+   */
+  constructor(host, shadow) {
+    this.root = host;
+    shadow.innerHTML = `<style>${STYLE}</style>
+<div class="stage" part="stage">
+  <canvas aria-label="3D view: drag to turn, pinch or scroll to zoom, two fingers or right-drag to pan"></canvas>
+  <div class="panel pill" part="panel"></div>
+  <div class="tools">
+    <button data-action="reset" title="Reset view (R)">Reset</button>
+    <button data-action="wireframe" title="Wireframe (W)" aria-pressed="false" class="optional">Wireframe</button>
+    <button data-action="fullscreen" title="Fullscreen (F)">Fullscreen</button>
+  </div>
+  <div class="status">
+    <div class="notice pill" role="status" hidden></div>
+    <div class="progress pill" aria-live="polite">Loading…</div>
+  </div>
+  <div class="bar" style="width: 0"></div>
+  <div class="error" role="alert" hidden><div><p></p><button data-action="retry">Try again</button></div></div>
+</div>`;
+    const $ = (/** @type {string} */ selector) => /** @type {HTMLElement} */ (shadow.querySelector(selector));
+    this.canvas = /** @type {HTMLCanvasElement} */ ($('canvas'));
+    this.stage = $('.stage');
+    this.panel = $('.panel');
+    this.progress = $('.progress');
+    this.notice = $('.notice');
+    this.bar = $('.bar');
+    this.error = $('.error');
+    this.wireButton = $('[data-action="wireframe"]');
+    $('[data-action="reset"]').onclick = () => this.onReset();
+    this.wireButton.onclick = () => this.onWireframe();
+    $('[data-action="fullscreen"]').onclick = () => this.toggleFullscreen();
+    $('[data-action="retry"]').onclick = () => this.onRetry();
+    this.#watchSize();
+  }
+
+  /** Keeps the drawing buffer at the canvas's size in device pixels. */
+  #watchSize() {
+    const apply = (/** @type {number} */ width, /** @type {number} */ height) => {
+      const w = Math.max(1, Math.round(width));
+      const h = Math.max(1, Math.round(height));
+      if (this.canvas.width !== w || this.canvas.height !== h) {
+        this.canvas.width = w;
+        this.canvas.height = h;
+        this.onResize();
+      }
+    };
+    const observer = new ResizeObserver(([entry]) => {
+      const ratio = Math.min(devicePixelRatio, MAX_PIXEL_RATIO);
+      const width = entry.contentRect.width * ratio;
+      const height = entry.contentRect.height * ratio;
+      // The device-pixel box is exact at fractional ratios; emulated ratios
+      // (DevTools) do not reach it, so it is used only when it agrees.
+      const exact = entry.devicePixelContentBoxSize?.[0];
+      const agrees = exact && Math.abs(exact.inlineSize - width) <= 1 && Math.abs(exact.blockSize - height) <= 1;
+      if (exact && agrees) apply(exact.inlineSize, exact.blockSize);
+      else apply(width, height);
+    });
+    try {
+      observer.observe(this.canvas, { box: 'device-pixel-content-box' });
+    } catch {
+      observer.observe(this.canvas);
+    }
+  }
+
+  /**
+   * @param {string} title
+   * @param {string} description
+   */
+  setDetails(title, description) {
+    this.panel.replaceChildren();
+    const h = document.createElement('h1');
+    h.textContent = title;
+    this.panel.append(h);
+    if (description) {
+      const p = document.createElement('p');
+      p.textContent = description;
+      this.panel.append(p);
+    }
+  }
+
+  /** @param {import('./viewer.js').ViewerState} state */
+  setProgress(state) {
+    if (state.shownLevel < 0) {
+      this.progress.textContent = `Loading… ${formatBytes(state.received)} received`;
+      return;
+    }
+    const vertices = state.vertices.toLocaleString('en');
+    this.progress.textContent =
+      `Level ${state.shownLevel} of ${state.lastLevel} · ${vertices} vertices · ${formatBytes(state.received)} received`;
+    this.bar.style.width = `${(100 * state.shownLevel) / Math.max(1, state.lastLevel)}%`;
+  }
+
+  /** @param {string | null} text */
+  showNotice(text) {
+    this.notice.hidden = text === null;
+    this.notice.textContent = text ?? '';
+  }
+
+  /** @param {string | null} text */
+  showError(text) {
+    this.error.hidden = text === null;
+    /** @type {HTMLElement} */ (this.error.querySelector('p')).textContent = text ? `Could not show this model: ${text}` : '';
+  }
+
+  /** @param {boolean} on */
+  setWireframe(on) {
+    this.wireButton.setAttribute('aria-pressed', String(on));
+  }
+
+  toggleFullscreen() {
+    if (document.fullscreenElement) void document.exitFullscreen();
+    else void this.root.requestFullscreen?.().catch(() => {});
+  }
+}
+
+/** @param {number} bytes */
+export function formatBytes(bytes) {
+  if (bytes < 1024) return `${bytes} B`;
+  if (bytes < 1024 * 1024) return `${(bytes / 1024).toFixed(1)} KB`;
+  return `${(bytes / (1024 * 1024)).toFixed(2)} MB`;
+}

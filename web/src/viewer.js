@@ -1,0 +1,365 @@
+// @ts-check
+/**
+ * One model on screen: reads the manifest, starts a decode worker, shows each
+ * level the worker sends, follows the visitor's level cap, and turns every
+ * failure into a message with a retry button.
+ */
+
+import { OrbitCamera } from './camera.js';
+import { OrbitControls } from './controls.js';
+import { Renderer } from './renderer.js';
+
+/**
+ * @typedef {object} ViewerOptions
+ * @property {string} manifestUrl absolute URL of `/api/models/{slug}`
+ * @property {URLSearchParams} query forwarded to every API request (`device`, `token`)
+ * @property {number | null} level load up to this level and show only it (tests, comparisons)
+ * @property {string} workerUrl absolute URL of the bundled decode worker
+ * @property {string} wasmUrl absolute URL of the decoder's WebAssembly
+ */
+
+/**
+ * The parts of the service's manifest the viewer reads (server/src/service/api.rs).
+ * @typedef {object} Manifest
+ * @property {string} slug
+ * @property {string} title
+ * @property {string} description
+ * @property {boolean} has_colour
+ * @property {number} last_level
+ * @property {Array<{ level: number, vertices: number, faces: number, bytes: number, url: string, allowed: boolean }>} levels
+ * @property {{ device: string, audience: string }} visitor
+ * @property {{ level: number, reason: string | null, retry_after_s: number | null }} cap
+ */
+
+/**
+ * What tests and benchmarks read from `element.viewer.state`.
+ * @typedef {object} ViewerState
+ * @property {'loading' | 'refining' | 'complete' | 'capped' | 'error'} status
+ * @property {number} shownLevel level on screen (-1: none yet)
+ * @property {number} decodedLevel newest level the worker sent
+ * @property {number} targetLevel level the viewer is heading for (cap or `level` option)
+ * @property {number} lastLevel
+ * @property {number} vertices of the level on screen
+ * @property {number} received payload bytes
+ * @property {number} decodeMs time inside the WASM decoder
+ * @property {number} deriveMs time computing normals and edges in the worker
+ * @property {number | null} firstFrameMs performance.now() of the first frame with a mesh
+ * @property {Record<number, number>} shownAtMs performance.now() when each level was first drawn
+ * @property {string | null} message cap or error text on screen
+ */
+
+/** @type {Map<string, Promise<WebAssembly.Module>>} */
+const compiled = new Map();
+
+/**
+ * Compiles the decoder once per page; every viewer's worker instantiates it.
+ * @param {string} url
+ */
+export function compileDecoder(url) {
+  let module = compiled.get(url);
+  if (!module) {
+    module = WebAssembly.compileStreaming(fetch(url)).catch(async () => {
+      // A server without the application/wasm type: compile from bytes.
+      const response = await fetch(url);
+      if (!response.ok) throw new Error(`the decoder could not be loaded (${response.status})`);
+      return WebAssembly.compile(await response.arrayBuffer());
+    });
+    compiled.set(url, module);
+  }
+  return module;
+}
+
+const REASONS = {
+  audience: () => 'the full-resolution scan is reserved for researchers',
+  device: (/** @type {string} */ device) => `that is the most detail sent to a ${device}`,
+  load: (/** @type {string} */ _, /** @type {number | null} */ retry) =>
+    `the server is busy${retry ? `; trying again every ${retry} s` : ''}`,
+};
+
+export class Viewer {
+  /** @type {ViewerState} */
+  state = {
+    status: 'loading',
+    shownLevel: -1,
+    decodedLevel: -1,
+    targetLevel: 0,
+    lastLevel: 0,
+    vertices: 0,
+    received: 0,
+    decodeMs: 0,
+    deriveMs: 0,
+    firstFrameMs: null,
+    shownAtMs: {},
+    message: null,
+  };
+  /** @type {Manifest | null} */
+  manifest = null;
+  /** @type {OrbitCamera | null} */
+  camera = null;
+  /**
+   * Created by start() once the requests are on their way: the first WebGL
+   * context of a page can hold the main thread for a while (a GPU process
+   * to start; ~1 s with SwiftShader), and the network need not wait for it.
+   * @type {Renderer | null}
+   */
+  renderer = null;
+  /** @type {Worker | null} */
+  #worker = null;
+  /** @type {ReturnType<typeof setTimeout> | null} */
+  #retry = null;
+  #wireframe = false;
+  /** Bumped by stop(), so a start() still waiting for the network gives up. */
+  #attempt = 0;
+  /** The cap in force: from the manifest, or from a batch the server refused. */
+  #cap = { level: 0, reason: /** @type {string | null} */ (null), retryAfterS: /** @type {number | null} */ (null) };
+
+  /**
+   * @param {import('./ui.js').ViewerUi} ui
+   * @param {ViewerOptions} options
+   */
+  constructor(ui, options) {
+    this.ui = ui;
+    this.options = options;
+    this.controls = new OrbitControls(ui.canvas, {
+      camera: () => this.camera,
+      changed: () => this.renderer?.requestFrame(),
+      reset: () => this.resetView(),
+      toggleWireframe: () => this.setWireframe(!this.#wireframe),
+      toggleFullscreen: () => ui.toggleFullscreen(),
+    });
+    ui.onReset = () => this.resetView();
+    ui.onWireframe = () => this.setWireframe(!this.#wireframe);
+    ui.onRetry = () => this.start();
+    ui.onResize = () => this.renderer?.requestFrame();
+  }
+
+  /** Loads from scratch (also the retry after an error). */
+  async start() {
+    this.stop();
+    const attempt = this.#attempt;
+    this.#set({ status: 'loading', message: null });
+    this.ui.showError(null);
+    this.ui.showNotice(null);
+    try {
+      // Manifest, decoder and worker script load in parallel.
+      const loading = Promise.all([this.#fetchManifest(), compileDecoder(this.options.wasmUrl), this.#createWorker()]);
+      loading.catch(() => {}); // awaited below; this only keeps a failure while the context is made from going unhandled
+      this.renderer ??= new Renderer(this.ui.canvas, null, {
+        onSwap: (level) => this.#shown(level),
+        onFrame: () => this.#framed(),
+      });
+      const [manifest, module, worker] = await loading;
+      if (attempt !== this.#attempt) {
+        worker.terminate();
+        return;
+      }
+      this.#begin(manifest, module, worker);
+    } catch (error) {
+      if (attempt === this.#attempt) this.#fail(error instanceof Error ? error.message : String(error));
+    }
+  }
+
+  stop() {
+    this.#attempt++;
+    this.#worker?.terminate();
+    this.#worker = null;
+    if (this.#retry) clearTimeout(this.#retry);
+    this.#retry = null;
+  }
+
+  resetView() {
+    this.camera?.reset();
+    this.renderer?.requestFrame();
+  }
+
+  /** @param {boolean} on */
+  setWireframe(on) {
+    this.#wireframe = on;
+    this.ui.setWireframe(on);
+    this.renderer?.setWireframe(on);
+    this.#worker?.postMessage({ type: 'wireframe', on });
+  }
+
+  /**
+   * @param {Manifest} manifest
+   * @param {WebAssembly.Module} module
+   * @param {Worker} worker
+   */
+  #begin(manifest, module, worker) {
+    this.manifest = manifest;
+    this.ui.setDetails(manifest.title, manifest.description);
+    this.#worker = worker;
+    worker.onmessage = (event) => this.#message(event.data);
+    worker.onerror = (event) => this.#fail(`the decoder failed: ${event.message}`);
+    this.#cap = { level: manifest.cap.level, reason: manifest.cap.reason, retryAfterS: manifest.cap.retry_after_s };
+    const target = this.#target(manifest.cap.level);
+    this.#set({ status: 'refining', lastLevel: manifest.last_level, targetLevel: target });
+    const url = (/** @type {string} */ path) => this.#apiUrl(path);
+    /** @type {import('./reconstruction.js').LoadRequest} */
+    const request = {
+      baseUrl: url(manifest.levels[0].url),
+      batchUrls: manifest.levels.slice(1).map((l) => url(l.url)),
+      upTo: target,
+      show: this.options.level === null ? 'each' : 'last',
+      showFrom: Math.min(this.state.shownLevel + 1, target),
+      wireframe: this.#wireframe,
+    };
+    worker.postMessage({ type: 'load', module, request });
+  }
+
+  /** @param {number} cap */
+  #target(cap) {
+    return this.options.level === null ? cap : Math.min(cap, this.options.level);
+  }
+
+  /** @param {import('./reconstruction.js').WorkerMessage} message */
+  #message(message) {
+    const renderer = /** @type {Renderer} */ (this.renderer);
+    switch (message.type) {
+      case 'level':
+        if (!this.camera) {
+          this.camera = new OrbitCamera(message.baseBounds);
+          renderer.camera = this.camera;
+        }
+        this.#set({
+          decodedLevel: message.level,
+          received: message.received,
+          decodeMs: message.decodeMs,
+          deriveMs: message.deriveMs,
+        });
+        renderer.show(message);
+        break;
+      case 'edges':
+        renderer.addEdges(message.level, message.edges);
+        break;
+      case 'progress':
+        this.#set({ received: message.received });
+        break;
+      case 'capped':
+        // The cap fell after the manifest was read: the server refused a batch.
+        this.#cap = { level: message.level, reason: message.reason, retryAfterS: message.retryAfterS };
+        this.#set({ targetLevel: message.level });
+        if (this.state.shownLevel >= message.level) this.#announceCap();
+        break;
+      case 'error': {
+        const where = message.level < 0 ? 'the base mesh' : `level ${message.level + 1}`;
+        const what = message.kind === 'decode' ? `could not decode ${where}` : 'a download failed';
+        this.#fail(`${what}: ${message.message}`);
+        break;
+      }
+      case 'done':
+        break;
+    }
+  }
+
+  /** @param {import('./reconstruction.js').LevelMessage} level */
+  #shown(level) {
+    this.#set({ shownLevel: level.level, vertices: level.vertices });
+    if (level.level < this.state.targetLevel || this.state.status !== 'refining') return;
+    const last = /** @type {Manifest} */ (this.manifest).last_level;
+    if (this.#cap.level < Math.min(last, this.options.level ?? last)) this.#announceCap();
+    else this.#set({ status: 'complete' });
+  }
+
+  #framed() {
+    const level = this.renderer?.current?.source.level;
+    if (level === undefined || level in this.state.shownAtMs) return;
+    const now = performance.now();
+    // Visible in DevTools and traces; the benchmark reads them.
+    performance.mark(`vitrine:level-${level}`);
+    this.state.shownAtMs[level] = now;
+    this.state.firstFrameMs ??= now;
+    this.ui.root.dispatchEvent(new CustomEvent('vitrine-level', { detail: { level }, bubbles: true, composed: true }));
+  }
+
+  /**
+   * The server holds refinement at the cap: say so, and ask again later if
+   * the reason may pass (load).
+   */
+  #announceCap() {
+    const { level, reason, retryAfterS } = this.#cap;
+    const manifest = /** @type {Manifest} */ (this.manifest);
+    const explain = REASONS[/** @type {keyof typeof REASONS} */ (reason ?? '')];
+    const why = explain ? explain(manifest.visitor.device, retryAfterS) : 'set by the server';
+    const message = `Refinement limited to level ${level} of ${manifest.last_level}: ${why}.`;
+    this.#set({ status: 'capped', message });
+    this.ui.showNotice(message);
+    if (retryAfterS && !this.#retry) {
+      this.#retry = setTimeout(() => this.#recheck(), retryAfterS * 1000);
+    }
+  }
+
+  /** Reads the manifest again and resumes if the cap rose. */
+  async #recheck() {
+    this.#retry = null;
+    let manifest;
+    try {
+      manifest = await this.#fetchManifest();
+    } catch {
+      manifest = null;
+    }
+    if (!this.#worker) return;
+    const current = /** @type {Manifest} */ (this.manifest);
+    if (!manifest) {
+      this.#retry = setTimeout(() => this.#recheck(), (current.cap.retry_after_s ?? 10) * 1000);
+      return;
+    }
+    this.manifest = manifest;
+    this.#cap = { level: manifest.cap.level, reason: manifest.cap.reason, retryAfterS: manifest.cap.retry_after_s };
+    const target = this.#target(manifest.cap.level);
+    if (target > this.state.targetLevel) {
+      this.ui.showNotice(null);
+      this.#set({ status: 'refining', message: null, targetLevel: target });
+      this.#worker.postMessage({ type: 'extend', upTo: target });
+    } else {
+      this.#cap.level = Math.min(this.#cap.level, this.state.targetLevel);
+      this.#announceCap();
+    }
+  }
+
+  /** @param {string} message */
+  #fail(message) {
+    this.stop();
+    this.#set({ status: 'error', message });
+    this.ui.showError(message);
+  }
+
+  /** @param {Partial<ViewerState>} patch */
+  #set(patch) {
+    Object.assign(this.state, patch);
+    this.ui.setProgress(this.state);
+  }
+
+  /** @returns {Promise<Manifest>} */
+  async #fetchManifest() {
+    let response;
+    try {
+      response = await fetch(this.#apiUrl(this.options.manifestUrl), { cache: 'no-store' });
+    } catch (error) {
+      throw new Error(`could not reach the server (${error instanceof Error ? error.message : error})`);
+    }
+    if (!response.ok) {
+      const body = await response.json().catch(() => null);
+      const detail = body?.message ?? body?.error ?? response.statusText;
+      throw new Error(`the server answered ${response.status} for this model (${detail})`);
+    }
+    return response.json();
+  }
+
+  /** @param {string} path relative to the manifest's URL */
+  #apiUrl(path) {
+    const url = new URL(path, this.options.manifestUrl);
+    for (const [key, value] of this.options.query) url.searchParams.set(key, value);
+    return url.href;
+  }
+
+  /** A worker from the same origin, or via a blob URL when the page is another site's. */
+  async #createWorker() {
+    const url = new URL(this.options.workerUrl);
+    if (url.origin === location.origin) return new Worker(url);
+    const response = await fetch(url);
+    if (!response.ok) throw new Error(`the decode worker could not be loaded (${response.status})`);
+    const blob = new Blob([await response.text()], { type: 'text/javascript' });
+    return new Worker(URL.createObjectURL(blob));
+  }
+}

@@ -1,0 +1,73 @@
+// @ts-check
+/**
+ * The real service for browser tests and benchmarks: generated models are
+ * ingested into a temporary SQLite database with the `vitrine` CLI, then
+ * `vitrine serve` listens on a free loopback port and serves web/dist.
+ */
+import { execFileSync, spawn } from 'node:child_process';
+import { existsSync, mkdtempSync, rmSync } from 'node:fs';
+import { tmpdir } from 'node:os';
+import { join } from 'node:path';
+import { root, vitrine } from './fixtures.mjs';
+
+export const webDist = join(root, 'web', 'dist');
+
+/**
+ * @typedef {object} ModelSpec
+ * @property {string} slug
+ * @property {string} title
+ * @property {string} [description]
+ * @property {'torus' | 'sphere' | 'plate'} kind
+ * @property {number} kiloVertices
+ * @property {boolean} [colour]
+ * @property {string} [policy] exhibition, open or researchers
+ */
+
+/**
+ * @param {{ models: ModelSpec[], serveArgs?: string[] }} options
+ * @returns {Promise<{ url: string, dir: string, stop: () => Promise<void> }>}
+ */
+export async function startService({ models, serveArgs = [] }) {
+  if (!existsSync(vitrine)) throw new Error(`build the CLI first: cargo build --release -p vitrine (${vitrine})`);
+  if (!existsSync(join(webDist, 'index.html'))) throw new Error('build the viewer first: npm run build');
+  const dir = mkdtempSync(join(tmpdir(), 'vitrine-service-'));
+  const db = `sqlite:${join(dir, 'vitrine.db')}`;
+  const env = { ...process.env, NO_COLOR: '1', RUST_LOG: process.env.RUST_LOG ?? 'warn,vitrine=info' };
+  for (const m of models) {
+    const mesh = join(dir, `${m.slug}.ply`);
+    const sample = ['sample', m.kind, '-o', mesh, '--kilo-vertices', String(m.kiloVertices)];
+    execFileSync(vitrine, m.colour ? [...sample, '--colour'] : sample, { stdio: 'pipe' });
+    const ingest = ['ingest', mesh, '--db', db, '--slug', m.slug, '--title', m.title];
+    ingest.push('--description', m.description ?? '', '--policy', m.policy ?? 'open');
+    execFileSync(vitrine, ingest, { stdio: 'pipe', env });
+  }
+  // Chromium on SwiftShader keeps both cores of a small machine busy, which
+  // the service would read as load and answer with load caps: tests that
+  // are not about load switch the load signals off.
+  const noLoadCaps = ['--load-high-inflight', '1000000', '--load-high-latency-ms', '1000000', '--load-high-queue-ms', '1000000'];
+  const args = ['serve', '--db', db, '--listen', '127.0.0.1:0', '--web-dir', webDist, ...noLoadCaps, ...serveArgs];
+  const child = spawn(vitrine, args, { stdio: ['ignore', 'ignore', 'pipe'], env });
+  let log = '';
+  const url = await new Promise((resolve, reject) => {
+    const timer = setTimeout(() => reject(new Error(`vitrine serve did not start:\n${log}`)), 30_000);
+    child.stderr.setEncoding('utf8');
+    child.stderr.on('data', (chunk) => {
+      log += chunk;
+      const match = log.match(/serving.*?addr=(\d+\.\d+\.\d+\.\d+:\d+)/);
+      if (match) {
+        clearTimeout(timer);
+        resolve(`http://${match[1]}`);
+      }
+    });
+    child.on('exit', (code) => reject(new Error(`vitrine serve exited with ${code}:\n${log}`)));
+  });
+  const stop = async () => {
+    if (child.exitCode === null) {
+      const exited = new Promise((resolve) => child.once('exit', resolve));
+      child.kill('SIGTERM');
+      await exited;
+    }
+    rmSync(dir, { recursive: true, force: true });
+  };
+  return { url, dir, stop };
+}
