@@ -55,7 +55,6 @@ pub(crate) struct Simplifier {
     pub colours: Option<Vec<[u8; 3]>>,
     pub geometric_guard: bool,
     pub live_vertices: usize,
-    pub live_faces: usize,
     state: Vec<u8>,
     tag: Vec<Tag>,
     face_done: Vec<bool>,
@@ -89,7 +88,6 @@ impl Simplifier {
         geometric_guard: bool,
     ) -> Self {
         let n = positions.len();
-        let live_faces = conn.face_count_slots();
         Simplifier {
             conn,
             ids: (0..n as u32).collect(),
@@ -97,7 +95,6 @@ impl Simplifier {
             colours,
             geometric_guard,
             live_vertices: n,
-            live_faces,
             state: vec![FREE; n],
             tag: vec![Tag::None; n],
             face_done: Vec::new(),
@@ -161,15 +158,6 @@ impl Simplifier {
             *v = self.ids[*v as usize];
         }
         out.connectivity = streams.conn.finish();
-        if std::env::var_os("VITRINE_DEBUG_PASSES").is_some() {
-            eprintln!(
-                "{kind:?}: live {} removed {} conn bytes {} geom bytes {}",
-                self.live_vertices,
-                out.removed.len(),
-                out.connectivity.len(),
-                streams.geom.clone().finish().len()
-            );
-        }
         out.geometry = streams.geom.finish();
         out.colour = streams.colour.finish();
         out
@@ -489,7 +477,6 @@ impl Simplifier {
         self.conn.out[p.centre as usize] = NONE;
         self.state[p.centre as usize] = REMOVED;
         self.live_vertices -= 1;
-        self.live_faces -= 2;
         for &o in &outer[1..d] {
             if o != NONE {
                 gates.push_back(o);

@@ -72,7 +72,6 @@ pub struct Encoded {
 struct Layer {
     decimating: PassOutput,
     cleaning: PassOutput,
-    faces_after: usize,
 }
 
 /// Encodes a manifold mesh (see [`crate::repair::prepare`]).
@@ -143,7 +142,6 @@ pub fn encode_with_progress(
         layers.push(Layer {
             decimating,
             cleaning,
-            faces_after: s.live_faces,
         });
         s.compact();
         progress(EncodeProgress {
@@ -155,7 +153,6 @@ pub fn encode_with_progress(
             break;
         }
     }
-    let _ = layers.last().map(|l| l.faces_after);
     Ok(write_stream(&s, &layers, quantization, &positions, mesh))
 }
 
