@@ -7,12 +7,12 @@
 //! every level the decoder produces is a valid manifold, and the final level
 //! is exactly the quantized repaired mesh.
 
+mod common;
+
 use proptest::prelude::*;
 use vitrine_codec::repair::{check_manifold, prepare, RepairOptions};
 use vitrine_codec::samples::{add_noise, compact, icosphere, plate_with_tunnels, torus};
-use vitrine_codec::{
-    encode, BaseTarget, Decoder, EncodeOptions, IndexedMesh, Limits, Quantization, StreamIndex,
-};
+use vitrine_codec::{encode, BaseTarget, Decoder, EncodeOptions, IndexedMesh, Limits, StreamIndex};
 
 #[derive(Clone, Debug)]
 enum Shape {
@@ -104,11 +104,6 @@ fn build(c: &Case) -> IndexedMesh {
     mesh
 }
 
-fn canonical(t: [u32; 3]) -> [u32; 3] {
-    let i = (0..3).min_by_key(|&i| t[i]).unwrap();
-    [t[i], t[(i + 1) % 3], t[(i + 2) % 3]]
-}
-
 /// Each undirected edge on at most two faces, each half-edge on one.
 fn edge_manifold(indices: &[u32]) -> Result<(), String> {
     let mut directed: Vec<(u32, u32)> = indices
@@ -179,46 +174,8 @@ fn check(c: &Case) -> Result<(), TestCaseError> {
     prop_assert!(d.is_complete());
 
     // The final level is the quantized input, vertex for vertex.
-    let q = Quantization::for_positions(&mesh.positions, c.bits).unwrap();
-    let order = &encoded.vertex_order;
-    prop_assert_eq!(order.len(), mesh.positions.len());
-    for (i, &v) in order.iter().enumerate() {
-        prop_assert_eq!(
-            d.quantized_positions()[i],
-            q.quantize(mesh.positions[v as usize]),
-            "vertex {}",
-            i
-        );
-    }
-    let mut expected: Vec<[u32; 3]> = mesh.triangles.iter().map(|&t| canonical(t)).collect();
-    let mut got: Vec<[u32; 3]> = d
-        .indices()
-        .chunks_exact(3)
-        .map(|t| {
-            canonical([
-                order[t[0] as usize],
-                order[t[1] as usize],
-                order[t[2] as usize],
-            ])
-        })
-        .collect();
-    expected.sort_unstable();
-    got.sort_unstable();
-    prop_assert_eq!(got, expected, "same triangles, same orientation");
-    match &mesh.colors {
-        Some(colours) => {
-            let decoded = d.colours().expect("stream keeps colour");
-            for (i, &v) in order.iter().enumerate() {
-                prop_assert_eq!(
-                    &decoded[3 * i..3 * i + 3],
-                    &colours[v as usize],
-                    "colour {}",
-                    i
-                );
-            }
-        }
-        None => prop_assert!(d.colours().is_none()),
-    }
+    let mismatch = common::final_level_mismatch(&mesh, c.bits, &d, &encoded.vertex_order);
+    prop_assert!(mismatch.is_none(), "final level differs: {:?}", mismatch);
     Ok(())
 }
 

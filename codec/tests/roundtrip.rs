@@ -4,14 +4,9 @@
 use vitrine_codec::samples::{
     add_noise, icosphere, merge, paint, plate_with_tunnels, punch_holes, torus,
 };
-use vitrine_codec::{
-    decode, encode, EncodeOptions, IndexedMesh, Limits, Quantization, StreamIndex,
-};
+use vitrine_codec::{decode, encode, EncodeOptions, IndexedMesh, Limits, StreamIndex};
 
-fn canonical(t: [u32; 3]) -> [u32; 3] {
-    let i = (0..3).min_by_key(|&i| t[i]).unwrap();
-    [t[i], t[(i + 1) % 3], t[(i + 2) % 3]]
-}
+mod common;
 
 /// Encodes, decodes level by level, and compares the final level with the input.
 fn assert_round_trip(mesh: &IndexedMesh, options: &EncodeOptions) -> usize {
@@ -32,43 +27,11 @@ fn assert_round_trip(mesh: &IndexedMesh, options: &EncodeOptions) -> usize {
     }
     assert!(decoder.is_complete());
 
-    let q = Quantization::for_positions(&mesh.positions, options.quantization_bits).unwrap();
     let order = &encoded.vertex_order;
-    assert_eq!(order.len(), mesh.positions.len());
-    for (i, &v) in order.iter().enumerate() {
-        assert_eq!(
-            decoder.quantized_positions()[i],
-            q.quantize(mesh.positions[v as usize]),
-            "vertex {i}"
-        );
-    }
-    let mut expected: Vec<[u32; 3]> = mesh.triangles.iter().map(|&t| canonical(t)).collect();
-    let mut got: Vec<[u32; 3]> = decoder
-        .indices()
-        .chunks_exact(3)
-        .map(|t| {
-            canonical([
-                order[t[0] as usize],
-                order[t[1] as usize],
-                order[t[2] as usize],
-            ])
-        })
-        .collect();
-    expected.sort_unstable();
-    got.sort_unstable();
-    assert_eq!(got, expected, "same triangles, same orientation");
-    match &mesh.colors {
-        Some(colours) => {
-            let decoded = decoder.colours().expect("stream keeps colour");
-            for (i, &v) in order.iter().enumerate() {
-                assert_eq!(
-                    &decoded[3 * i..3 * i + 3],
-                    &colours[v as usize],
-                    "colour {i}"
-                );
-            }
-        }
-        None => assert!(decoder.colours().is_none()),
+    if let Some(diff) =
+        common::final_level_mismatch(mesh, options.quantization_bits, &decoder, order)
+    {
+        panic!("final level differs from the quantized input: {diff}");
     }
     // A fresh decode of the whole stream gives the same buffers.
     let whole = decode(&encoded.bytes, None, Limits::default()).unwrap();
