@@ -31,7 +31,8 @@ pub mod samples;
 
 pub use decoder::{decode, Decoder, Limits};
 pub use encoder::{
-    encode, encode_with_progress, BaseTarget, EncodeOptions, EncodeProgress, Encoded,
+    encode, encode_guarded, encode_with_progress, BaseTarget, CandidatePatch, EncodeOptions,
+    EncodeProgress, Encoded, PatchGuard,
 };
 pub use error::{Error, Result};
 pub use format::{Header, LevelInfo, StreamIndex, MAGIC, VERSION};
@@ -40,6 +41,8 @@ pub use mesh::IndexedMesh;
 pub use quantize::Quantization;
 
 // --- import/repair/export (helper) ---
+#[cfg(feature = "import")]
+pub mod ccc;
 #[cfg(feature = "import")]
 pub mod export;
 #[cfg(feature = "import")]

@@ -3,6 +3,7 @@
 
 use std::collections::VecDeque;
 
+use super::{CandidatePatch, PatchGuard};
 use crate::entropy::RangeEncoder;
 use crate::halfedge::{face, next, prev, Connectivity, NONE};
 use crate::patch::{pattern, Pattern, Tag, MAX_VALENCE, NO_TWIN};
@@ -47,13 +48,17 @@ impl PassOutput {
 }
 
 /// The mesh being simplified, with input-vertex ids throughout.
-pub(crate) struct Simplifier {
+pub(crate) struct Simplifier<'g> {
     pub conn: Connectivity,
     /// Input-vertex id of each current vertex (the mesh is compacted per layer).
     pub ids: Vec<u32>,
     pub positions: Vec<[i32; 3]>,
     pub colours: Option<Vec<[u8; 3]>>,
     pub geometric_guard: bool,
+    /// A caller's veto on decimations (the cell complex, a colour metric).
+    pub patch_guard: Option<&'g dyn PatchGuard>,
+    /// Mean face area of the mesh at the start of the pass, for guards.
+    mean_face_area: f64,
     pub live_vertices: usize,
     state: Vec<u8>,
     tag: Vec<Tag>,
@@ -80,12 +85,13 @@ struct Streams {
     models: PassModels,
 }
 
-impl Simplifier {
+impl<'g> Simplifier<'g> {
     pub(crate) fn new(
         conn: Connectivity,
         positions: Vec<[i32; 3]>,
         colours: Option<Vec<[u8; 3]>>,
         geometric_guard: bool,
+        patch_guard: Option<&'g dyn PatchGuard>,
     ) -> Self {
         let n = positions.len();
         Simplifier {
@@ -94,6 +100,8 @@ impl Simplifier {
             positions,
             colours,
             geometric_guard,
+            patch_guard,
+            mean_face_area: 0.0,
             live_vertices: n,
             state: vec![FREE; n],
             tag: vec![Tag::None; n],
@@ -111,6 +119,9 @@ impl Simplifier {
             };
         }
         self.tag.fill(Tag::None);
+        if self.patch_guard.is_some() {
+            self.mean_face_area = self.mean_face_area();
+        }
         self.face_done.clear();
         self.face_done.resize(self.conn.face_count_slots(), false);
         let mut streams = Streams {
@@ -364,7 +375,46 @@ impl Simplifier {
         if self.geometric_guard && self.folds(&patch) {
             return None;
         }
+        if let Some(guard) = self.patch_guard {
+            if !guard.allows(&self.candidate(&patch)) {
+                return None;
+            }
+        }
         Some(patch)
+    }
+
+    fn candidate<'p>(&self, p: &'p Patch) -> CandidatePatch<'p> {
+        let mut polygon = [[0i32; 3]; MAX_VALENCE];
+        let mut polygon_colours = [[0u8; 3]; MAX_VALENCE];
+        for i in 0..p.valence {
+            polygon[i] = self.positions[p.polygon[i] as usize];
+            if let Some(c) = &self.colours {
+                polygon_colours[i] = c[p.polygon[i] as usize];
+            }
+        }
+        CandidatePatch {
+            centre: self.positions[p.centre as usize],
+            centre_colour: self.colours.as_ref().map(|c| c[p.centre as usize]),
+            valence: p.valence,
+            polygon,
+            polygon_colours,
+            triangles: &p.pattern.triangles[..p.pattern.triangle_count()],
+            mean_face_area: self.mean_face_area,
+        }
+    }
+
+    fn mean_face_area(&self) -> f64 {
+        let (mut sum, mut n) = (0.0, 0usize);
+        for t in self.conn.triangles() {
+            let [a, b, c] = t.map(|v| glam::DVec3::from(self.positions[v as usize].map(f64::from)));
+            sum += 0.5 * (b - a).cross(c - a).length();
+            n += 1;
+        }
+        if n == 0 {
+            0.0
+        } else {
+            sum / n as f64
+        }
     }
 
     /// Whether a new triangle would face against the patch (a visible fold).

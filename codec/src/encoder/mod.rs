@@ -7,6 +7,7 @@ use crate::format::{
     write_section, write_varint, ChunkHeader, Header, LevelInfo, BASE_TAG, BATCH_TAG, VERSION,
 };
 use crate::halfedge::connectivity;
+use crate::patch::MAX_VALENCE;
 use crate::quantize::Quantization;
 use crate::{Error, IndexedMesh, Result};
 use conquest::{PassKind, PassOutput, Simplifier};
@@ -82,6 +83,40 @@ pub fn encode(mesh: &IndexedMesh, options: &EncodeOptions) -> Result<Encoded> {
 pub fn encode_with_progress(
     mesh: &IndexedMesh,
     options: &EncodeOptions,
+    progress: impl FnMut(EncodeProgress),
+) -> Result<Encoded> {
+    encode_guarded(mesh, options, None, progress)
+}
+
+/// A caller's veto on decimating a patch: when it refuses, the vertex stays
+/// (a null patch) and the stream records nothing more, so decoders need not
+/// know the guard. Deterministic guards keep encoding deterministic.
+pub trait PatchGuard: Sync {
+    fn allows(&self, patch: &CandidatePatch<'_>) -> bool;
+}
+
+/// A patch the encoder is about to decimate, in quantized coordinates.
+#[derive(Clone, Debug)]
+pub struct CandidatePatch<'a> {
+    /// The vertex that would be removed.
+    pub centre: [i32; 3],
+    pub centre_colour: Option<[u8; 3]>,
+    pub valence: usize,
+    /// Its neighbours, counter-clockwise; the first `valence` are meaningful.
+    pub polygon: [[i32; 3]; MAX_VALENCE],
+    pub polygon_colours: [[u8; 3]; MAX_VALENCE],
+    /// The retriangulation, `valence − 2` counter-clockwise triangles of polygon indices.
+    pub triangles: &'a [[u8; 3]],
+    /// Mean face area of the current level (quantization units squared).
+    pub mean_face_area: f64,
+}
+
+/// [`encode_with_progress`] with a decimation guard (e.g. the cubic cell
+/// complex's, [`crate::ccc`]).
+pub fn encode_guarded(
+    mesh: &IndexedMesh,
+    options: &EncodeOptions,
+    guard: Option<&dyn PatchGuard>,
     mut progress: impl FnMut(EncodeProgress),
 ) -> Result<Encoded> {
     if mesh.triangles.is_empty() {
@@ -121,6 +156,7 @@ pub fn encode_with_progress(
         positions.clone(),
         mesh.colors.clone(),
         options.geometric_guard,
+        guard,
     );
     let mut layers = Vec::new();
     while s.live_vertices > target && layers.len() < options.max_layers as usize {

@@ -274,3 +274,18 @@ mod tests {
         }
     }
 }
+
+/// A photographic colour texture and the file's own texture coordinates: the
+/// colour source the cubic cell complex samples at full resolution. The
+/// triangles are the file's, before welding and repair (a UV seam keeps its
+/// two sides apart here).
+#[derive(Clone, Debug)]
+pub struct TexturedSurface {
+    /// Model units, the same space as the imported mesh's positions.
+    pub positions: Vec<[f32; 3]>,
+    /// One per position. Image convention of glTF: `(0, 0)` is the image's
+    /// top-left corner, `v` grows downward (OBJ's `v` is flipped on import).
+    pub uvs: Vec<[f32; 2]>,
+    pub triangles: Vec<[u32; 3]>,
+    pub image: image::RgbImage,
+}
