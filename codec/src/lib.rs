@@ -47,5 +47,7 @@ pub mod ccc;
 pub mod export;
 #[cfg(feature = "import")]
 pub mod import;
+#[cfg(feature = "import")]
+pub mod metrics;
 pub mod repair;
 // --- end ---

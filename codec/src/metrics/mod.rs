@@ -1,0 +1,68 @@
+//! Quality metrics for a level against the original (issue #5; REFERENCE.md §6).
+//!
+//! - [`hausdorff`]: the symmetric Hausdorff distance between two surfaces,
+//!   estimated Metro-style by dense area-uniform surface sampling (Cignoni,
+//!   Rocchini, Scopigno, "Metro: measuring error on simplified surfaces",
+//!   Computer Graphics Forum 17(2), 1998).
+//! - [`roy_colour_rmse`]: the per-vertex colour RMSE of Roy, Foufou and
+//!   Truchetet, "Mesh comparison using attribute deviation metric" (IJIG 4(1), 2004):
+//!   every vertex of the original against the nearest vertex of the approximation.
+//! - [`image_rmse`]: the image-space luminance RMSE of Lindstrom and Turk,
+//!   "Image-driven simplification" (ACM TOG 19(3), 2000): 24 snapshots from the
+//!   vertices of a small rhombicuboctahedron ([`views::rhombicuboctahedron`]),
+//!   rendered by the CPU rasterizer in [`raster`] so no GPU is needed.
+//!
+//! Everything is deterministic: sampling uses a fixed seed, and the work split
+//! over threads does not change any result.
+
+mod bvh;
+mod colour;
+mod hausdorff;
+mod image_rmse;
+mod kdtree;
+pub mod raster;
+mod sampling;
+pub mod views;
+
+pub use colour::{roy_colour_rmse, ColourError};
+pub use hausdorff::{hausdorff, Hausdorff};
+pub use image_rmse::{image_rmse, image_rmse_per_view};
+pub use raster::{
+    default_shader, render, Camera, ConstantColour, Frame, Lighting, RenderOptions, SurfaceShader,
+    VertexColours,
+};
+
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+/// `f(0..n)` on every available core; results in index order.
+pub(crate) fn parallel_map<T: Send>(n: usize, f: impl Fn(usize) -> T + Sync) -> Vec<T> {
+    let threads = std::thread::available_parallelism()
+        .map_or(1, |t| t.get())
+        .min(n);
+    if threads <= 1 {
+        return (0..n).map(f).collect();
+    }
+    let next = AtomicUsize::new(0);
+    let mut results: Vec<(usize, T)> = std::thread::scope(|scope| {
+        let workers: Vec<_> = (0..threads)
+            .map(|_| {
+                scope.spawn(|| {
+                    let mut done = Vec::new();
+                    loop {
+                        let i = next.fetch_add(1, Ordering::Relaxed);
+                        if i >= n {
+                            return done;
+                        }
+                        done.push((i, f(i)));
+                    }
+                })
+            })
+            .collect();
+        workers
+            .into_iter()
+            .flat_map(|w| w.join().expect("metrics worker panicked"))
+            .collect()
+    });
+    results.sort_unstable_by_key(|(i, _)| *i);
+    results.into_iter().map(|(_, t)| t).collect()
+}
