@@ -1081,3 +1081,515 @@ fn shared_meshes_import_and_repair() {
         );
     }
 }
+
+// ---------------------------------------------------------------- textures
+
+mod textured {
+    use super::*;
+    use image::{ImageBuffer, Luma, Rgb, Rgba};
+    use vitrine_codec::import::{
+        import_path_textured, import_path_textured_with, Imported, TextureOptions,
+    };
+
+    /// A fresh folder for one test's files.
+    fn folder(name: &str) -> PathBuf {
+        let dir = tmp("textured").join(name);
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        dir
+    }
+
+    /// 4 × 2 RGBA image: pixel (x, y) = (60x, 100y, 7, 200).
+    fn rgba_png() -> Vec<u8> {
+        let img = ImageBuffer::from_fn(4, 2, |x, y| Rgba([60 * x as u8, 100 * y as u8, 7, 200]));
+        let mut out = std::io::Cursor::new(Vec::new());
+        img.write_to(&mut out, image::ImageFormat::Png).unwrap();
+        out.into_inner()
+    }
+
+    /// 3 × 5 16-bit grey image: pixel (x, y) = 257 · (10x + 40y).
+    fn grey16_png() -> Vec<u8> {
+        let img = ImageBuffer::from_fn(3, 5, |x, y| Luma([257 * (10 * x + 40 * y) as u16]));
+        let mut out = std::io::Cursor::new(Vec::new());
+        img.write_to(&mut out, image::ImageFormat::Png).unwrap();
+        out.into_inner()
+    }
+
+    fn crc32(data: &[u8]) -> u32 {
+        let mut c = !0u32;
+        for &b in data {
+            c ^= b as u32;
+            for _ in 0..8 {
+                c = if c & 1 != 0 {
+                    0xEDB8_8320 ^ (c >> 1)
+                } else {
+                    c >> 1
+                };
+            }
+        }
+        !c
+    }
+
+    fn chunk(out: &mut Vec<u8>, kind: &[u8; 4], data: &[u8]) {
+        out.extend_from_slice(&(data.len() as u32).to_be_bytes());
+        let start = out.len();
+        out.extend_from_slice(kind);
+        out.extend_from_slice(data);
+        let crc = crc32(&out[start..]);
+        out.extend_from_slice(&crc.to_be_bytes());
+    }
+
+    /// A valid-looking PNG that claims `w` × `h` RGB pixels, with a tiny IDAT.
+    fn bomb_png(w: u32, h: u32) -> Vec<u8> {
+        let mut out = b"\x89PNG\r\n\x1a\n".to_vec();
+        let mut ihdr = Vec::new();
+        ihdr.extend_from_slice(&w.to_be_bytes());
+        ihdr.extend_from_slice(&h.to_be_bytes());
+        ihdr.extend_from_slice(&[8, 2, 0, 0, 0]);
+        chunk(&mut out, b"IHDR", &ihdr);
+        chunk(
+            &mut out,
+            b"IDAT",
+            &[0x78, 0x9c, 0x03, 0x00, 0x00, 0x00, 0x00, 0x01],
+        );
+        chunk(&mut out, b"IEND", &[]);
+        out
+    }
+
+    /// Two triangles over a unit quad whose second triangle has its own
+    /// `vt` on the shared vertex 3 (a UV seam).
+    const QUAD_OBJ: &str = "mtllib  my materials.mtl\n\
+        v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n\
+        vt 0 0\nvt 1 0\nvt 1 1\nvt 0.25 0.75\nvt 0.5 0.5\n\
+        vn 0 0 1\nusemtl skin\n\
+        f 1/1/1 2/2/1 3/3/1\nf 1/1/1 3/5/1 4/4/1\n";
+
+    fn write(dir: &Path, name: &str, data: impl AsRef<[u8]>) {
+        if let Some(parent) = dir.join(name).parent() {
+            std::fs::create_dir_all(parent).unwrap();
+        }
+        std::fs::write(dir.join(name), data).unwrap();
+    }
+
+    fn textured(path: &Path) -> Imported {
+        import_path_textured(path, &opts()).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+    }
+
+    #[test]
+    fn obj_mtl_png() {
+        let dir = folder("obj");
+        write(&dir, "quad.obj", QUAD_OBJ);
+        write(
+            &dir,
+            "my materials.mtl",
+            "newmtl other\nmap_Kd nothere.png\n\nnewmtl skin\nKd 1 1 1\n\
+             map_Kd -s 1 1 1 -clamp on \"tex dir/skin tex.png\"\n",
+        );
+        write(&dir, "tex dir/skin tex.png", rgba_png());
+        let path = dir.join("quad.obj");
+        let got = textured(&path);
+        assert!(got.warnings.is_empty(), "{:?}", got.warnings);
+        // The mesh is exactly what import_path gives.
+        let plain = import_path(&path, &opts()).unwrap();
+        assert_eq!(got.mesh.positions, plain.positions);
+        assert_eq!(got.mesh.triangles, plain.triangles);
+        let t = got.texture.expect("texture");
+        assert_eq!(t.triangles.len(), 2);
+        // Vertex 1 and 3 are shared with the same vt; vertex 3 also has a second vt.
+        assert_eq!(t.positions.len(), 5);
+        assert_eq!(t.uvs.len(), 5);
+        let uv_of =
+            |p: [f32; 3], uv: [f32; 2]| (0..5).any(|i| t.positions[i] == p && t.uvs[i] == uv);
+        assert!(uv_of([0.0, 0.0, 0.0], [0.0, 1.0]), "{:?}", t.uvs); // v flipped
+        assert!(uv_of([0.0, 1.0, 0.0], [0.25, 0.25]), "{:?}", t.uvs);
+        assert!(uv_of([1.0, 1.0, 0.0], [1.0, 0.0]));
+        assert!(uv_of([1.0, 1.0, 0.0], [0.5, 0.5]));
+        for tri in &t.triangles {
+            assert!(tri.iter().all(|&i| (i as usize) < 5));
+        }
+        assert_eq!(t.image.dimensions(), (4, 2));
+        assert_eq!(*t.image.get_pixel(3, 1), Rgb([180, 100, 7])); // alpha dropped
+    }
+
+    #[test]
+    fn obj_without_material_or_uvs_has_no_texture() {
+        let dir = folder("obj-plain");
+        write(&dir, "a.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+        let got = textured(&dir.join("a.obj"));
+        assert!(got.texture.is_none() && got.warnings.is_empty());
+        // A map_Kd but faces without vt: a warning.
+        write(&dir, "b.mtl", "newmtl m\nmap_Kd t.png\n");
+        write(&dir, "t.png", rgba_png());
+        write(
+            &dir,
+            "b.obj",
+            "mtllib b.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl m\nf 1 2 3\n",
+        );
+        let got = textured(&dir.join("b.obj"));
+        assert!(got.texture.is_none());
+        assert!(
+            got.warnings[0].contains("no texture coordinates"),
+            "{:?}",
+            got.warnings
+        );
+        // Bad vt data is an error with its line.
+        write(
+            &dir,
+            "c.obj",
+            "mtllib b.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nusemtl m\nf 1/1 2/1 3/4\n",
+        );
+        let e = import_path_textured(&dir.join("c.obj"), &opts()).unwrap_err();
+        assert!(e.to_string().contains("line 7"), "{e}");
+        assert!(e.to_string().contains("texture coordinate index 4"), "{e}");
+    }
+
+    #[test]
+    fn obj_missing_texture_or_library_is_a_warning() {
+        let dir = folder("obj-missing");
+        write(&dir, "quad.obj", QUAD_OBJ);
+        let path = dir.join("quad.obj");
+        let got = textured(&path);
+        assert!(got.texture.is_none());
+        assert!(got.warnings[0].contains("not found"), "{:?}", got.warnings);
+        write(&dir, "my materials.mtl", "newmtl skin\nmap_Kd skin.jpg\n");
+        let got = textured(&path);
+        assert!(got.texture.is_none());
+        assert!(got.warnings[0].contains("not found"), "{:?}", got.warnings);
+        assert!(got.warnings[0].contains("skin.jpg"), "{:?}", got.warnings);
+        assert_eq!(got.mesh.triangles.len(), 2);
+    }
+
+    #[test]
+    fn obj_reference_outside_the_folder_is_not_followed() {
+        let dir = folder("obj-escape");
+        // A texture outside the model's folder that must not be read…
+        write(&dir, "secret.png", rgba_png());
+        let model = dir.join("model");
+        write(&model, "quad.obj", QUAD_OBJ);
+        write(
+            &model,
+            "my materials.mtl",
+            "newmtl skin\nmap_Kd ../secret.png\n",
+        );
+        let got = textured(&model.join("quad.obj"));
+        assert!(got.texture.is_none());
+        assert!(
+            got.warnings.iter().any(|w| w.contains("outside")),
+            "{:?}",
+            got.warnings
+        );
+        // …but an exporter's absolute path finds the file of that name beside the OBJ.
+        write(
+            &model,
+            "my materials.mtl",
+            "newmtl skin\nmap_Kd C:\\Users\\me\\scans\\skin.png\n",
+        );
+        write(&model, "skin.png", rgba_png());
+        let got = textured(&model.join("quad.obj"));
+        assert_eq!(got.texture.expect("texture").image.dimensions(), (4, 2));
+        assert!(
+            got.warnings[0].contains("beside the model"),
+            "{:?}",
+            got.warnings
+        );
+    }
+
+    /// A textured quad with TEXCOORD_1 (used by the material) as normalized
+    /// ushort, after 4 float positions and 6 ushort indices.
+    fn textured_quad(image: &str, extra_images: &str) -> (String, Vec<u8>) {
+        let mut bin = Vec::new();
+        for p in [
+            [0f32, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [1.0, 1.0, 0.0],
+            [0.0, 1.0, 0.0],
+        ] {
+            for v in p {
+                bin.extend_from_slice(&v.to_le_bytes());
+            }
+        }
+        for i in [0u16, 1, 2, 0, 2, 3] {
+            bin.extend_from_slice(&i.to_le_bytes());
+        }
+        // TEXCOORD_0: garbage floats; TEXCOORD_1: the real one.
+        for _ in 0..8 {
+            bin.extend_from_slice(&9f32.to_le_bytes());
+        }
+        for uv in [[0u16, 65535], [65535, 65535], [65535, 0], [0, 0]] {
+            for v in uv {
+                bin.extend_from_slice(&v.to_le_bytes());
+            }
+        }
+        let json = format!(
+            r#"{{"asset":{{"version":"2.0"}},"scene":0,"scenes":[{{"nodes":[0]}}],
+            "nodes":[{{"mesh":0,"translation":[0,0,5]}}],
+            "meshes":[{{"primitives":[{{"attributes":{{"POSITION":0,"TEXCOORD_0":2,"TEXCOORD_1":3}},
+                "indices":1,"material":0}}]}}],
+            "materials":[{{"pbrMetallicRoughness":{{"baseColorTexture":{{"index":0,"texCoord":1}}}}}}],
+            "textures":[{{"source":0}}],
+            "images":[{image}{extra_images}],
+            "buffers":[BUFFER],
+            "bufferViews":[{{"buffer":0,"byteOffset":0,"byteLength":48}},{{"buffer":0,"byteOffset":48,"byteLength":12}},
+                           {{"buffer":0,"byteOffset":60,"byteLength":32}},{{"buffer":0,"byteOffset":92,"byteLength":16}}
+                           IMAGEVIEW],
+            "accessors":[{{"bufferView":0,"componentType":5126,"count":4,"type":"VEC3","min":[0,0,0],"max":[1,1,0]}},
+                         {{"bufferView":1,"componentType":5123,"count":6,"type":"SCALAR"}},
+                         {{"bufferView":2,"componentType":5126,"count":4,"type":"VEC2"}},
+                         {{"bufferView":3,"componentType":5123,"normalized":true,"count":4,"type":"VEC2"}}]}}"#
+        );
+        (json, bin)
+    }
+
+    fn check_quad(got: &Imported, size: (u32, u32)) -> image::RgbImage {
+        assert!(got.warnings.is_empty(), "{:?}", got.warnings);
+        let t = got.texture.clone().expect("texture");
+        assert_eq!(t.positions, got.mesh.positions);
+        assert_eq!(t.positions[2], [1.0, 1.0, 5.0]);
+        assert_eq!(t.triangles, vec![[0, 1, 2], [0, 2, 3]]);
+        assert_eq!(t.uvs, vec![[0.0, 1.0], [1.0, 1.0], [1.0, 0.0], [0.0, 0.0]]);
+        assert_eq!(t.image.dimensions(), size);
+        t.image
+    }
+
+    #[test]
+    fn glb_image_in_buffer_view() {
+        let dir = folder("glb");
+        let png = grey16_png();
+        let (json, mut bin) = textured_quad(r#"{"bufferView":4,"mimeType":"image/png"}"#, "");
+        let json = json
+            .replace(
+                "BUFFER",
+                &format!(r#"{{"byteLength":{}}}"#, 108 + png.len()),
+            )
+            .replace(
+                "IMAGEVIEW",
+                &format!(
+                    r#",{{"buffer":0,"byteOffset":108,"byteLength":{}}}"#,
+                    png.len()
+                ),
+            );
+        bin.extend_from_slice(&png);
+        write(&dir, "quad.glb", glb(&json, &bin));
+        let got = textured(&dir.join("quad.glb"));
+        let image = check_quad(&got, (3, 5));
+        // 16-bit grey → 8-bit RGB.
+        assert_eq!(*image.get_pixel(2, 4), Rgb([180, 180, 180]));
+        assert_eq!(
+            got.mesh.positions,
+            import_path(&dir.join("quad.glb"), &opts())
+                .unwrap()
+                .positions
+        );
+    }
+
+    fn gltf_with(dir: &Path, image: &str) -> PathBuf {
+        let (json, bin) = textured_quad(image, "");
+        let json = json
+            .replace(
+                "BUFFER",
+                &format!(
+                    r#"{{"byteLength":108,"uri":"data:application/octet-stream;base64,{}"}}"#,
+                    base64(&bin)
+                ),
+            )
+            .replace("IMAGEVIEW", "");
+        write(dir, "quad.gltf", json);
+        dir.join("quad.gltf")
+    }
+
+    #[test]
+    fn gltf_image_file_and_data_uri() {
+        let dir = folder("gltf");
+        write(&dir, "maps/skin tex.png", rgba_png());
+        let got = textured(&gltf_with(&dir, r#"{"uri":"maps/skin%20tex.png"}"#));
+        let image = check_quad(&got, (4, 2));
+        assert_eq!(*image.get_pixel(1, 1), Rgb([60, 100, 7]));
+        let uri = format!(
+            r#"{{"uri":"data:image/png;base64,{}"}}"#,
+            base64(&rgba_png())
+        );
+        let got = textured(&gltf_with(&dir, &uri));
+        check_quad(&got, (4, 2));
+        // Without a texture: None, no warning.
+        let (json, bin) = textured_quad(r#"{"uri":"x.png"}"#, "");
+        let json = json
+            .replace(r#","material":0"#, "")
+            .replace(
+                "BUFFER",
+                &format!(
+                    r#"{{"byteLength":108,"uri":"data:;base64,{}"}}"#,
+                    base64(&bin)
+                ),
+            )
+            .replace("IMAGEVIEW", "");
+        write(&dir, "plain.gltf", json);
+        let got = textured(&dir.join("plain.gltf"));
+        assert!(
+            got.texture.is_none() && got.warnings.is_empty(),
+            "{:?}",
+            got.warnings
+        );
+    }
+
+    #[test]
+    fn gltf_missing_image_is_a_warning() {
+        let dir = folder("gltf-missing");
+        let got = textured(&gltf_with(&dir, r#"{"uri":"gone.jpg"}"#));
+        assert!(got.texture.is_none());
+        assert!(got.warnings[0].contains("not found"), "{:?}", got.warnings);
+        assert_eq!(got.mesh.triangles.len(), 2);
+    }
+
+    #[test]
+    fn gltf_traversal_uri_is_refused() {
+        let dir = folder("gltf-escape");
+        write(&dir, "secret.png", rgba_png());
+        let model = dir.join("model");
+        std::fs::create_dir_all(&model).unwrap();
+        for uri in [
+            "../secret.png",
+            "sub/%2e%2e/%2e%2e/secret.png",
+            "/etc/passwd",
+            "file:///etc/passwd",
+        ] {
+            let path = gltf_with(&model, &format!(r#"{{"uri":"{uri}"}}"#));
+            match import_path_textured(&path, &opts()) {
+                Err(e @ Error::Input { .. }) => {
+                    let e = e.to_string();
+                    assert!(e.contains("image 0") && e.contains(uri), "{e}");
+                }
+                other => panic!("{uri}: {other:?}"),
+            }
+        }
+    }
+
+    #[test]
+    fn bomb_and_corrupt_images_are_refused() {
+        let dir = folder("bomb");
+        write(&dir, "quad.obj", QUAD_OBJ);
+        write(&dir, "my materials.mtl", "newmtl skin\nmap_Kd skin.png\n");
+        let path = dir.join("quad.obj");
+        // A header claiming 10^10 pixels: refused from the header, at once.
+        write(&dir, "skin.png", bomb_png(100_000, 100_000));
+        let t = Instant::now();
+        match import_path_textured(&path, &opts()) {
+            Err(Error::Limit(m)) => assert!(m.contains("100000 × 100000"), "{m}"),
+            other => panic!("{other:?}"),
+        }
+        assert!(t.elapsed().as_millis() < 500, "{:?}", t.elapsed());
+        // Within the pixel budget but a lie about its data: a decoding error.
+        write(&dir, "skin.png", bomb_png(300, 200));
+        match import_path_textured(&path, &opts()) {
+            Err(e @ Error::Input { .. }) => assert!(e.to_string().contains("skin.png"), "{e}"),
+            other => panic!("{other:?}"),
+        }
+        // A smaller budget refuses a real image.
+        write(&dir, "skin.png", rgba_png());
+        let small = TextureOptions {
+            max_texture_pixels: 7,
+        };
+        match import_path_textured_with(&path, &opts(), &small) {
+            Err(Error::Limit(m)) => assert!(m.contains("4 × 2 = 8 pixels"), "{m}"),
+            other => panic!("{other:?}"),
+        }
+        // Truncated and garbage images.
+        let png = rgba_png();
+        write(&dir, "skin.png", &png[..png.len() / 2]);
+        assert!(matches!(
+            import_path_textured(&path, &opts()),
+            Err(Error::Input { .. })
+        ));
+        write(&dir, "skin.png", b"GIF89a this is not a png");
+        let got = textured(&path);
+        assert!(got.texture.is_none());
+        assert!(
+            got.warnings[0].contains("only PNG and JPEG"),
+            "{:?}",
+            got.warnings
+        );
+        write(&dir, "skin.png", b"\xff\xd8\xff\xe0 not really a jpeg");
+        assert!(import_path_textured(&path, &opts()).is_err());
+        // The same bomb inside a GLB.
+        let png = bomb_png(65_536, 65_536);
+        let (json, mut bin) = textured_quad(r#"{"bufferView":4,"mimeType":"image/png"}"#, "");
+        let json = json
+            .replace(
+                "BUFFER",
+                &format!(r#"{{"byteLength":{}}}"#, 108 + png.len()),
+            )
+            .replace(
+                "IMAGEVIEW",
+                &format!(
+                    r#",{{"buffer":0,"byteOffset":108,"byteLength":{}}}"#,
+                    png.len()
+                ),
+            );
+        bin.extend_from_slice(&png);
+        write(&dir, "bomb.glb", glb(&json, &bin));
+        assert!(matches!(
+            import_path_textured(&dir.join("bomb.glb"), &opts()),
+            Err(Error::Limit(_))
+        ));
+    }
+
+    #[test]
+    fn other_formats_have_no_texture() {
+        let dir = folder("ply");
+        write(&dir, "a.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n");
+        let got = textured(&dir.join("a.off"));
+        assert!(got.texture.is_none() && got.warnings.is_empty());
+        assert_eq!(got.mesh.triangles.len(), 1);
+    }
+
+    #[test]
+    fn shared_textured_scans() {
+        let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/data/meshes");
+        let scans = [
+            ("mask/mask-gltf-2.0_separated-valid.gltf", (4096, 4096)),
+            ("banana/textured_simple_reoriented.obj", (0, 0)),
+        ];
+        for (name, size) in scans {
+            let path = dir.join(name);
+            if !path.exists() {
+                eprintln!("note: {} is absent; skipped", path.display());
+                continue;
+            }
+            let t = Instant::now();
+            let got = textured(&path);
+            let elapsed = t.elapsed();
+            assert!(got.warnings.is_empty(), "{name}: {:?}", got.warnings);
+            let tex = got
+                .texture
+                .as_ref()
+                .unwrap_or_else(|| panic!("{name}: no texture"));
+            if size != (0, 0) {
+                assert_eq!(tex.image.dimensions(), size, "{name}");
+            }
+            assert_eq!(tex.uvs.len(), tex.positions.len());
+            assert!(tex.uvs.iter().flatten().all(|v| v.is_finite()));
+            let n = tex.positions.len() as u32;
+            assert!(tex.triangles.iter().flatten().all(|&i| i < n));
+            assert_eq!(tex.triangles.len(), got.mesh.triangles.len(), "{name}");
+            let inside = tex
+                .uvs
+                .iter()
+                .filter(|uv| uv.iter().all(|&v| (-1e-3..=1.001).contains(&v)))
+                .count();
+            let (w, h) = tex.image.dimensions();
+            let mean = tex.image.pixels().fold([0u64; 3], |m, p| {
+                [m[0] + p[0] as u64, m[1] + p[1] as u64, m[2] + p[2] as u64]
+            });
+            let px = (w as u64 * h as u64).max(1);
+            eprintln!(
+                "{name}: mesh {} vertices / {} triangles; textured surface {} vertices \
+                 ({} UVs in [0,1]), {} triangles; image {w}×{h}, mean RGB {:?}; {elapsed:.0?}",
+                got.mesh.positions.len(),
+                got.mesh.triangles.len(),
+                tex.positions.len(),
+                inside,
+                tex.triangles.len(),
+                mean.map(|c| c / px),
+            );
+        }
+    }
+}

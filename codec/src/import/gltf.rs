@@ -12,6 +12,11 @@
 //! file without scenes, or whose scene instances no mesh, gives all meshes
 //! untransformed. `COLOR_0` is linear RGB per the glTF specification and is
 //! converted to the sRGB bytes that [`IndexedMesh::colors`] holds.
+//!
+//! [`read_textured`] also reads the primitives' `baseColorTexture` image and
+//! their `TEXCOORD_n` (the `texCoord` of the texture reference); only then
+//! are images decoded, through [`super::texture`]. `KHR_texture_transform`
+//! is ignored.
 
 use std::borrow::Cow;
 use std::path::{Component, Path};
@@ -20,7 +25,8 @@ use gltf::accessor::DataType;
 use gltf::buffer::Source;
 use gltf::mesh::{Mode, Semantic};
 
-use super::{push_triangle, ImportOptions, MeshFormat};
+use super::texture;
+use super::{push_triangle, ImportOptions, MeshFormat, TexturedSurface};
 use crate::{Error, IndexedMesh, Result};
 
 type Mat4 = [[f64; 4]; 4];
@@ -411,6 +417,43 @@ pub(super) fn read(
     base: Option<&Path>,
     opts: &ImportOptions,
 ) -> Result<IndexedMesh> {
+    read_inner(bytes, format, base, opts, None).map(|(mesh, _)| mesh)
+}
+
+/// [`read`] plus the base colour texture and the texture coordinates of the
+/// primitives that use it. Warnings go to `warnings`.
+pub(super) fn read_textured(
+    bytes: &[u8],
+    format: MeshFormat,
+    base: &Path,
+    opts: &ImportOptions,
+    max_pixels: u64,
+    warnings: &mut Vec<String>,
+) -> Result<(IndexedMesh, Option<TexturedSurface>)> {
+    read_inner(
+        bytes,
+        format,
+        Some(base),
+        opts,
+        Some((max_pixels, warnings)),
+    )
+}
+
+/// A primitive with a base colour texture, in the combined mesh.
+struct TexturedPrimitive {
+    vertices: std::ops::Range<usize>,
+    triangles: std::ops::Range<usize>,
+    image: usize,
+    uvs: Vec<[f32; 2]>,
+}
+
+fn read_inner(
+    bytes: &[u8],
+    format: MeshFormat,
+    base: Option<&Path>,
+    opts: &ImportOptions,
+    mut textured: Option<(u64, &mut Vec<String>)>,
+) -> Result<(IndexedMesh, Option<TexturedSurface>)> {
     let what = if bytes.starts_with(b"glTF") {
         MeshFormat::Glb.name()
     } else {
@@ -472,6 +515,9 @@ pub(super) fn read(
     let mut colors: Vec<[u8; 3]> = Vec::new();
     let mut any_colour = false;
     let mut triangles: Vec<[u32; 3]> = Vec::new();
+    let mut textured_prims: Vec<TexturedPrimitive> = Vec::new();
+    // Triangles whose material has a texture but no such TEXCOORD_n.
+    let mut without_uvs = 0usize;
     for (mesh, world) in &instances {
         for prim in mesh.primitives() {
             let mode = prim.mode();
@@ -487,9 +533,31 @@ pub(super) fn read(
             let ctx = format!("mesh {} primitive {}", mesh.index(), prim.index());
             let colour_acc = prim.get(&Semantic::Colors(0));
             let index_acc = prim.indices();
-            for acc in [Some(&pos_acc), colour_acc.as_ref(), index_acc.as_ref()]
-                .into_iter()
-                .flatten()
+            // (image, TEXCOORD_n accessor) of a textured primitive.
+            let texture = match &textured {
+                Some(_) => prim
+                    .material()
+                    .pbr_metallic_roughness()
+                    .base_color_texture()
+                    .map(|info| {
+                        let set = info.tex_coord();
+                        (
+                            info.texture().source().index(),
+                            set,
+                            prim.get(&Semantic::TexCoords(set)),
+                        )
+                    }),
+                None => None,
+            };
+            let uv_acc = texture.as_ref().and_then(|t| t.2.as_ref());
+            for acc in [
+                Some(&pos_acc),
+                colour_acc.as_ref(),
+                index_acc.as_ref(),
+                uv_acc,
+            ]
+            .into_iter()
+            .flatten()
             {
                 if let Some(view) = acc.view() {
                     buffers.load(&view.buffer())?;
@@ -553,6 +621,33 @@ pub(super) fn read(
                 None => {}
             }
 
+            let uvs = match uv_acc {
+                Some(acc) => {
+                    let set = texture.as_ref().map_or(0, |t| t.1);
+                    let t = open(acc, &buffers, what)?;
+                    if t.dims != 2 || t.count != n {
+                        return Err(Error::input(
+                            what,
+                            format!("{ctx}: TEXCOORD_{set} must be VEC2 with one value per vertex"),
+                        ));
+                    }
+                    let mut uvs = Vec::with_capacity(n);
+                    for i in 0..n {
+                        let uv = [t.value(i, 0) as f32, t.value(i, 1) as f32];
+                        if !uv.iter().all(|v| v.is_finite()) {
+                            return Err(Error::input(
+                                what,
+                                format!("{ctx}: TEXCOORD_{set} {i} is not finite {uv:?}"),
+                            ));
+                        }
+                        uvs.push(uv);
+                    }
+                    Some(uvs)
+                }
+                None => None,
+            };
+            let first_triangle = triangles.len();
+
             let flip = det3(world) < 0.0;
             let mut emit = |t: [u64; 3], k: usize| -> Result<()> {
                 for &v in &t {
@@ -606,6 +701,16 @@ pub(super) fn read(
                     }
                 }
             }
+            match (texture, uvs) {
+                (Some((image, _, _)), Some(uvs)) => textured_prims.push(TexturedPrimitive {
+                    vertices: base..base + n,
+                    triangles: first_triangle..triangles.len(),
+                    image,
+                    uvs,
+                }),
+                (Some(_), None) => without_uvs += triangles.len() - first_triangle,
+                _ => {}
+            }
         }
     }
     if positions.is_empty() || triangles.is_empty() {
@@ -614,11 +719,122 @@ pub(super) fn read(
             "contains no triangle meshes (empty mesh)",
         ));
     }
-    Ok(IndexedMesh {
+    let mesh = IndexedMesh {
         positions,
         colors: any_colour.then_some(colors),
         triangles,
-    })
+    };
+    let Some((max_pixels, warnings)) = textured.as_mut() else {
+        return Ok((mesh, None));
+    };
+    if without_uvs > 0 {
+        warnings.push(format!(
+            "{without_uvs} {what} triangles have a base colour texture but not its TEXCOORD \
+             attribute; they are left out of the textured surface"
+        ));
+    }
+    // The image covering the most triangles (lowest index on a tie).
+    let mut votes: Vec<(usize, usize)> = Vec::new();
+    for p in &textured_prims {
+        match votes.iter_mut().find(|v| v.0 == p.image) {
+            Some(v) => v.1 += p.triangles.len(),
+            None => votes.push((p.image, p.triangles.len())),
+        }
+    }
+    let Some(&(image_index, used)) = votes
+        .iter()
+        .max_by(|a, b| a.1.cmp(&b.1).then_with(|| b.0.cmp(&a.0)))
+    else {
+        return Ok((mesh, None));
+    };
+    let image = match load_image(&doc, image_index, &mut buffers, what, *max_pixels)? {
+        Ok(image) => image,
+        Err(w) => {
+            warnings.push(w);
+            return Ok((mesh, None));
+        }
+    };
+    let textured_total: usize = votes.iter().map(|v| v.1).sum();
+    if textured_total > used {
+        warnings.push(format!(
+            "{} {what} triangles use another base colour image than image {image_index}; \
+             they are left out of the textured surface",
+            textured_total - used
+        ));
+    }
+
+    let chosen = || textured_prims.iter().filter(|p| p.image == image_index);
+    let nv: usize = chosen().map(|p| p.vertices.len()).sum();
+    let mut surface = TexturedSurface {
+        positions: Vec::with_capacity(nv),
+        uvs: Vec::with_capacity(nv),
+        triangles: Vec::with_capacity(used),
+        image,
+    };
+    for p in chosen() {
+        let offset = surface.positions.len() as u32;
+        let from = p.vertices.start as u32;
+        surface
+            .positions
+            .extend_from_slice(&mesh.positions[p.vertices.clone()]);
+        surface.uvs.extend_from_slice(&p.uvs);
+        surface.triangles.extend(
+            mesh.triangles[p.triangles.clone()]
+                .iter()
+                .map(|t| t.map(|v| v - from + offset)),
+        );
+    }
+    Ok((mesh, Some(surface)))
+}
+
+/// Decodes image `index` of the document (from a buffer view, a `data:` URI
+/// or a file beside the glTF). `Ok(Err(warning))`: absent, or a format
+/// that is not read.
+fn load_image(
+    doc: &gltf::Document,
+    index: usize,
+    buffers: &mut Buffers<'_>,
+    what: &'static str,
+    max_pixels: u64,
+) -> Result<std::result::Result<image::RgbImage, String>> {
+    let Some(image) = doc.images().nth(index) else {
+        return Err(Error::input(what, format!("image {index} does not exist")));
+    };
+    match image.source() {
+        gltf::image::Source::View { view, .. } => {
+            let name = format!("{what} image {index} (buffer view {})", view.index());
+            buffers.load(&view.buffer())?;
+            let data = buffers.get(view.buffer().index());
+            let bytes = view
+                .offset()
+                .checked_add(view.length())
+                .and_then(|end| data.get(view.offset()..end))
+                .ok_or_else(|| {
+                    Error::input(
+                        what,
+                        format!(
+                            "image {index}: buffer view {} ends past its buffer ({} bytes)",
+                            view.index(),
+                            data.len()
+                        ),
+                    )
+                })?;
+            texture::load(texture::Source::Bytes(bytes), &name, max_pixels)
+        }
+        gltf::image::Source::Uri { uri, .. } if uri.starts_with("data:") => {
+            let name = format!("{what} image {index} (data URI)");
+            let bytes = decode_data_uri(uri)
+                .map_err(|e| Error::input(what, format!("image {index}: bad data URI: {e}")))?;
+            texture::load(texture::Source::Bytes(&bytes), &name, max_pixels)
+        }
+        gltf::image::Source::Uri { uri, .. } => {
+            let name = format!("{what} image {index} ({uri:?})");
+            let rel = relative_uri_path(uri)
+                .map_err(|e| Error::input(what, format!("image {index}: uri {uri:?}: {e}")))?;
+            let base = buffers.base.unwrap_or_else(|| Path::new("."));
+            texture::load(texture::Source::File(&base.join(rel)), &name, max_pixels)
+        }
+    }
 }
 
 #[cfg(test)]

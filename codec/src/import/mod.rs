@@ -9,6 +9,10 @@
 //! Importers do not clean the mesh: duplicate positions, degenerate faces and
 //! non-manifold configurations come out as they are in the file. Run
 //! [`crate::repair::prepare`] before encoding.
+//!
+//! [`import_path_textured`] also reads the colour texture of a scan (OBJ
+//! `map_Kd`, glTF `baseColorTexture`) with the file's own texture
+//! coordinates, as a [`TexturedSurface`].
 
 use std::path::Path;
 
@@ -18,6 +22,7 @@ mod gltf;
 mod obj;
 mod off;
 mod ply;
+mod texture;
 
 pub(crate) use gltf::srgb_u8_to_linear;
 
@@ -122,20 +127,7 @@ impl Default for ImportOptions {
 /// (`.bin`) are read from beside it; image files are never read.
 pub fn import_path(path: &Path, opts: &ImportOptions) -> Result<IndexedMesh> {
     let bytes = std::fs::read(path).map_err(|e| with_path(e, path))?;
-    let format = match MeshFormat::from_path(path) {
-        // A GLB named .gltf (or the reverse) is read as what it is.
-        Some(MeshFormat::Gltf | MeshFormat::Glb) if bytes.starts_with(b"glTF") => MeshFormat::Glb,
-        Some(MeshFormat::Glb) if MeshFormat::sniff(&bytes) == Some(MeshFormat::Gltf) => {
-            MeshFormat::Gltf
-        }
-        Some(f) => f,
-        None => MeshFormat::sniff(&bytes).ok_or_else(|| {
-            Error::Unsupported(format!(
-                "{}: unknown mesh format (expected .ply, .obj, .off, .gltf or .glb)",
-                path.display()
-            ))
-        })?,
-    };
+    let format = detect_format(path, &bytes)?;
     match format {
         MeshFormat::Gltf | MeshFormat::Glb => {
             let base = path.parent().unwrap_or_else(|| Path::new("."));
@@ -143,6 +135,119 @@ pub fn import_path(path: &Path, opts: &ImportOptions) -> Result<IndexedMesh> {
         }
         _ => import_bytes(&bytes, format, opts),
     }
+}
+
+/// Budgets for the texture image of [`import_path_textured_with`].
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct TextureOptions {
+    /// Most pixels (width × height) a texture may have (default 64 Mpx =
+    /// 8192²). Checked against the image header before decoding; the
+    /// decoder then runs under an allocation budget sized for the image.
+    pub max_texture_pixels: u64,
+}
+
+impl Default for TextureOptions {
+    fn default() -> Self {
+        TextureOptions {
+            max_texture_pixels: 8192 * 8192,
+        }
+    }
+}
+
+/// A mesh file read with its colour texture, by [`import_path_textured`].
+#[derive(Clone, Debug)]
+pub struct Imported {
+    /// Exactly what [`import_path`] returns for the same file.
+    pub mesh: IndexedMesh,
+    /// The colour texture with the file's texture coordinates; `None` for
+    /// formats without textures (PLY, OFF), models without one, and
+    /// textures that could not be found (see `warnings`).
+    pub texture: Option<TexturedSurface>,
+    /// What was skipped and why, in words: a missing texture or material
+    /// file, an image format that is not read, triangles left out of the
+    /// textured surface, a reference that pointed outside the model's folder.
+    pub warnings: Vec<String>,
+}
+
+/// [`import_path`] plus the model's colour texture, with default
+/// [`TextureOptions`].
+///
+/// * OBJ: the `mtllib` files (beside the OBJ), the materials' `map_Kd`
+///   image (options such as `-s 1 1 1` before the name are skipped; names
+///   may hold spaces or be quoted), `vt` and the corners' `vt` indices. `v`
+///   is flipped to the image convention.
+/// * glTF/GLB: the primitives' material `pbrMetallicRoughness.baseColorTexture`
+///   image (a file beside the `.gltf`, a `data:` URI, or a buffer view), read
+///   through `TEXCOORD_n` with the texture's `texCoord`. `KHR_texture_transform`
+///   is ignored: the UVs are those of the file.
+///
+/// A model has one texture here: when materials use several images, the
+/// one covering the most triangles is read and the other triangles are left
+/// out of [`TexturedSurface::triangles`] (with a warning).
+///
+/// Geometry comes first: a missing texture or material file, or an image in
+/// a format other than PNG and JPEG, gives `texture: None` and a warning.
+/// A texture that is present but malformed, or larger than
+/// [`TextureOptions::max_texture_pixels`], is an error, as is a glTF image
+/// URI that is absolute or leaves the model's folder (`..`), like its
+/// buffers. OBJ/MTL files often carry the exporting machine's absolute path
+/// (`C:\scans\vase.jpg`): such a reference, or one with `..`, is never
+/// followed; only its file name is looked for beside the OBJ, with a warning.
+pub fn import_path_textured(path: &Path, opts: &ImportOptions) -> Result<Imported> {
+    import_path_textured_with(path, opts, &TextureOptions::default())
+}
+
+/// [`import_path_textured`] with explicit texture budgets.
+pub fn import_path_textured_with(
+    path: &Path,
+    opts: &ImportOptions,
+    tex: &TextureOptions,
+) -> Result<Imported> {
+    let bytes = std::fs::read(path).map_err(|e| with_path(e, path))?;
+    let format = detect_format(path, &bytes)?;
+    let base = path.parent().unwrap_or_else(|| Path::new("."));
+    let base = if base.as_os_str().is_empty() {
+        Path::new(".")
+    } else {
+        base
+    };
+    let mut warnings = Vec::new();
+    let (mesh, texture) = match format {
+        MeshFormat::Obj => {
+            obj::read_textured(&bytes, opts, base, tex.max_texture_pixels, &mut warnings)?
+        }
+        MeshFormat::Gltf | MeshFormat::Glb => gltf::read_textured(
+            &bytes,
+            format,
+            base,
+            opts,
+            tex.max_texture_pixels,
+            &mut warnings,
+        )?,
+        _ => (import_bytes(&bytes, format, opts)?, None),
+    };
+    Ok(Imported {
+        mesh,
+        texture,
+        warnings,
+    })
+}
+
+fn detect_format(path: &Path, bytes: &[u8]) -> Result<MeshFormat> {
+    Ok(match MeshFormat::from_path(path) {
+        // A GLB named .gltf (or the reverse) is read as what it is.
+        Some(MeshFormat::Gltf | MeshFormat::Glb) if bytes.starts_with(b"glTF") => MeshFormat::Glb,
+        Some(MeshFormat::Glb) if MeshFormat::sniff(bytes) == Some(MeshFormat::Gltf) => {
+            MeshFormat::Gltf
+        }
+        Some(f) => f,
+        None => MeshFormat::sniff(bytes).ok_or_else(|| {
+            Error::Unsupported(format!(
+                "{}: unknown mesh format (expected .ply, .obj, .off, .gltf or .glb)",
+                path.display()
+            ))
+        })?,
+    })
 }
 
 /// Reads a mesh from memory. glTF JSON input must be self-contained (buffers
