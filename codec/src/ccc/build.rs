@@ -105,11 +105,12 @@ pub(crate) fn sample_bilinear(image: &image::RgbImage, uv: DVec2) -> [f64; 3] {
 }
 
 /// The default cube edge: the thesis picks it per model (30 units for small
-/// objects, 6 for statues); here it follows the vertex count so a cell holds
-/// a few hundred vertices at any scale, and the grid stays within 24-bit numbers.
+/// objects, 6 for statues); here it follows the vertex count.
 fn default_cell_size(extent: DVec3, vertices: usize) -> f64 {
     let longest = extent.max_element().max(f64::MIN_POSITIVE);
-    let cubes = (2.5 * (vertices as f64).powf(0.3)).clamp(8.0, 200.0);
+    // About the edge length of a base mesh with 1 % of the vertices: the
+    // guard then rarely fires (measured in BENCHMARKS.md).
+    let cubes = (0.16 * (vertices as f64).sqrt()).clamp(12.0, 200.0);
     longest / cubes
 }
 
@@ -413,7 +414,10 @@ fn render_cell(
     let mut tiles: [Option<Vec<[u8; 3]>>; FACES] = Default::default();
     let (mut ambiguous, mut covered) = (0u64, 0u64);
     let mut sum = [0.0f64; 3];
+    let local_min = |p: DVec3| (p - min) / s;
+    let mut bins = TexelBins::default();
     for (face, slot) in tiles.iter_mut().enumerate() {
+        bins.fill(face, centre, t, local.iter().map(|r| [r.v0, r.v0 + r.e1, r.v0 + r.e2].map(local_min)));
         let mut texels: Vec<Option<[f64; 3]>> = vec![None; t * t];
         for j in 0..t {
             for i in 0..t {
@@ -421,7 +425,8 @@ fn render_cell(
                 let dir = (face_point(face, uv) - centre) * s;
                 let mut first: Option<(f64, usize, [f64; 3])> = None;
                 let (mut near, mut far) = (f64::INFINITY, f64::NEG_INFINITY);
-                for tri in &local {
+                for &k in bins.texel(j * t + i) {
+                    let tri = &local[k as usize];
                     let Some((h, bary)) = tri.hit(origin, dir) else {
                         continue;
                     };
@@ -462,6 +467,84 @@ fn render_cell(
         ambiguous,
         covered,
     )
+}
+
+/// Triangles that may cover each texel of one face's tile: the bounding
+/// box of each triangle's central projection onto the face (the whole tile
+/// when the triangle reaches behind the face's half-space), in CSR form.
+#[derive(Default)]
+struct TexelBins {
+    start: Vec<u32>,
+    items: Vec<u32>,
+    ranges: Vec<(u32, [usize; 4])>,
+}
+
+impl TexelBins {
+    /// `triangles`: corners in cube units.
+    fn fill(&mut self, face: usize, centre: DVec3, t: usize, triangles: impl Iterator<Item = [DVec3; 3]>) {
+        let axis = face / 2;
+        let sign = if face % 2 == 0 { 1.0 } else { -1.0 };
+        let plane = if face % 2 == 0 { 1.0 } else { 0.0 };
+        let depth = sign * (plane - centre[axis]);
+        let (b0, b1) = match axis {
+            0 => (1, 2),
+            1 => (0, 2),
+            _ => (0, 1),
+        };
+        self.ranges.clear();
+        for (k, tri) in triangles.enumerate() {
+            let w = tri.map(|p| sign * (p[axis] - centre[axis]));
+            if w.iter().all(|&w| w <= 0.0) {
+                continue;
+            }
+            let range = if w.iter().all(|&w| w > 1e-9) {
+                let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+                for (p, w) in tri.iter().zip(w) {
+                    let scale = depth / w;
+                    for (d, b) in [b0, b1].into_iter().enumerate() {
+                        let x = (centre[b] + (p[b] - centre[b]) * scale) * t as f64 - 0.5;
+                        lo[d] = lo[d].min(x);
+                        hi[d] = hi[d].max(x);
+                    }
+                }
+                let first = |x: f64| (x - 1e-6).ceil().clamp(0.0, t as f64) as usize;
+                let last = |x: f64| ((x + 1e-6).floor() + 1.0).clamp(0.0, t as f64) as usize;
+                [first(lo[0]), last(hi[0]), first(lo[1]), last(hi[1])]
+            } else {
+                [0, t, 0, t]
+            };
+            if range[0] < range[1] && range[2] < range[3] {
+                self.ranges.push((k as u32, range));
+            }
+        }
+        self.start.clear();
+        self.start.resize(t * t + 1, 0);
+        for (_, [i0, i1, j0, j1]) in &self.ranges {
+            for j in *j0..*j1 {
+                for i in *i0..*i1 {
+                    self.start[j * t + i + 1] += 1;
+                }
+            }
+        }
+        for i in 0..t * t {
+            self.start[i + 1] += self.start[i];
+        }
+        self.items.clear();
+        self.items.resize(self.start[t * t] as usize, 0);
+        let mut at = self.start.clone();
+        for (k, [i0, i1, j0, j1]) in &self.ranges {
+            for j in *j0..*j1 {
+                for i in *i0..*i1 {
+                    self.items[at[j * t + i] as usize] = *k;
+                    at[j * t + i] += 1;
+                }
+            }
+        }
+    }
+
+    fn texel(&self, i: usize) -> &[u32] {
+        &self.items[self.start[i] as usize..self.start[i + 1] as usize]
+    }
 }
 
 /// Fills texels no ray coloured with the mean of their coloured neighbours,
