@@ -3,12 +3,18 @@
 //! commit; a crash or kill before it leaves no trace.
 
 use crate::storage::{
-    valid_slug, NewCompression, NewLevel, NewModel, OnExisting, Storage, StoredModel,
+    valid_slug, NewCompression, NewLevel, NewModel, NewTexture, NewTextureMapping, OnExisting,
+    Storage, StoredModel,
 };
 use anyhow::{bail, Context};
 use serde_json::json;
+use std::sync::Arc;
 use std::time::{Duration, Instant};
-use vitrine_codec::{BaseTarget, EncodeOptions, IndexedMesh, StreamIndex};
+use vitrine_codec::ccc::{
+    encode_with_ccc, CccOptions, CccParameters, CccReport, ColourSource, TextureMapping,
+};
+use vitrine_codec::import::TexturedSurface;
+use vitrine_codec::{BaseTarget, EncodeOptions, Encoded, IndexedMesh, StreamIndex};
 
 /// What a model is called and who may see it.
 #[derive(Clone, Debug)]
@@ -52,8 +58,44 @@ pub struct SourceInfo {
 #[derive(Clone, Debug, Default)]
 pub struct IngestOptions {
     pub encode: EncodeOptions,
+    /// How the model's colour travels.
+    pub colour: ColourMode,
     /// Test hook: wait this long inside the open transaction before committing.
     pub pause_before_commit: Option<Duration>,
+}
+
+/// How a model's colour is stored.
+#[derive(Clone, Debug, Default)]
+pub enum ColourMode {
+    /// Per-vertex colour in the stream, if the mesh has any (`vertex`).
+    #[default]
+    Vertex,
+    /// No colour at all (`none`): the viewer shows clay.
+    None,
+    /// A cubic cell complex (`ccc`, `codec/CCC.md`): colour in a cell and a
+    /// colour texture shared by every level, the stream geometry only, and
+    /// decimation kept inside the complex. The colour comes from `texture`
+    /// (a photographic texture through the file's UVs) or, without one, from
+    /// the mesh's per-vertex colour.
+    Ccc {
+        options: CccOptions,
+        texture: Option<Arc<TexturedSurface>>,
+    },
+}
+
+impl ColourMode {
+    /// `vertex`, `none` or `ccc` (default complex options).
+    pub fn parse(name: &str) -> Option<ColourMode> {
+        match name {
+            "vertex" => Some(ColourMode::Vertex),
+            "none" => Some(ColourMode::None),
+            "ccc" => Some(ColourMode::Ccc {
+                options: CccOptions::default(),
+                texture: None,
+            }),
+            _ => None,
+        }
+    }
 }
 
 #[derive(Clone, Debug)]
@@ -65,36 +107,121 @@ pub struct IngestReport {
     pub full_vertices: u32,
     pub stream_bytes: usize,
     pub encode_time: Duration,
+    /// The complex, in `ccc` mode.
+    pub ccc: Option<CccReport>,
 }
 
 /// Encodes `mesh` (already repaired: see `vitrine_codec::repair::prepare`)
-/// and stores it as a new model or model version.
+/// in the chosen colour mode and stores it as a new model or model version.
 pub async fn ingest_mesh(
     storage: &dyn Storage,
-    mesh: IndexedMesh,
+    mut mesh: IndexedMesh,
     meta: ModelMeta,
     options: &IngestOptions,
 ) -> anyhow::Result<IngestReport> {
-    if !valid_slug(&meta.slug) {
-        bail!(
-            "slug {:?} must be 1–64 of a-z, 0-9 and '-', not starting or ending with '-'",
-            meta.slug
-        );
+    check_slug(&meta.slug)?;
+    let source = source_info(&meta, &mesh);
+    let encode_options = options.encode.clone();
+    let colour = options.colour.clone();
+    if let ColourMode::Ccc { texture: None, .. } = &colour {
+        if mesh.colors.is_none() {
+            bail!("colour mode ccc needs colour: the mesh has no per-vertex colour and no texture was given");
+        }
     }
-    let source = meta.source.clone().unwrap_or_else(|| SourceInfo {
+    let started = Instant::now();
+    let (encoded, mapping) = tokio::task::spawn_blocking(move || match colour {
+        ColourMode::Vertex => vitrine_codec::encode(&mesh, &encode_options).map(|e| (e, None)),
+        ColourMode::None => {
+            mesh.colors = None;
+            vitrine_codec::encode(&mesh, &encode_options).map(|e| (e, None))
+        }
+        ColourMode::Ccc { options, texture } => {
+            let source = match &texture {
+                Some(t) => ColourSource::Texture(t),
+                None => ColourSource::PerVertex(&mesh),
+            };
+            encode_with_ccc(&mesh, &encode_options, source, &options, |_| {})
+                .map(|(e, m)| (e, Some(m)))
+        }
+    })
+    .await
+    .context("encoder task failed")?
+    .context("encoding failed")?;
+    let encode_time = started.elapsed();
+    store(
+        storage,
+        &encoded,
+        encode_time,
+        mapping.as_ref(),
+        meta,
+        source,
+        options,
+    )
+    .await
+}
+
+/// Stores a stream the caller encoded, with its CCC colour mapping if it has
+/// one (built for the same mesh and quantization, and the stream encoded
+/// under its guard: `vitrine_codec::ccc::encode_with_ccc`). The mapping's
+/// three images and parameters go into the same transaction as the model;
+/// they are checked against the parameters first.
+pub async fn ingest_encoded(
+    storage: &dyn Storage,
+    encoded: &Encoded,
+    encode_time: Duration,
+    mapping: Option<&TextureMapping>,
+    meta: ModelMeta,
+    options: &IngestOptions,
+) -> anyhow::Result<IngestReport> {
+    check_slug(&meta.slug)?;
+    let final_level = encoded.header.final_level();
+    let source = meta.source.clone().unwrap_or(SourceInfo {
+        name: String::new(),
+        vertices: u64::from(final_level.vertices),
+        faces: u64::from(final_level.faces),
+        repair: None,
+    });
+    store(
+        storage,
+        encoded,
+        encode_time,
+        mapping,
+        meta,
+        source,
+        options,
+    )
+    .await
+}
+
+fn check_slug(slug: &str) -> anyhow::Result<()> {
+    if !valid_slug(slug) {
+        bail!("slug {slug:?} must be 1–64 of a-z, 0-9 and '-', not starting or ending with '-'");
+    }
+    Ok(())
+}
+
+fn source_info(meta: &ModelMeta, mesh: &IndexedMesh) -> SourceInfo {
+    meta.source.clone().unwrap_or_else(|| SourceInfo {
         name: String::new(),
         vertices: mesh.vertex_count() as u64,
         faces: mesh.face_count() as u64,
         repair: None,
-    });
-    let encode_options = options.encode.clone();
-    let started = Instant::now();
-    let encoded =
-        tokio::task::spawn_blocking(move || vitrine_codec::encode(&mesh, &encode_options))
-            .await
-            .context("encoder task failed")?
-            .context("encoding failed")?;
-    let encode_time = started.elapsed();
+    })
+}
+
+async fn store(
+    storage: &dyn Storage,
+    encoded: &Encoded,
+    encode_time: Duration,
+    mapping: Option<&TextureMapping>,
+    meta: ModelMeta,
+    source: SourceInfo,
+    options: &IngestOptions,
+) -> anyhow::Result<IngestReport> {
+    let mapping = mapping
+        .map(new_mapping)
+        .transpose()
+        .context("the colour mapping is not storable")?;
     let index =
         StreamIndex::parse(&encoded.bytes).context("encoder produced an unreadable stream")?;
     let levels = &index.header.levels;
@@ -124,11 +251,12 @@ pub async fn ingest_mesh(
         source_faces: source.faces,
         compression: NewCompression {
             codec_version: index.header.version,
-            options: encode_options_json(&options.encode).to_string(),
+            options: encode_options_json(&options.encode, &options.colour).to_string(),
             stats: json!({
                 "bits_per_vertex": encoded.bytes.len() as f64 * 8.0 / f64::from(full.vertices.max(1)),
                 "encode_ms": encode_time.as_millis() as u64,
                 "repair": source.repair,
+                "ccc": mapping.as_ref().map(|m| m.1),
             })
             .to_string(),
             quantization_bits: index.header.quantization.bits,
@@ -138,6 +266,7 @@ pub async fn ingest_mesh(
             base: level(0, &index.base),
             batches: index.batches.iter().enumerate().map(|(k, r)| level(k + 1, r)).collect(),
         },
+        mapping: mapping.as_ref().map(|m| m.0.clone()),
     };
     let staged = storage
         .stage_model(&new)
@@ -163,10 +292,11 @@ pub async fn ingest_mesh(
         full_vertices: full.vertices,
         stream_bytes: encoded.bytes.len(),
         encode_time,
+        ccc: mapping.map(|m| m.1),
     })
 }
 
-fn encode_options_json(o: &EncodeOptions) -> serde_json::Value {
+fn encode_options_json(o: &EncodeOptions, colour: &ColourMode) -> serde_json::Value {
     let base = match o.base {
         BaseTarget::Vertices(n) => json!({ "vertices": n }),
         BaseTarget::Fraction(f) => json!({ "fraction": f }),
@@ -178,5 +308,140 @@ fn encode_options_json(o: &EncodeOptions) -> serde_json::Value {
         "max_layers": o.max_layers,
         "min_layer_fraction": o.min_layer_fraction,
         "geometric_guard": o.geometric_guard,
+        "colour": match colour {
+            ColourMode::Vertex => json!("vertex"),
+            ColourMode::None => json!("none"),
+            ColourMode::Ccc { options, texture } => json!({
+                "mode": "ccc",
+                "source": if texture.is_some() { "texture" } else { "vertex" },
+                "cell_size": options.cell_size,
+                "tile_size": options.tile_size,
+                "jpeg_quality": options.jpeg_quality,
+                "low_res_factor": options.low_res_factor,
+                "max_atlas_side": options.max_atlas_side,
+            }),
+        },
     })
+}
+
+/// The rows of a mapping, after checking that each image is what the
+/// parameters say: a PNG of the cell texture's size (8-bit RGB) and two
+/// JPEGs of the atlas's full and reduced size.
+fn new_mapping(
+    m: &TextureMapping,
+) -> anyhow::Result<(NewTextureMapping, vitrine_codec::ccc::CccReport)> {
+    let p: &CccParameters = &m.parameters;
+    if p.version != 1 {
+        bail!("CCC version {} is not supported (1 is)", p.version);
+    }
+    if p.low_res_factor == 0 || p.cell_size.is_nan() || p.cell_size <= 0.0 {
+        bail!("CCC parameters have a zero low-resolution factor or cell size");
+    }
+    let grid = u64::from(p.dims[0]) * u64::from(p.dims[1]) * u64::from(p.dims[2]);
+    let cell_texels = u64::from(p.cell_texture.width) * u64::from(p.cell_texture.height);
+    if u64::from(p.cell_texture.cells_offset) != grid || grid + 4 * u64::from(p.cells) > cell_texels
+    {
+        bail!(
+            "cell texture {}×{} cannot hold a {}×{}×{} grid and {} cells at offset {}",
+            p.cell_texture.width,
+            p.cell_texture.height,
+            p.dims[0],
+            p.dims[1],
+            p.dims[2],
+            p.cells,
+            p.cell_texture.cells_offset
+        );
+    }
+    let (w, h, depth, colour_type) =
+        image_size::png(&m.cell_png).context("the cell texture is not a PNG")?;
+    if (w, h) != (p.cell_texture.width, p.cell_texture.height) || (depth, colour_type) != (8, 2) {
+        bail!(
+            "the cell texture is {w}×{h} (bit depth {depth}, colour type {colour_type}); \
+             the parameters say {}×{} 8-bit RGB",
+            p.cell_texture.width,
+            p.cell_texture.height
+        );
+    }
+    let full = (p.atlas.width, p.atlas.height);
+    let low = (
+        p.atlas.width.div_ceil(p.low_res_factor),
+        p.atlas.height.div_ceil(p.low_res_factor),
+    );
+    for (what, bytes, want) in [
+        ("colour texture", &m.colour_jpeg, full),
+        ("low-resolution colour texture", &m.colour_low_jpeg, low),
+    ] {
+        let size = image_size::jpeg(bytes).with_context(|| format!("the {what} is not a JPEG"))?;
+        if size != want {
+            bail!(
+                "the {what} is {}×{}; the parameters say {}×{}",
+                size.0,
+                size.1,
+                want.0,
+                want.1
+            );
+        }
+    }
+    let texture = |kind, media_type, (width, height): (u32, u32), bytes: &Vec<u8>| NewTexture {
+        kind,
+        media_type,
+        width,
+        height,
+        bytes: bytes.clone(),
+    };
+    Ok((
+        NewTextureMapping {
+            parameters: serde_json::to_string(p)?,
+            cell: texture("cell", "image/png", (w, h), &m.cell_png),
+            colour: texture("colour", "image/jpeg", full, &m.colour_jpeg),
+            colour_low: texture("colour", "image/jpeg", low, &m.colour_low_jpeg),
+        },
+        m.report,
+    ))
+}
+
+/// Image sizes from the headers, without decoding.
+mod image_size {
+    use anyhow::{bail, Context};
+
+    /// Width, height, bit depth and colour type from the IHDR chunk.
+    pub fn png(bytes: &[u8]) -> anyhow::Result<(u32, u32, u8, u8)> {
+        const SIGNATURE: &[u8] = b"\x89PNG\r\n\x1a\n";
+        if bytes.len() < 33 || &bytes[..8] != SIGNATURE || &bytes[12..16] != b"IHDR" {
+            bail!("no PNG signature and IHDR chunk");
+        }
+        let be = |at: usize| {
+            u32::from_be_bytes([bytes[at], bytes[at + 1], bytes[at + 2], bytes[at + 3]])
+        };
+        Ok((be(16), be(20), bytes[24], bytes[25]))
+    }
+
+    /// Width and height from the first start-of-frame marker.
+    pub fn jpeg(bytes: &[u8]) -> anyhow::Result<(u32, u32)> {
+        if bytes.get(..2) != Some(&[0xff, 0xd8]) {
+            bail!("no start-of-image marker");
+        }
+        let mut at = 2;
+        loop {
+            let marker = bytes.get(at..at + 4).context("no start-of-frame marker")?;
+            if marker[0] != 0xff {
+                bail!("damaged marker at byte {at}");
+            }
+            if marker[1] == 0xff {
+                at += 1; // fill byte
+                continue;
+            }
+            let len = usize::from(u16::from_be_bytes([marker[2], marker[3]]));
+            // SOF0–SOF15 except DHT (C4), JPG (C8) and DAC (CC).
+            if (0xc0..=0xcf).contains(&marker[1]) && ![0xc4, 0xc8, 0xcc].contains(&marker[1]) {
+                let frame = bytes
+                    .get(at + 5..at + 9)
+                    .context("truncated start of frame")?;
+                let height = u32::from(u16::from_be_bytes([frame[0], frame[1]]));
+                let width = u32::from(u16::from_be_bytes([frame[2], frame[3]]));
+                return Ok((width, height));
+            }
+            at += 2 + len;
+        }
+    }
 }

@@ -1,6 +1,6 @@
 //! `vitrine ingest <mesh> --db … --slug … --title …`
 
-use crate::ingest::{ingest_mesh, IngestOptions, ModelMeta, SourceInfo};
+use crate::ingest::{ingest_mesh, ColourMode, IngestOptions, ModelMeta, SourceInfo};
 use crate::storage::{ConnectOptions, OnExisting};
 use anyhow::Context;
 use std::path::PathBuf;
@@ -37,6 +37,11 @@ pub struct IngestArgs {
     /// Position quantization, 8–16 bits.
     #[arg(long, default_value_t = 12)]
     pub quantization_bits: u8,
+    /// How colour travels: `vertex` (per-vertex colour in the stream),
+    /// `ccc` (a cubic cell complex: a cell texture and a colour texture
+    /// shared by every level, built from the per-vertex colour) or `none`.
+    #[arg(long, default_value = "vertex", value_parser = ["vertex", "ccc", "none"])]
+    pub colour: String,
     /// Test hook: pause inside the transaction before committing.
     #[arg(long, hide = true, env = "VITRINE_TEST_PAUSE_BEFORE_COMMIT_MS")]
     pub pause_before_commit_ms: Option<u64>,
@@ -85,6 +90,8 @@ pub async fn run_ingest(args: IngestArgs) -> anyhow::Result<()> {
             quantization_bits: args.quantization_bits,
             ..EncodeOptions::default()
         },
+        colour: ColourMode::parse(&args.colour)
+            .with_context(|| format!("unknown colour mode {:?}", args.colour))?,
         pause_before_commit: args.pause_before_commit_ms.map(Duration::from_millis),
     };
     let slug = meta.slug.clone();
@@ -99,5 +106,16 @@ pub async fn run_ingest(args: IngestArgs) -> anyhow::Result<()> {
         report.stream_bytes,
         report.encode_time.as_secs_f64(),
     );
+    if let Some(ccc) = &report.ccc {
+        println!(
+            "colour: {} cells, {} tiles, {:.1} % of covered texels ambiguous; cell texture {} bytes, colour texture {} bytes ({} low-resolution)",
+            ccc.cells,
+            ccc.tiles,
+            100.0 * ccc.ambiguous_texels as f64 / ccc.covered_texels.max(1) as f64,
+            ccc.cell_texture_bytes,
+            ccc.colour_texture_bytes,
+            ccc.colour_texture_low_bytes,
+        );
+    }
     Ok(())
 }

@@ -5,7 +5,7 @@ use super::error::AppError;
 use super::payload;
 use super::visitor::VisitorHints;
 use super::{AppState, Visitor};
-use crate::storage::{valid_slug, ModelRecord, ModelSummary};
+use crate::storage::{valid_slug, ModelRecord, ModelSummary, TextureRef};
 use axum::extract::{Path, State};
 use axum::http::{header, HeaderValue};
 use axum::response::{IntoResponse, Response};
@@ -94,6 +94,10 @@ struct Manifest<'a> {
     last_level: u32,
     good_enough_level: u32,
     levels: Vec<ManifestLevel>,
+    /// How the model is coloured: `ccc` (textures through a cubic cell
+    /// complex, shared by every level), `vertex` (colour in the stream) or
+    /// `none`.
+    colour: ManifestColour<'a>,
     textures: Vec<ManifestTexture<'a>>,
     visitor: ManifestVisitor,
     cap: ManifestCap,
@@ -116,9 +120,33 @@ struct ManifestLevel {
 struct ManifestTexture<'a> {
     id: i64,
     kind: &'a str,
+    /// `cell`, `colour` or `colour_low`.
+    role: &'a str,
     media_type: &'a str,
     bytes: u64,
+    width: Option<u32>,
+    height: Option<u32>,
     url: String,
+}
+
+#[derive(Serialize)]
+struct ManifestCcc<'a> {
+    parameters: &'a serde_json::Value,
+    cell_texture: ManifestTexture<'a>,
+    colour_texture: ManifestTexture<'a>,
+    colour_texture_low: ManifestTexture<'a>,
+}
+
+#[derive(Serialize)]
+#[serde(tag = "mode", rename_all = "lowercase")]
+enum ManifestColour<'a> {
+    /// Colour mapping through a cubic cell complex (`codec/CCC.md`): the
+    /// viewer loads the cell texture and the low-resolution colour texture
+    /// after the base mesh, then the full-resolution one.
+    Ccc(Box<ManifestCcc<'a>>),
+    /// Per-vertex colour travels in the stream.
+    Vertex,
+    None,
 }
 
 #[derive(Serialize)]
@@ -186,17 +214,35 @@ fn build_manifest<'a>(
             allowed: k as u32 <= cap.level,
         })
         .collect();
-    let textures = record
-        .textures
-        .iter()
-        .map(|t| ManifestTexture {
-            id: t.id,
-            kind: &t.kind,
-            media_type: &t.media_type,
-            bytes: t.bytes,
-            url: format!("/api/textures/{}", t.id),
-        })
-        .collect();
+    let texture = |t: &'a TextureRef| ManifestTexture {
+        id: t.id,
+        kind: &t.kind,
+        role: &t.role,
+        media_type: &t.media_type,
+        bytes: t.bytes,
+        width: t.width,
+        height: t.height,
+        url: format!("/api/textures/{}", t.id),
+    };
+    let textures = record.textures.iter().map(texture).collect();
+    let role = |r: &str| record.textures.iter().find(|t| t.role == r).map(texture);
+    let colour = match (
+        &record.mapping,
+        role("cell"),
+        role("colour"),
+        role("colour_low"),
+    ) {
+        (Some(mapping), Some(cell_texture), Some(colour_texture), Some(colour_texture_low)) => {
+            ManifestColour::Ccc(Box::new(ManifestCcc {
+                parameters: &mapping.parameters,
+                cell_texture,
+                colour_texture,
+                colour_texture_low,
+            }))
+        }
+        _ if record.has_colour => ManifestColour::Vertex,
+        _ => ManifestColour::None,
+    };
     Manifest {
         slug: &record.slug,
         version: record.version,
@@ -208,6 +254,7 @@ fn build_manifest<'a>(
         last_level: record.batch_count(),
         good_enough_level: good_enough_level(record, &state.config().caps),
         levels,
+        colour,
         textures,
         visitor: ManifestVisitor {
             audience: visitor.audience,

@@ -212,6 +212,7 @@ mod tests {
                     rmse: None,
                 })
                 .collect(),
+            mapping: None,
             textures: vec![],
         }
     }

@@ -46,6 +46,7 @@ macro_rules! sql_storage {
                     )?,
                     has_colour: row.try_get("has_colour").map_err(get)?,
                     levels: Vec::new(),
+                    mapping: None,
                     textures: Vec::new(),
                 })
             }
@@ -99,17 +100,38 @@ macro_rules! sql_storage {
                     )));
                 }
                 if let Some(mapping) = mapping {
+                    let parameters: Option<String> =
+                        row.try_get("mapping_parameters").map_err(c)?;
+                    let parameters = serde_json::from_str(parameters.as_deref().unwrap_or(""))
+                        .map_err(|e| {
+                            StorageError::Corrupt(format!(
+                                "texture mapping {mapping} has unreadable parameters: {e}"
+                            ))
+                        })?;
+                    record.mapping = Some(MappingRecord {
+                        id: mapping,
+                        parameters,
+                    });
                     for row in sqlx::query(TEXTURES)
                         .bind(mapping)
                         .fetch_all(&self.pool)
                         .await
                         .map_err(c)?
                     {
+                        let side = |name: &str| -> $crate::storage::Result<Option<u32>> {
+                            match row.try_get::<Option<i64>, _>(name).map_err(c)? {
+                                Some(v) => Ok(Some(narrow(v, "texture size")?)),
+                                None => Ok(None),
+                            }
+                        };
                         record.textures.push(TextureRef {
                             id: row.try_get("id").map_err(c)?,
                             kind: row.try_get("kind").map_err(c)?,
+                            role: row.try_get("role").map_err(c)?,
                             media_type: row.try_get("media_type").map_err(c)?,
                             bytes: narrow(row.try_get("byte_len").map_err(c)?, "texture.byte_len")?,
+                            width: side("width")?,
+                            height: side("height")?,
                         });
                     }
                 }

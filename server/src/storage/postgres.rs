@@ -2,8 +2,9 @@
 
 use super::backend::sql_storage;
 use super::{
-    is_connection_error, AudiencePolicy, ConnectOptions, LevelRecord, ModelRecord, ModelSummary,
-    NewModel, NewToken, StagedModel, Storage, StorageError, TexturePayload, TextureRef, TokenGrant,
+    is_connection_error, AudiencePolicy, ConnectOptions, LevelRecord, MappingRecord, ModelRecord,
+    ModelSummary, NewModel, NewToken, StagedModel, Storage, StorageError, TexturePayload,
+    TextureRef, TokenGrant,
 };
 use sqlx::postgres::{PgConnectOptions, PgPoolOptions};
 use sqlx::{PgPool, Postgres, Transaction};

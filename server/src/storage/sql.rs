@@ -11,9 +11,11 @@ macro_rules! record_select {
         "SELECT m.id AS model_id, m.slug, m.version, m.title, m.description, \
          m.good_enough_level, m.created_at, p.name AS policy_name, p.public_access, \
          p.public_max_vertex_fraction, p.public_full_resolution, p.token_full_resolution, \
-         c.id AS compression_id, c.quantization_bits, c.has_colour, c.mapping_id \
+         c.id AS compression_id, c.quantization_bits, c.has_colour, c.mapping_id, \
+         tm.parameters AS mapping_parameters \
          FROM model m JOIN audience_policy p ON p.id = m.policy_id \
-         JOIN compression c ON c.model_id = m.id "
+         JOIN compression c ON c.model_id = m.id \
+         LEFT JOIN texture_mapping tm ON tm.id = c.mapping_id "
     };
 }
 
@@ -28,8 +30,12 @@ pub(super) const LEVELS: &str =
      FROM base_mesh WHERE compression_id = $1 \
      UNION ALL SELECT iteration, vertices, faces, byte_len, sha256, hausdorff, rmse \
      FROM refinement_batch WHERE compression_id = $1 ORDER BY iteration";
-pub(super) const TEXTURES: &str = "SELECT t.id, t.kind, t.media_type, t.byte_len \
-     FROM texture_mapping tm JOIN texture t ON t.id = tm.cell_texture_id OR t.id = tm.colour_texture_id \
+/// The images of mapping `$1` and which of its columns names each.
+pub(super) const TEXTURES: &str = "SELECT t.id, t.kind, t.media_type, t.byte_len, t.width, t.height, \
+     CASE WHEN t.id = tm.cell_texture_id THEN 'cell' \
+     WHEN t.id = tm.colour_texture_id THEN 'colour' ELSE 'colour_low' END AS role \
+     FROM texture_mapping tm \
+     JOIN texture t ON t.id IN (tm.cell_texture_id, tm.colour_texture_id, tm.colour_low_texture_id) \
      WHERE tm.id = $1 ORDER BY t.id";
 pub(super) const LIST: &str = "SELECT m.slug, m.title, m.version, m.created_at, p.public_access, c.batch_count \
      FROM model m JOIN audience_policy p ON p.id = m.policy_id JOIN compression c ON c.model_id = m.id \
@@ -41,7 +47,8 @@ pub(super) const BASE: &str = "SELECT bytes FROM base_mesh WHERE compression_id 
 pub(super) const BATCH: &str =
     "SELECT bytes FROM refinement_batch WHERE compression_id = $1 AND iteration = $2";
 pub(super) const TEXTURE: &str = "SELECT t.media_type, t.sha256, t.bytes, m.slug, p.public_access \
-     FROM texture t JOIN texture_mapping tm ON t.id = tm.cell_texture_id OR t.id = tm.colour_texture_id \
+     FROM texture t \
+     JOIN texture_mapping tm ON t.id IN (tm.cell_texture_id, tm.colour_texture_id, tm.colour_low_texture_id) \
      JOIN model m ON m.id = tm.model_id JOIN audience_policy p ON p.id = m.policy_id \
      WHERE t.id = $1 AND m.status = 'ready' ORDER BY p.public_access DESC LIMIT 1";
 pub(super) const TOKEN: &str = "SELECT id, label, model_slug FROM access_token \
@@ -56,11 +63,17 @@ pub(super) const INSERT_MODEL: &str =
      good_enough_level, source_name, source_vertices, source_faces, status, created_at) \
      VALUES ($1, $2, $3, $4, $5, $6, $7, $8, $9, 'ready', $10) RETURNING id";
 pub(super) const INSERT_COMPRESSION: &str = "INSERT INTO compression (model_id, codec_version, options, stats, \
-     quantization_bits, has_colour, batch_count, final_vertices, final_faces, stream_bytes, encode_ms, created_at) \
-     VALUES ($1, $2, $3, $4, $5, $6, $7, $8, $9, $10, $11, $12) RETURNING id";
+     quantization_bits, has_colour, batch_count, final_vertices, final_faces, stream_bytes, encode_ms, created_at, \
+     mapping_id) VALUES ($1, $2, $3, $4, $5, $6, $7, $8, $9, $10, $11, $12, $13) RETURNING id";
 pub(super) const INSERT_BASE: &str =
     "INSERT INTO base_mesh (compression_id, vertices, faces, byte_len, sha256, bytes) \
      VALUES ($1, $2, $3, $4, $5, $6)";
+pub(super) const INSERT_TEXTURE: &str = "INSERT INTO texture \
+     (kind, media_type, width, height, byte_len, sha256, bytes, created_at) \
+     VALUES ($1, $2, $3, $4, $5, $6, $7, $8) RETURNING id";
+pub(super) const INSERT_MAPPING: &str = "INSERT INTO texture_mapping \
+     (model_id, cell_texture_id, colour_texture_id, colour_low_texture_id, parameters, created_at) \
+     VALUES ($1, $2, $3, $4, $5, $6) RETURNING id";
 pub(super) const INSERT_BATCH: &str = "INSERT INTO refinement_batch \
      (compression_id, iteration, vertices, faces, byte_len, sha256, bytes) VALUES ($1, $2, $3, $4, $5, $6, $7)";
 

@@ -41,6 +41,36 @@ macro_rules! stage_body {
             .fetch_one(&mut *$tx)
             .await
             .map_err(conflict)?;
+        let mut mapping_id: Option<i64> = None;
+        if let Some(mapping) = &$model.mapping {
+            let mut ids = [0i64; 3];
+            for (id, texture) in ids.iter_mut().zip([&mapping.cell, &mapping.colour, &mapping.colour_low]) {
+                *id = sqlx::query_scalar(INSERT_TEXTURE)
+                    .bind(texture.kind)
+                    .bind(texture.media_type)
+                    .bind(i64::from(texture.width))
+                    .bind(i64::from(texture.height))
+                    .bind(texture.bytes.len() as i64)
+                    .bind(sha256_hex(&texture.bytes))
+                    .bind(texture.bytes.as_slice())
+                    .bind(now)
+                    .fetch_one(&mut *$tx)
+                    .await
+                    .map_err(c)?;
+            }
+            mapping_id = Some(
+                sqlx::query_scalar(INSERT_MAPPING)
+                    .bind(model_id)
+                    .bind(ids[0])
+                    .bind(ids[1])
+                    .bind(ids[2])
+                    .bind(mapping.parameters.clone())
+                    .bind(now)
+                    .fetch_one(&mut *$tx)
+                    .await
+                    .map_err(c)?,
+            );
+        }
         let comp = &$model.compression;
         let last = comp.batches.last().unwrap_or(&comp.base);
         let compression_id: i64 = sqlx::query_scalar(INSERT_COMPRESSION)
@@ -56,6 +86,7 @@ macro_rules! stage_body {
             .bind(comp.stream_bytes as i64)
             .bind(comp.encode_ms as i64)
             .bind(now)
+            .bind(mapping_id)
             .fetch_one(&mut *$tx)
             .await
             .map_err(c)?;

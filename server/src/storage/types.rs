@@ -31,10 +31,22 @@ pub struct LevelRecord {
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct TextureRef {
     pub id: i64,
-    /// `"cell"` or `"colour"`.
+    /// `"cell"` or `"colour"` (column `texture.kind`).
     pub kind: String,
+    /// Which image of the mapping: `"cell"`, `"colour"` or `"colour_low"`.
+    pub role: String,
     pub media_type: String,
     pub bytes: u64,
+    pub width: Option<u32>,
+    pub height: Option<u32>,
+}
+
+/// The colour mapping (cubic cell complex) a compression uses.
+#[derive(Clone, Debug, PartialEq)]
+pub struct MappingRecord {
+    pub id: i64,
+    /// The complex's parameters (`codec/CCC.md`), as stored.
+    pub parameters: serde_json::Value,
 }
 
 /// A visible model version and the compression the service serves for it.
@@ -54,6 +66,9 @@ pub struct ModelRecord {
     pub has_colour: bool,
     /// `levels[0]` is the base mesh, `levels[k]` the mesh after batch `k`.
     pub levels: Vec<LevelRecord>,
+    /// The CCC colour mapping, if the model has one.
+    pub mapping: Option<MappingRecord>,
+    /// The mapping's images, by id.
     pub textures: Vec<TextureRef>,
 }
 
@@ -138,6 +153,29 @@ pub struct NewModel {
     pub source_vertices: u64,
     pub source_faces: u64,
     pub compression: NewCompression,
+    /// A CCC colour mapping, stored in the same transaction.
+    pub mapping: Option<NewTextureMapping>,
+}
+
+/// An image to store in table `texture`.
+#[derive(Clone, Debug)]
+pub struct NewTexture {
+    /// `"cell"` or `"colour"`.
+    pub kind: &'static str,
+    pub media_type: &'static str,
+    pub width: u32,
+    pub height: u32,
+    pub bytes: Vec<u8>,
+}
+
+/// The three images of a CCC colour mapping and its parameters.
+#[derive(Clone, Debug)]
+pub struct NewTextureMapping {
+    /// Parameters as JSON (`codec/CCC.md`, "Parameters").
+    pub parameters: String,
+    pub cell: NewTexture,
+    pub colour: NewTexture,
+    pub colour_low: NewTexture,
 }
 
 #[derive(Clone, Debug)]

@@ -3,6 +3,7 @@
 //! skipped with a note when unreachable, a failure when `CI` is set).
 
 mod caps;
+mod colour;
 mod harness;
 mod http;
 mod kill;
@@ -56,6 +57,10 @@ on_both_backends!(
     http::shedding_and_body_limit,
     http::graceful_shutdown,
     kill::killed_ingest_leaves_nothing,
+    colour::ccc_mapping_stored_and_served,
+    colour::restricted_textures_need_a_token,
+    colour::inconsistent_mappings_are_refused,
+    colour::ccc_ingest_from_vertex_colour,
 );
 
 #[test]
