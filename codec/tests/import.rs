@@ -1232,15 +1232,31 @@ mod textured {
             "{:?}",
             got.warnings
         );
-        // Bad vt data is an error with its line.
-        write(
-            &dir,
-            "c.obj",
-            "mtllib b.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nusemtl m\nf 1/1 2/1 3/4\n",
-        );
-        let e = import_path_textured(&dir.join("c.obj"), &opts()).unwrap_err();
-        assert!(e.to_string().contains("line 7"), "{e}");
-        assert!(e.to_string().contains("texture coordinate index 4"), "{e}");
+        // Bad vt data costs the texture, not the geometry: a warning with its line.
+        for (obj, needles) in [
+            (
+                "vt 0 0\nusemtl m\nf 1/1 2/1 3/4\n",
+                ["line 7", "texture coordinate index 4 is out of range"],
+            ),
+            (
+                "vt 0 zero\nusemtl m\nf 1/1 2/1 3/1\n",
+                ["line 5", "bad number \"zero\""],
+            ),
+            (
+                "vt 0 0\nusemtl m\nf 1/1 2/-2 3/1\n",
+                ["line 7", "reaches before the first"],
+            ),
+        ] {
+            let obj = format!("mtllib b.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\n{obj}");
+            write(&dir, "c.obj", &obj);
+            let got = textured(&dir.join("c.obj"));
+            assert!(got.texture.is_none(), "{obj}");
+            assert_eq!(got.mesh.triangles, vec![[0, 1, 2]]);
+            assert_eq!(got.warnings.len(), 1, "{:?}", got.warnings);
+            for n in needles {
+                assert!(got.warnings[0].contains(n), "{n}: {:?}", got.warnings);
+            }
+        }
     }
 
     #[test]
@@ -1441,6 +1457,29 @@ mod textured {
     }
 
     #[test]
+    fn gltf_bad_texture_coordinates_are_warnings() {
+        let dir = folder("gltf-bad-uv");
+        write(&dir, "t.png", rgba_png());
+        let path = gltf_with(&dir, r#"{"uri":"t.png"}"#);
+        let good = std::fs::read_to_string(&path).unwrap();
+        for (from, to, needle) in [
+            (
+                r#""normalized":true,"count":4"#,
+                r#""normalized":true,"count":3"#,
+                "TEXCOORD_1 must be VEC2 with one value per vertex",
+            ),
+            (r#""texCoord":1"#, r#""texCoord":2"#, "not its TEXCOORD"),
+        ] {
+            assert!(good.contains(from));
+            std::fs::write(&path, good.replace(from, to)).unwrap();
+            let got = textured(&path);
+            assert!(got.texture.is_none());
+            assert_eq!(got.mesh.triangles.len(), 2);
+            assert!(got.warnings[0].contains(needle), "{:?}", got.warnings);
+        }
+    }
+
+    #[test]
     fn gltf_traversal_uri_is_refused() {
         let dir = folder("gltf-escape");
         write(&dir, "secret.png", rgba_png());
@@ -1555,8 +1594,13 @@ mod textured {
                 continue;
             }
             let t = Instant::now();
+            let plain = import_path(&path, &opts()).unwrap();
+            let geometry = t.elapsed();
+            let t = Instant::now();
             let got = textured(&path);
             let elapsed = t.elapsed();
+            assert_eq!(got.mesh.positions, plain.positions, "{name}");
+            assert_eq!(got.mesh.triangles, plain.triangles, "{name}");
             assert!(got.warnings.is_empty(), "{name}: {:?}", got.warnings);
             let tex = got
                 .texture
@@ -1582,7 +1626,7 @@ mod textured {
             let px = (w as u64 * h as u64).max(1);
             eprintln!(
                 "{name}: mesh {} vertices / {} triangles; textured surface {} vertices \
-                 ({} UVs in [0,1]), {} triangles; image {w}×{h}, mean RGB {:?}; {elapsed:.0?}",
+                 ({} UVs in [0,1]), {} triangles; image {w}×{h}, mean RGB {:?}; textured import {elapsed:.2?} (geometry alone {geometry:.2?})",
                 got.mesh.positions.len(),
                 got.mesh.triangles.len(),
                 tex.positions.len(),

@@ -550,14 +550,9 @@ fn read_inner(
                 None => None,
             };
             let uv_acc = texture.as_ref().and_then(|t| t.2.as_ref());
-            for acc in [
-                Some(&pos_acc),
-                colour_acc.as_ref(),
-                index_acc.as_ref(),
-                uv_acc,
-            ]
-            .into_iter()
-            .flatten()
+            for acc in [Some(&pos_acc), colour_acc.as_ref(), index_acc.as_ref()]
+                .into_iter()
+                .flatten()
             {
                 if let Some(view) = acc.view() {
                     buffers.load(&view.buffer())?;
@@ -621,31 +616,11 @@ fn read_inner(
                 None => {}
             }
 
-            let uvs = match uv_acc {
-                Some(acc) => {
-                    let set = texture.as_ref().map_or(0, |t| t.1);
-                    let t = open(acc, &buffers, what)?;
-                    if t.dims != 2 || t.count != n {
-                        return Err(Error::input(
-                            what,
-                            format!("{ctx}: TEXCOORD_{set} must be VEC2 with one value per vertex"),
-                        ));
-                    }
-                    let mut uvs = Vec::with_capacity(n);
-                    for i in 0..n {
-                        let uv = [t.value(i, 0) as f32, t.value(i, 1) as f32];
-                        if !uv.iter().all(|v| v.is_finite()) {
-                            return Err(Error::input(
-                                what,
-                                format!("{ctx}: TEXCOORD_{set} {i} is not finite {uv:?}"),
-                            ));
-                        }
-                        uvs.push(uv);
-                    }
-                    Some(uvs)
-                }
-                None => None,
-            };
+            // Unreadable texture coordinates cost the texture, not the geometry.
+            let uvs = uv_acc.map(|acc| {
+                let set = texture.as_ref().map_or(0, |t| t.1);
+                read_uvs(acc, &mut buffers, what, &ctx, set, n)
+            });
             let first_triangle = triangles.len();
 
             let flip = det3(world) < 0.0;
@@ -702,12 +677,20 @@ fn read_inner(
                 }
             }
             match (texture, uvs) {
-                (Some((image, _, _)), Some(uvs)) => textured_prims.push(TexturedPrimitive {
+                (Some((image, _, _)), Some(Ok(uvs))) => textured_prims.push(TexturedPrimitive {
                     vertices: base..base + n,
                     triangles: first_triangle..triangles.len(),
                     image,
                     uvs,
                 }),
+                (Some(_), Some(Err(e))) => {
+                    if let Some((_, warnings)) = textured.as_mut() {
+                        warnings.push(format!(
+                            "{e}; its {} triangles are left out of the textured surface",
+                            triangles.len() - first_triangle
+                        ));
+                    }
+                }
                 (Some(_), None) => without_uvs += triangles.len() - first_triangle,
                 _ => {}
             }
@@ -785,6 +768,39 @@ fn read_inner(
         );
     }
     Ok((mesh, Some(surface)))
+}
+
+/// A primitive's `TEXCOORD_<set>`, `n` finite values.
+fn read_uvs(
+    acc: &gltf::Accessor<'_>,
+    buffers: &mut Buffers<'_>,
+    what: &'static str,
+    ctx: &str,
+    set: u32,
+    n: usize,
+) -> Result<Vec<[f32; 2]>> {
+    if let Some(view) = acc.view() {
+        buffers.load(&view.buffer())?;
+    }
+    let t = open(acc, buffers, what)?;
+    if t.dims != 2 || t.count != n {
+        return Err(Error::input(
+            what,
+            format!("{ctx}: TEXCOORD_{set} must be VEC2 with one value per vertex"),
+        ));
+    }
+    let mut uvs = Vec::with_capacity(n);
+    for i in 0..n {
+        let uv = [t.value(i, 0) as f32, t.value(i, 1) as f32];
+        if !uv.iter().all(|v| v.is_finite()) {
+            return Err(Error::input(
+                what,
+                format!("{ctx}: TEXCOORD_{set} value {i} is not finite {uv:?}"),
+            ));
+        }
+        uvs.push(uv);
+    }
+    Ok(uvs)
 }
 
 /// Decodes image `index` of the document (from a buffer view, a `data:` URI

@@ -185,8 +185,11 @@ pub struct Imported {
 /// one covering the most triangles is read and the other triangles are left
 /// out of [`TexturedSurface::triangles`] (with a warning).
 ///
-/// Geometry comes first: a missing texture or material file, or an image in
-/// a format other than PNG and JPEG, gives `texture: None` and a warning.
+/// Geometry comes first: `mesh` is always what [`import_path`] gives, and a
+/// missing texture or material file, an image in a format other than PNG
+/// and JPEG, or unusable texture coordinates (an OBJ `vt` index out of
+/// range, a glTF `TEXCOORD_n` that is not one VEC2 per vertex) give
+/// `texture: None` (or leave those triangles out) and a warning.
 /// A texture that is present but malformed, or larger than
 /// [`TextureOptions::max_texture_pixels`], is an error, as is a glTF image
 /// URI that is absolute or leaves the model's folder (`..`), like its

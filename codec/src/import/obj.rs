@@ -38,6 +38,9 @@ struct TexState {
     forward: Vec<(usize, usize, i64)>,
     /// `vt` indices of the face being read (reused).
     corners: Vec<u32>,
+    /// The first problem with the texture coordinates: the geometry is still
+    /// read, the texture is not.
+    broken: Option<Error>,
 }
 
 const WHAT: &str = "OBJ file";
@@ -79,7 +82,14 @@ impl Reader<'_> {
         match tokens.next() {
             Some(b"v") => self.vertex(tokens, no),
             Some(b"f") => self.face(tokens, no),
-            Some(b"vt") if self.tex.is_some() => self.tex_coord(tokens, no),
+            Some(b"vt") if self.tex.as_ref().is_some_and(|t| t.broken.is_none()) => {
+                if let Err(e) = self.tex_coord(tokens, no) {
+                    if let Some(tex) = self.tex.as_mut() {
+                        tex.broken = Some(e);
+                    }
+                }
+                Ok(())
+            }
             Some(b"usemtl") => {
                 if let Some(tex) = self.tex.as_mut() {
                     let name = rest_of_line(line, b"usemtl");
@@ -197,7 +207,12 @@ impl Reader<'_> {
             let v = parts.next().unwrap_or(t);
             if let Some(tex) = self.tex.as_mut() {
                 let vt = match parts.next() {
-                    Some(vt) if !vt.is_empty() => tex.corner(vt, no, face)?,
+                    Some(vt) if !vt.is_empty() && tex.broken.is_none() => {
+                        tex.corner(vt, no, face).unwrap_or_else(|e| {
+                            tex.broken = Some(e);
+                            NONE
+                        })
+                    }
                     _ => NONE,
                 };
                 tex.corners.push(vt);
@@ -381,10 +396,10 @@ fn parse(
             format!("face {face}: vertex index {i} is out of range: the file has {nv} vertices"),
         ));
     }
-    if let Some(tex) = &r.tex {
+    if let Some(tex) = r.tex.as_mut().filter(|t| t.broken.is_none()) {
         let n = tex.uvs.len();
         if let Some(&(line, face, i)) = tex.forward.iter().find(|f| f.2 > n as i64) {
-            return Err(err(
+            tex.broken = Some(err(
                 line,
                 format!(
                     "face {face}: texture coordinate index {i} is out of range: \
@@ -431,6 +446,10 @@ pub(super) fn read_textured(
         return Ok((mesh, None));
     };
     if tex.mtllibs.is_empty() {
+        return Ok((mesh, None));
+    }
+    if let Some(e) = &tex.broken {
+        warnings.push(format!("{e}; imported without texture"));
         return Ok((mesh, None));
     }
 
