@@ -1,0 +1,458 @@
+//! Per-scenario numbers, the Markdown table and the SVG plot.
+
+use crate::sim::{Audience, CrowdOutcome, Device, Req, VisitorResult};
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+use std::fmt::Write as _;
+
+/// When a lone visitor of each (device, audience) had each level on screen.
+#[derive(Clone, Debug, Default, Serialize, Deserialize)]
+pub struct Baselines(pub Vec<(Device, Audience, Vec<f64>)>);
+
+impl Baselines {
+    pub fn from_visitors(visitors: &[VisitorResult]) -> Baselines {
+        Baselines(
+            visitors
+                .iter()
+                .filter_map(|v| Some((v.device?, v.audience?, v.level_ms.clone())))
+                .collect(),
+        )
+    }
+
+    /// A lone visitor's time to `level`, for this kind of visitor.
+    pub fn time(&self, device: Device, audience: Audience, level: u32) -> Option<f64> {
+        self.0
+            .iter()
+            .find(|(d, a, _)| *d == device && *a == audience)
+            .and_then(|(_, _, t)| t.get(level as usize).copied())
+    }
+}
+
+#[derive(Clone, Debug, Default, Serialize, Deserialize)]
+pub struct Summary {
+    pub caps: String,
+    pub visitors: usize,
+    pub pattern: String,
+    pub run: usize,
+    pub requests: usize,
+    pub p50_ms: f64,
+    pub p95_ms: f64,
+    pub p99_ms: f64,
+    pub max_ms: f64,
+    /// Time to the visitor's last level (completed visitors).
+    pub recon_median_s: f64,
+    pub recon_p95_s: f64,
+    /// Each visitor's time over a lone visitor's time to the same level.
+    pub ratio_median: f64,
+    pub ratio_p95: f64,
+    pub ratio_max: f64,
+    pub completed: usize,
+    pub failed: usize,
+    /// Public desktop visitors: median level reached.
+    pub public_desktop_level: f64,
+    pub load_capped: usize,
+    /// Level at which load-capped visitors stopped → how many.
+    pub load_capped_levels: BTreeMap<u32, usize>,
+    pub bytes: u64,
+    /// Status (or "no answer") → count, for everything but 200 and 304.
+    pub errors: BTreeMap<String, usize>,
+    /// 429/503 answers without `Retry-After`.
+    pub missing_retry_after: usize,
+    pub server_cpu_s: f64,
+    /// Of one core: 200 % is both cores.
+    pub server_cpu_pct: f64,
+    pub server_peak_rss_mib: f64,
+    pub harness_cpu_s: f64,
+    pub wall_s: f64,
+    pub pressure_max: u8,
+}
+
+pub fn percentile(sorted: &[f64], p: f64) -> f64 {
+    if sorted.is_empty() {
+        return f64::NAN;
+    }
+    let rank = ((p / 100.0) * sorted.len() as f64).ceil() as usize;
+    sorted[rank.clamp(1, sorted.len()) - 1]
+}
+
+fn sorted(mut v: Vec<f64>) -> Vec<f64> {
+    v.sort_by(f64::total_cmp);
+    v
+}
+
+pub fn status_key(r: &Req) -> Option<String> {
+    match r.status {
+        200 | 304 => None,
+        0 => Some("no answer".into()),
+        s => Some(s.to_string()),
+    }
+}
+
+pub fn summarize(outcome: &CrowdOutcome, baselines: &Baselines) -> Summary {
+    let lat = sorted(
+        outcome
+            .requests
+            .iter()
+            .map(|r| r.dur_us as f64 / 1e3)
+            .collect(),
+    );
+    let done: Vec<&VisitorResult> = outcome.visitors.iter().filter(|v| v.complete()).collect();
+    let recon = sorted(done.iter().filter_map(|v| v.total_ms()).collect());
+    let ratios = sorted(
+        done.iter()
+            .filter_map(|v| {
+                let level = v.reached()?;
+                let alone = baselines.time(v.device?, v.audience?, level)?;
+                Some(v.total_ms()? / alone)
+            })
+            .collect(),
+    );
+    let levels = sorted(
+        outcome
+            .visitors
+            .iter()
+            .filter(|v| v.device == Some(Device::Desktop) && v.audience == Some(Audience::Public))
+            .filter_map(|v| v.reached().map(f64::from))
+            .collect(),
+    );
+    let mut errors = BTreeMap::new();
+    let mut missing_retry_after = 0;
+    for r in &outcome.requests {
+        if let Some(k) = status_key(r) {
+            *errors.entry(k).or_insert(0) += 1;
+        }
+        if matches!(r.status, 429 | 503) && !r.retry_after {
+            missing_retry_after += 1;
+        }
+    }
+    let mut load_capped_levels = BTreeMap::new();
+    for v in outcome.visitors.iter().filter(|v| v.load_capped()) {
+        if let Some(l) = v.reached() {
+            *load_capped_levels.entry(l).or_insert(0) += 1;
+        }
+    }
+    Summary {
+        requests: outcome.requests.len(),
+        p50_ms: percentile(&lat, 50.0),
+        p95_ms: percentile(&lat, 95.0),
+        p99_ms: percentile(&lat, 99.0),
+        max_ms: lat.last().copied().unwrap_or(f64::NAN),
+        recon_median_s: percentile(&recon, 50.0) / 1e3,
+        recon_p95_s: percentile(&recon, 95.0) / 1e3,
+        ratio_median: percentile(&ratios, 50.0),
+        ratio_p95: percentile(&ratios, 95.0),
+        ratio_max: ratios.last().copied().unwrap_or(f64::NAN),
+        completed: done.len(),
+        failed: outcome.visitors.len() - done.len(),
+        public_desktop_level: percentile(&levels, 50.0),
+        load_capped: outcome.visitors.iter().filter(|v| v.load_capped()).count(),
+        load_capped_levels,
+        bytes: outcome.requests.iter().map(|r| r.bytes).sum(),
+        errors,
+        missing_retry_after,
+        wall_s: outcome.wall.as_secs_f64(),
+        pressure_max: outcome.pressure_max,
+        visitors: outcome.visitors.len(),
+        ..Summary::default()
+    }
+}
+
+/// Column-wise medians of several runs of one scenario.
+pub fn median_of(runs: &[Summary]) -> Summary {
+    let mut m = runs[runs.len() / 2].clone();
+    if runs.len() < 2 {
+        return m;
+    }
+    let med = |f: &dyn Fn(&Summary) -> f64| percentile(&sorted(runs.iter().map(f).collect()), 50.0);
+    m.p50_ms = med(&|s| s.p50_ms);
+    m.p95_ms = med(&|s| s.p95_ms);
+    m.p99_ms = med(&|s| s.p99_ms);
+    m.max_ms = med(&|s| s.max_ms);
+    m.recon_median_s = med(&|s| s.recon_median_s);
+    m.recon_p95_s = med(&|s| s.recon_p95_s);
+    m.ratio_median = med(&|s| s.ratio_median);
+    m.ratio_p95 = med(&|s| s.ratio_p95);
+    m.ratio_max = med(&|s| s.ratio_max);
+    m.server_cpu_s = med(&|s| s.server_cpu_s);
+    m.server_cpu_pct = med(&|s| s.server_cpu_pct);
+    m.server_peak_rss_mib = med(&|s| s.server_peak_rss_mib);
+    m.harness_cpu_s = med(&|s| s.harness_cpu_s);
+    m.wall_s = med(&|s| s.wall_s);
+    m.bytes = med(&|s| s.bytes as f64) as u64;
+    m.load_capped = med(&|s| s.load_capped as f64) as usize;
+    m.failed = med(&|s| s.failed as f64) as usize;
+    m.run = 0;
+    m
+}
+
+fn map(m: &BTreeMap<impl std::fmt::Display, usize>) -> String {
+    if m.is_empty() {
+        return "–".into();
+    }
+    m.iter()
+        .map(|(k, v)| format!("{k}: {v}"))
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+pub fn markdown(rows: &[Summary]) -> String {
+    let mut s = String::new();
+    s.push_str("| caps | visitors | arrivals | requests | p50 ms | p95 ms | p99 ms | reconstruction median / p95 s | × lone visitor, median / p95 | public desktop level (median) | load-capped visitors (at level: n) | failed visitors | non-2xx answers | bytes served | server CPU s (% of a core) | server peak RSS MiB | harness CPU s | max pressure |\n");
+    s.push_str(
+        "|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---|---:|---|---:|---:|---:|---:|---:|\n",
+    );
+    for r in rows {
+        let _ = writeln!(
+            s,
+            "| {} | {} | {} | {} | {:.1} | {:.1} | {:.1} | {:.2} / {:.2} | {:.2} / {:.2} | {} | {} ({}) | {} | {} | {:.1} MB | {:.1} ({:.0} %) | {:.0} | {:.1} | {} |",
+            r.caps,
+            r.visitors,
+            r.pattern,
+            r.requests,
+            r.p50_ms,
+            r.p95_ms,
+            r.p99_ms,
+            r.recon_median_s,
+            r.recon_p95_s,
+            r.ratio_median,
+            r.ratio_p95,
+            r.public_desktop_level,
+            r.load_capped,
+            map(&r.load_capped_levels),
+            r.failed,
+            map(&r.errors),
+            r.bytes as f64 / 1e6,
+            r.server_cpu_s,
+            r.server_cpu_pct,
+            r.server_peak_rss_mib,
+            r.harness_cpu_s,
+            r.pressure_max,
+        );
+    }
+    s
+}
+
+/// A panel: label, left edge, (value, whisker top) of a row, goal line.
+type Panel<'a> = (
+    &'a str,
+    f64,
+    &'a dyn Fn(&Summary) -> (f64, f64),
+    Option<(f64, &'a str)>,
+);
+
+/// Two panels: reconstruction time (median, p95 whisker) and request p99
+/// against visitors (log scale), caps off and on.
+pub fn svg(rows: &[Summary], lone_s: Option<f64>, title: &str) -> String {
+    let (w, h) = (960.0, 420.0);
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        r#"<svg xmlns="http://www.w3.org/2000/svg" width="{w}" height="{h}" viewBox="0 0 {w} {h}" font-family="sans-serif" font-size="12">"#
+    );
+    let _ = writeln!(s, r#"<rect width="{w}" height="{h}" fill="white"/>"#);
+    let _ = writeln!(
+        s,
+        r#"<text x="{}" y="20" text-anchor="middle" font-size="14">{}</text>"#,
+        w / 2.0,
+        escape(title)
+    );
+    let max_v = rows.iter().map(|r| r.visitors).max().unwrap_or(1).max(2) as f64;
+    let series = |caps: &str| -> Vec<&Summary> {
+        let mut v: Vec<&Summary> = rows.iter().filter(|r| r.caps == caps).collect();
+        v.sort_by_key(|r| r.visitors);
+        v
+    };
+    let colour = |caps: &str| if caps == "on" { "#1f77b4" } else { "#d62728" };
+    let panels: [Panel; 2] = [
+        (
+            "full reconstruction per visitor, s (median, whisker to p95)",
+            30.0,
+            &|r: &Summary| (r.recon_median_s, r.recon_p95_s),
+            lone_s.map(|l| (l * 1.2, "1.2 × lone visitor")),
+        ),
+        (
+            "request latency p99, ms",
+            510.0,
+            &|r: &Summary| (r.p99_ms, r.p99_ms),
+            Some((100.0, "goal 100 ms")),
+        ),
+    ];
+    for (label, x0, value, goal) in panels {
+        let (px, py, pw, ph) = (x0 + 50.0, 50.0, 380.0, 300.0);
+        let ymax = rows
+            .iter()
+            .map(|r| value(r).1)
+            .chain(goal.map(|g| g.0))
+            .filter(|v| v.is_finite())
+            .fold(0.0_f64, f64::max)
+            * 1.1;
+        let ymax = if ymax > 0.0 { nice(ymax) } else { 1.0 };
+        let x = |v: f64| px + pw * (v.max(1.0).ln() / max_v.ln());
+        let y = |v: f64| py + ph - ph * (v / ymax).clamp(0.0, 1.0);
+        let _ = writeln!(
+            s,
+            r##"<rect x="{px}" y="{py}" width="{pw}" height="{ph}" fill="none" stroke="#888"/>"##
+        );
+        let _ = writeln!(
+            s,
+            r#"<text x="{}" y="{}" text-anchor="middle">{}</text>"#,
+            px + pw / 2.0,
+            py - 8.0,
+            escape(label)
+        );
+        for i in 0..=4 {
+            let v = ymax * f64::from(i) / 4.0;
+            let _ = writeln!(
+                s,
+                r##"<line x1="{px}" x2="{}" y1="{y}" y2="{y}" stroke="#eee"/><text x="{}" y="{}" text-anchor="end">{}</text>"##,
+                px + pw,
+                px - 4.0,
+                y(v) + 4.0,
+                short(v),
+                y = y(v)
+            );
+        }
+        let mut ticks: Vec<usize> = rows.iter().map(|r| r.visitors).collect();
+        ticks.sort_unstable();
+        ticks.dedup();
+        for t in ticks {
+            let _ = writeln!(
+                s,
+                r#"<text x="{}" y="{}" text-anchor="middle">{t}</text>"#,
+                x(t as f64),
+                py + ph + 16.0
+            );
+        }
+        let _ = writeln!(
+            s,
+            r#"<text x="{}" y="{}" text-anchor="middle">simultaneous visitors (log scale)</text>"#,
+            px + pw / 2.0,
+            py + ph + 34.0
+        );
+        if let Some((g, text)) = goal {
+            let _ = writeln!(
+                s,
+                r##"<line x1="{px}" x2="{}" y1="{y}" y2="{y}" stroke="#2ca02c" stroke-dasharray="6 4"/><text x="{}" y="{}" fill="#2ca02c" text-anchor="end">{}</text>"##,
+                px + pw,
+                px + pw - 4.0,
+                y(g) - 4.0,
+                escape(text),
+                y = y(g)
+            );
+        }
+        for caps in ["off", "on"] {
+            let pts = series(caps);
+            if pts.is_empty() {
+                continue;
+            }
+            let c = colour(caps);
+            let path: Vec<String> = pts
+                .iter()
+                .filter(|r| value(r).0.is_finite())
+                .map(|r| format!("{:.1},{:.1}", x(r.visitors as f64), y(value(r).0)))
+                .collect();
+            let _ = writeln!(
+                s,
+                r#"<polyline points="{}" fill="none" stroke="{c}" stroke-width="2"/>"#,
+                path.join(" ")
+            );
+            for r in pts {
+                let (m, hi) = value(r);
+                if !m.is_finite() {
+                    continue;
+                }
+                let cx = x(r.visitors as f64);
+                if hi.is_finite() && hi > m {
+                    let _ = writeln!(
+                        s,
+                        r#"<line x1="{cx}" x2="{cx}" y1="{}" y2="{}" stroke="{c}"/>"#,
+                        y(m),
+                        y(hi)
+                    );
+                }
+                let _ = writeln!(s, r#"<circle cx="{cx}" cy="{}" r="3.5" fill="{c}"/>"#, y(m));
+            }
+        }
+    }
+    for (i, caps) in ["off", "on"].iter().enumerate() {
+        let lx = 100.0 + 200.0 * i as f64;
+        let _ = writeln!(
+            s,
+            r#"<line x1="{lx}" x2="{}" y1="{}" y2="{}" stroke="{}" stroke-width="2"/><text x="{}" y="{}">load caps {caps}</text>"#,
+            lx + 24.0,
+            h - 14.0,
+            h - 14.0,
+            colour(caps),
+            lx + 30.0,
+            h - 10.0
+        );
+    }
+    s.push_str("</svg>\n");
+    s
+}
+
+fn nice(v: f64) -> f64 {
+    let p = 10f64.powf(v.log10().floor());
+    for m in [1.0, 2.0, 2.5, 5.0, 10.0] {
+        if m * p >= v {
+            return m * p;
+        }
+    }
+    10.0 * p
+}
+
+fn short(v: f64) -> String {
+    if v >= 100.0 || v == 0.0 {
+        format!("{v:.0}")
+    } else if v >= 10.0 {
+        format!("{v:.1}")
+    } else {
+        format!("{v:.2}")
+    }
+}
+
+fn escape(s: &str) -> String {
+    s.replace('&', "&amp;")
+        .replace('<', "&lt;")
+        .replace('>', "&gt;")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn percentiles() {
+        let v: Vec<f64> = (1..=100).map(f64::from).collect();
+        assert_eq!(percentile(&v, 50.0), 50.0);
+        assert_eq!(percentile(&v, 99.0), 99.0);
+        assert_eq!(percentile(&v, 100.0), 100.0);
+        assert_eq!(percentile(&[7.0], 99.0), 7.0);
+    }
+
+    #[test]
+    fn svg_is_well_formed_enough() {
+        let rows = vec![
+            Summary {
+                caps: "off".into(),
+                visitors: 1,
+                recon_median_s: 3.0,
+                recon_p95_s: 3.0,
+                p99_ms: 5.0,
+                ..Summary::default()
+            },
+            Summary {
+                caps: "on".into(),
+                visitors: 100,
+                recon_median_s: 3.2,
+                recon_p95_s: 3.5,
+                p99_ms: 50.0,
+                ..Summary::default()
+            },
+        ];
+        let svg = svg(&rows, Some(3.0), "t <x>");
+        assert!(svg.starts_with("<svg") && svg.trim_end().ends_with("</svg>"));
+        assert!(svg.contains("t &lt;x&gt;"));
+        assert_eq!(svg.matches("<polyline").count(), 4);
+    }
+}

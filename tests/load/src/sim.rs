@@ -1,0 +1,615 @@
+//! Simulated visitors that fetch like the viewer (`web/src/reconstruction.js`):
+//! the manifest, then the textures it lists, the base mesh, then batches
+//! 1, 2, … up to the manifest's cap. Batch k + 1 is requested as soon as
+//! batch k has arrived, while k "decodes": the visitor waits the measured
+//! decode time of that level (native, times a device factor) without using
+//! CPU, as the decoding happens on the visitor's device, not on the server's.
+//! A 403/429 `level_capped` answer stops the visitor at the level it has, as
+//! in the viewer; any other failure ends the visit.
+
+use anyhow::{Context, Result};
+use reqwest::header::{HeaderMap, HeaderValue, AUTHORIZATION, RETRY_AFTER};
+use reqwest::Client;
+use serde::{Deserialize, Serialize};
+use std::sync::atomic::{AtomicBool, AtomicU8, Ordering};
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Device {
+    Desktop,
+    Tablet,
+}
+
+impl Device {
+    /// What the service's `guess_device` reads (server/src/service/visitor.rs).
+    fn user_agent(self) -> &'static str {
+        match self {
+            Device::Desktop => {
+                "Mozilla/5.0 (X11; Linux x86_64) AppleWebKit/537.36 Chrome/120.0 Safari/537.36 vitrine-load"
+            }
+            Device::Tablet => {
+                "Mozilla/5.0 (iPad; CPU OS 17_0 like Mac OS X) AppleWebKit/605.1.15 Mobile/15E148 vitrine-load"
+            }
+        }
+    }
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Audience {
+    Public,
+    Researcher,
+}
+
+/// How visitors arrive over the run.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub enum Pattern {
+    /// All at once (the thesis' JMeter runs).
+    Burst,
+    /// Arrival rate rising linearly from zero over this many seconds.
+    Ramp(f64),
+    /// Evenly spaced over this many seconds.
+    Steady(f64),
+}
+
+impl std::str::FromStr for Pattern {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        let secs = |v: &str| v.parse::<f64>().map_err(|e| format!("{s}: {e}"));
+        match s.split_once(':') {
+            None if s == "burst" => Ok(Pattern::Burst),
+            Some(("ramp", v)) => Ok(Pattern::Ramp(secs(v)?)),
+            Some(("steady", v)) => Ok(Pattern::Steady(secs(v)?)),
+            _ => Err(format!(
+                "pattern must be burst, ramp:SECS or steady:SECS, not {s:?}"
+            )),
+        }
+    }
+}
+
+impl std::fmt::Display for Pattern {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Pattern::Burst => write!(f, "burst"),
+            Pattern::Ramp(s) => write!(f, "ramp:{s}"),
+            Pattern::Steady(s) => write!(f, "steady:{s}"),
+        }
+    }
+}
+
+impl Pattern {
+    /// When visitor `i` of `n` arrives, from the start of the run.
+    fn arrival(self, i: usize, n: usize) -> Duration {
+        let x = i as f64 / n.max(1) as f64;
+        Duration::from_secs_f64(match self {
+            Pattern::Burst => 0.0,
+            Pattern::Ramp(d) => d * x.sqrt(),
+            Pattern::Steady(d) => d * x,
+        })
+    }
+}
+
+/// Native decode time of each level on this machine: `[0]` the base mesh,
+/// `[k]` batch k.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct DecodeProfile {
+    pub model: String,
+    pub decode_ms: Vec<f64>,
+    pub vertices: Vec<u32>,
+    pub bytes: Vec<u64>,
+}
+
+/// Fetches every level the token allows and decodes it `runs` times with
+/// the codec, keeping the fastest time per level.
+pub async fn measure_profile(
+    base_url: &str,
+    slug: &str,
+    token: Option<&str>,
+    runs: usize,
+) -> Result<DecodeProfile> {
+    let client = Client::new();
+    let auth = |r: reqwest::RequestBuilder| match token {
+        Some(t) => r.bearer_auth(t),
+        None => r,
+    };
+    let manifest: serde_json::Value = auth(client.get(format!("{base_url}/api/models/{slug}")))
+        .send()
+        .await?
+        .error_for_status()?
+        .json()
+        .await?;
+    let cap = manifest["cap"]["level"]
+        .as_u64()
+        .context("manifest without cap")? as usize;
+    let levels = manifest["levels"]
+        .as_array()
+        .context("manifest without levels")?;
+    let mut payloads = Vec::new();
+    let mut vertices = Vec::new();
+    for level in levels.iter().take(cap + 1) {
+        let url = level["url"].as_str().context("level without url")?;
+        let bytes = auth(client.get(format!("{base_url}{url}")))
+            .send()
+            .await?
+            .error_for_status()?
+            .bytes()
+            .await?;
+        payloads.push(bytes.to_vec());
+        vertices.push(level["vertices"].as_u64().unwrap_or(0) as u32);
+    }
+    let bytes = payloads.iter().map(|p| p.len() as u64).collect();
+    let decode_ms = tokio::task::spawn_blocking(move || -> Result<Vec<f64>> {
+        let mut best = vec![f64::INFINITY; payloads.len()];
+        for _ in 0..runs.max(1) {
+            let t = Instant::now();
+            let mut decoder =
+                vitrine_codec::Decoder::new(&payloads[0], vitrine_codec::Limits::default())?;
+            best[0] = best[0].min(t.elapsed().as_secs_f64() * 1e3);
+            for (k, batch) in payloads.iter().enumerate().skip(1) {
+                let t = Instant::now();
+                decoder.apply_batch(batch)?;
+                best[k] = best[k].min(t.elapsed().as_secs_f64() * 1e3);
+            }
+        }
+        Ok(best)
+    })
+    .await??;
+    Ok(DecodeProfile {
+        model: slug.to_owned(),
+        decode_ms,
+        vertices,
+        bytes,
+    })
+}
+
+/// What the crowd is.
+#[derive(Clone, Debug)]
+pub struct CrowdConfig {
+    pub base_url: String,
+    pub slug: String,
+    pub token: Option<String>,
+    pub visitors: usize,
+    pub pattern: Pattern,
+    pub tablet_share: f64,
+    pub researcher_share: f64,
+    /// Tablets decode this many times slower than the measured (native) time.
+    pub tablet_factor: f64,
+    pub request_timeout: Duration,
+    /// Sends SIGTERM to this process this long after the start.
+    pub sigterm: Option<(u32, Duration)>,
+    /// Only the first visitor of each (device, audience) pair, one after another.
+    pub sequential: bool,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub enum Kind {
+    Manifest,
+    Texture,
+    Base,
+    Batch,
+}
+
+/// One HTTP request as the visitor saw it.
+#[derive(Clone, Copy, Debug, Serialize, Deserialize)]
+pub struct Req {
+    pub kind: Kind,
+    /// From the start of the run.
+    pub start_us: u64,
+    /// To the last byte of the body.
+    pub dur_us: u64,
+    /// 0: no answer (connection refused, reset, timed out).
+    pub status: u16,
+    pub retry_after: bool,
+    pub bytes: u64,
+}
+
+#[derive(Clone, Debug, Default, Serialize, Deserialize)]
+pub struct VisitorResult {
+    pub device: Option<Device>,
+    pub audience: Option<Audience>,
+    pub arrive_ms: f64,
+    /// The cap in the manifest and why.
+    pub manifest_cap: Option<u32>,
+    pub manifest_reason: Option<String>,
+    pub target: u32,
+    /// `level_ms[k]`: when level k was on screen (decoded), from arrival.
+    pub level_ms: Vec<f64>,
+    /// A batch refused with 403/429: (level, status, reason).
+    pub refused: Option<(u32, u16, Option<String>)>,
+    pub failure: Option<String>,
+}
+
+impl VisitorResult {
+    pub fn reached(&self) -> Option<u32> {
+        self.level_ms.len().checked_sub(1).map(|l| l as u32)
+    }
+
+    pub fn total_ms(&self) -> Option<f64> {
+        self.level_ms.last().copied()
+    }
+
+    /// The cap this visitor ended at was set by load (manifest or 429).
+    pub fn load_capped(&self) -> bool {
+        self.manifest_reason.as_deref() == Some("load")
+            || self
+                .refused
+                .as_ref()
+                .is_some_and(|r| r.2.as_deref() == Some("load") || r.1 == 429)
+    }
+
+    pub fn complete(&self) -> bool {
+        self.failure.is_none()
+    }
+}
+
+pub struct CrowdOutcome {
+    pub visitors: Vec<VisitorResult>,
+    pub requests: Vec<Req>,
+    pub wall: Duration,
+    pub pressure_max: u8,
+    /// When SIGTERM was sent, from the start.
+    pub sigterm_at: Option<Duration>,
+}
+
+/// Visitor `i`'s device and audience: spread evenly through the crowd.
+pub fn mix(i: usize, tablet_share: f64, researcher_share: f64) -> (Device, Audience) {
+    // Low-discrepancy sequences, so that any prefix of the crowd has the mix.
+    let frac = |a: f64| ((i + 1) as f64 * a).fract();
+    let device = if frac(0.618_033_988_749_895) < tablet_share {
+        Device::Tablet
+    } else {
+        Device::Desktop
+    };
+    let audience = if frac(0.754_877_666_246_693) < researcher_share {
+        Audience::Researcher
+    } else {
+        Audience::Public
+    };
+    (device, audience)
+}
+
+struct Visit {
+    config: Arc<CrowdConfig>,
+    profile: Arc<DecodeProfile>,
+    epoch: Instant,
+}
+
+struct Fetched {
+    req: Req,
+    body: Option<Vec<u8>>,
+    error: Option<String>,
+}
+
+impl Visit {
+    /// One request; the body is kept only when asked or when it is an error
+    /// answer, else counted and dropped as it streams in.
+    async fn fetch(&self, client: &Client, kind: Kind, path: &str, keep: bool) -> Fetched {
+        let start = Instant::now();
+        let mut req = Req {
+            kind,
+            start_us: start.duration_since(self.epoch).as_micros() as u64,
+            dur_us: 0,
+            status: 0,
+            retry_after: false,
+            bytes: 0,
+        };
+        let url = format!("{}{}", self.config.base_url, path);
+        let mut body = None;
+        let mut error = None;
+        match client.get(&url).send().await {
+            Err(e) => error = Some(format!("{kind:?}: {e}")),
+            Ok(mut response) => {
+                req.status = response.status().as_u16();
+                req.retry_after = response.headers().contains_key(RETRY_AFTER);
+                let keep = keep || !response.status().is_success();
+                let mut kept = Vec::new();
+                loop {
+                    match response.chunk().await {
+                        Ok(Some(chunk)) => {
+                            req.bytes += chunk.len() as u64;
+                            if keep {
+                                kept.extend_from_slice(&chunk);
+                            }
+                        }
+                        Ok(None) => break,
+                        Err(e) => {
+                            error = Some(format!("{kind:?} body cut off: {e}"));
+                            req.status = 0;
+                            break;
+                        }
+                    }
+                }
+                if keep {
+                    body = Some(kept);
+                }
+            }
+        }
+        req.dur_us = start.elapsed().as_micros() as u64;
+        Fetched { req, body, error }
+    }
+
+    async fn decode_wait(&self, level: usize, device: Device) {
+        let ms = self.profile.decode_ms.get(level).copied().unwrap_or(0.0);
+        let factor = match device {
+            Device::Desktop => 1.0,
+            Device::Tablet => self.config.tablet_factor,
+        };
+        tokio::time::sleep(Duration::from_secs_f64(ms * factor / 1e3)).await;
+    }
+
+    async fn run(
+        self: Arc<Self>,
+        device: Device,
+        audience: Audience,
+        arrive: Duration,
+    ) -> (VisitorResult, Vec<Req>) {
+        tokio::time::sleep_until((self.epoch + arrive).into()).await;
+        let mut result = VisitorResult {
+            device: Some(device),
+            audience: Some(audience),
+            arrive_ms: self.epoch.elapsed().as_secs_f64() * 1e3,
+            ..VisitorResult::default()
+        };
+        let mut reqs = Vec::with_capacity(16);
+        let mut headers = HeaderMap::new();
+        if audience == Audience::Researcher {
+            if let Some(token) = &self.config.token {
+                if let Ok(v) = HeaderValue::from_str(&format!("Bearer {token}")) {
+                    headers.insert(AUTHORIZATION, v);
+                }
+            }
+        }
+        let client = match Client::builder()
+            .user_agent(device.user_agent())
+            .default_headers(headers)
+            .tcp_nodelay(true)
+            .pool_max_idle_per_host(2)
+            .connect_timeout(Duration::from_secs(10))
+            .timeout(self.config.request_timeout)
+            .build()
+        {
+            Ok(c) => c,
+            Err(e) => {
+                result.failure = Some(format!("client: {e}"));
+                return (result, reqs);
+            }
+        };
+        let t0 = Instant::now();
+        let fail = |result: &mut VisitorResult, f: &Fetched, what: &str| {
+            result.failure = Some(
+                f.error
+                    .clone()
+                    .unwrap_or_else(|| format!("{what}: HTTP {}", f.req.status)),
+            );
+        };
+
+        let path = format!("/api/models/{}", self.config.slug);
+        let m = self.fetch(&client, Kind::Manifest, &path, true).await;
+        reqs.push(m.req);
+        let manifest: serde_json::Value = match (&m.body, m.req.status) {
+            (Some(b), 200) => serde_json::from_slice(b).unwrap_or_default(),
+            _ => {
+                fail(&mut result, &m, "manifest");
+                return (result, reqs);
+            }
+        };
+        let last = manifest["last_level"].as_u64().unwrap_or(0) as u32;
+        let cap = manifest["cap"]["level"].as_u64().unwrap_or(0) as u32;
+        result.manifest_cap = Some(cap);
+        result.manifest_reason = manifest["cap"]["reason"].as_str().map(str::to_owned);
+        result.target = cap.min(last);
+        let urls: Vec<String> = manifest["levels"]
+            .as_array()
+            .map(|a| {
+                a.iter()
+                    .map(|l| l["url"].as_str().unwrap_or("").to_owned())
+                    .collect()
+            })
+            .unwrap_or_default();
+        if urls.len() <= result.target as usize {
+            result.failure = Some("manifest lists fewer levels than its cap".into());
+            return (result, reqs);
+        }
+        if let Some(textures) = manifest["textures"].as_array() {
+            for t in textures {
+                let f = self
+                    .fetch(
+                        &client,
+                        Kind::Texture,
+                        t["url"].as_str().unwrap_or(""),
+                        false,
+                    )
+                    .await;
+                reqs.push(f.req);
+                if f.req.status != 200 {
+                    fail(&mut result, &f, "texture");
+                    return (result, reqs);
+                }
+            }
+        }
+
+        let base = self.fetch(&client, Kind::Base, &urls[0], false).await;
+        reqs.push(base.req);
+        if base.req.status != 200 {
+            fail(&mut result, &base, "base");
+            return (result, reqs);
+        }
+        self.decode_wait(0, device).await;
+        result.level_ms.push(t0.elapsed().as_secs_f64() * 1e3);
+
+        let mut prefetch: Option<tokio::task::JoinHandle<Fetched>> = None;
+        for k in 1..=result.target as usize {
+            let f = match prefetch.take() {
+                Some(handle) => match handle.await {
+                    Ok(f) => f,
+                    Err(e) => {
+                        result.failure = Some(format!("prefetch task: {e}"));
+                        break;
+                    }
+                },
+                None => self.fetch(&client, Kind::Batch, &urls[k], false).await,
+            };
+            reqs.push(f.req);
+            if f.req.status == 403 || f.req.status == 429 {
+                let body: serde_json::Value = f
+                    .body
+                    .as_deref()
+                    .and_then(|b| serde_json::from_slice(b).ok())
+                    .unwrap_or_default();
+                if body["error"] == "level_capped" {
+                    let reason = body["reason"].as_str().map(str::to_owned);
+                    result.refused = Some((k as u32, f.req.status, reason));
+                    break;
+                }
+            }
+            if f.req.status != 200 {
+                fail(&mut result, &f, &format!("batch {k}"));
+                break;
+            }
+            if k < result.target as usize {
+                let (visit, client, url) = (Arc::clone(&self), client.clone(), urls[k + 1].clone());
+                prefetch = Some(tokio::spawn(async move {
+                    visit.fetch(&client, Kind::Batch, &url, false).await
+                }));
+            }
+            self.decode_wait(k, device).await;
+            result.level_ms.push(t0.elapsed().as_secs_f64() * 1e3);
+        }
+        (result, reqs)
+    }
+}
+
+/// Runs a crowd to the end.
+pub async fn run_crowd(config: CrowdConfig, profile: Arc<DecodeProfile>) -> Result<CrowdOutcome> {
+    let config = Arc::new(config);
+    let epoch = Instant::now();
+    let visit = Arc::new(Visit {
+        config: Arc::clone(&config),
+        profile,
+        epoch,
+    });
+    let done = Arc::new(AtomicBool::new(false));
+    let pressure = Arc::new(AtomicU8::new(0));
+    let sampler = tokio::spawn(sample_pressure(
+        config.base_url.clone(),
+        Arc::clone(&done),
+        Arc::clone(&pressure),
+    ));
+    let sigterm = config.sigterm.map(|(pid, after)| {
+        tokio::spawn(async move {
+            tokio::time::sleep(after).await;
+            let at = epoch.elapsed();
+            let _ = tokio::process::Command::new("kill")
+                .args(["-TERM", &pid.to_string()])
+                .status()
+                .await;
+            at
+        })
+    });
+
+    let mut visitors = Vec::with_capacity(config.visitors);
+    let mut requests = Vec::with_capacity(config.visitors * 16);
+    if config.sequential {
+        // One visitor per (device, audience) pair present in the mix, alone.
+        let mut seen = Vec::new();
+        for i in 0..config.visitors {
+            let pair = mix(i, config.tablet_share, config.researcher_share);
+            if seen.contains(&pair) {
+                continue;
+            }
+            seen.push(pair);
+            let start = epoch.elapsed();
+            let (r, q) = Arc::clone(&visit).run(pair.0, pair.1, start).await;
+            visitors.push(r);
+            requests.extend(q);
+        }
+    } else {
+        let mut set = tokio::task::JoinSet::new();
+        for i in 0..config.visitors {
+            let (device, audience) = mix(i, config.tablet_share, config.researcher_share);
+            let arrive = config.pattern.arrival(i, config.visitors);
+            set.spawn(Arc::clone(&visit).run(device, audience, arrive));
+        }
+        while let Some(joined) = set.join_next().await {
+            let (r, q) = joined.context("visitor task")?;
+            visitors.push(r);
+            requests.extend(q);
+        }
+    }
+    let wall = epoch.elapsed();
+    done.store(true, Ordering::Relaxed);
+    let _ = sampler.await;
+    let sigterm_at = match sigterm {
+        Some(h) => Some(h.await?),
+        None => None,
+    };
+    Ok(CrowdOutcome {
+        visitors,
+        requests,
+        wall,
+        pressure_max: pressure.load(Ordering::Relaxed),
+        sigterm_at,
+    })
+}
+
+/// Polls `/metrics` for the highest load pressure seen.
+async fn sample_pressure(base_url: String, done: Arc<AtomicBool>, max: Arc<AtomicU8>) {
+    let client = Client::new();
+    while !done.load(Ordering::Relaxed) {
+        if let Ok(r) = client
+            .get(format!("{base_url}/metrics"))
+            .timeout(Duration::from_secs(2))
+            .send()
+            .await
+        {
+            if let Ok(text) = r.text().await {
+                if let Some(p) = metric(&text, "vitrine_load_pressure") {
+                    max.fetch_max(p as u8, Ordering::Relaxed);
+                }
+            }
+        }
+        tokio::time::sleep(Duration::from_millis(250)).await;
+    }
+}
+
+/// The value of an unlabelled metric in Prometheus text format.
+pub fn metric(text: &str, name: &str) -> Option<f64> {
+    text.lines()
+        .filter(|l| !l.starts_with('#'))
+        .find_map(|l| l.strip_prefix(name)?.strip_prefix(' ')?.trim().parse().ok())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn patterns_parse_and_spread() {
+        assert_eq!("burst".parse::<Pattern>(), Ok(Pattern::Burst));
+        assert_eq!("ramp:10".parse::<Pattern>(), Ok(Pattern::Ramp(10.0)));
+        assert!("steady".parse::<Pattern>().is_err());
+        let p = Pattern::Steady(10.0);
+        assert_eq!(p.arrival(5, 10), Duration::from_secs(5));
+        assert!(Pattern::Ramp(10.0).arrival(1, 4) > Duration::from_secs(4));
+    }
+
+    #[test]
+    fn mix_shares_hold_in_prefixes() {
+        let tablets = (0..1000)
+            .filter(|&i| mix(i, 0.3, 0.05).0 == Device::Tablet)
+            .count();
+        let researchers = (0..1000)
+            .filter(|&i| mix(i, 0.3, 0.05).1 == Audience::Researcher)
+            .count();
+        assert!((280..=320).contains(&tablets), "{tablets}");
+        assert!((40..=60).contains(&researchers), "{researchers}");
+    }
+
+    #[test]
+    fn metric_lines() {
+        let text = "# HELP x\nvitrine_load_pressure 3\nvitrine_load_pressure_other 9\n";
+        assert_eq!(metric(text, "vitrine_load_pressure"), Some(3.0));
+    }
+}
