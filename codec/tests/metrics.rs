@@ -120,7 +120,7 @@ fn roy_rmse_of_a_recoloured_mesh_is_the_known_value() {
     let mut approx = original.clone();
     // Every other vertex moves by (3, 4, 0): a colour distance of 5.
     for (i, c) in approx.colors.as_mut().unwrap().iter_mut().enumerate() {
-        if i % 2 == 0 {
+        if i.is_multiple_of(2) {
             *c = [c[0] + 3, c[1] - 4, c[2]];
         }
     }
@@ -142,7 +142,7 @@ fn roy_rmse_against_a_coarser_mesh_matches_a_brute_force_nearest_vertex() {
         .zip(original.colors.as_ref().unwrap())
         .enumerate()
     {
-        if i % 3 == 0 {
+        if i.is_multiple_of(3) {
             approx.positions.push([p[0] * 1.02, p[1], p[2] + 0.01]);
             colours.push([c[0] / 2, c[1], 255 - c[2]]);
         }

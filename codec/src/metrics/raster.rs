@@ -146,22 +146,58 @@ impl Lighting {
 
     /// The lit colour (sRGB, `0..=1`) of albedo `srgb` under unit view-space normal `n`.
     pub fn shade(&self, n: Vec3, srgb: [f32; 3]) -> [f32; 3] {
+        self.linear(n, srgb)
+            .map(|c| c.clamp(0.0, 1.0).powf(1.0 / 2.2))
+    }
+
+    /// [`Lighting::shade`] before gamma encoding (not clamped).
+    fn linear(&self, n: Vec3, srgb: [f32; 3]) -> [f32; 3] {
         let ambient = self.ground + (self.sky - self.ground) * (0.5 + 0.5 * n.y);
         let light = ambient
             + self.key_intensity * n.dot(self.key).max(0.0)
             + self.fill_intensity * n.dot(self.fill).max(0.0);
         let spec = if self.specular > 0.0 {
             let half = (self.key + Vec3::Z).normalize();
-            self.specular * n.dot(half).max(0.0).powf(self.shininess)
+            let cos = n.dot(half).max(0.0);
+            let power = if self.shininess.fract() == 0.0 && self.shininess.abs() < 256.0 {
+                cos.powi(self.shininess as i32)
+            } else {
+                cos.powf(self.shininess)
+            };
+            self.specular * power
         } else {
             0.0
         };
-        srgb.map(|c| {
-            (c.clamp(0.0, 1.0).powf(2.2) * light + spec)
-                .clamp(0.0, 1.0)
-                .powf(1.0 / 2.2)
-        })
+        srgb.map(|c| c.clamp(0.0, 1.0).powf(2.2) * light + spec)
     }
+}
+
+/// `round(255 · clamp(x, 0, 1)^(1/2.2))`, the viewer's gamma encoding to 8 bits,
+/// through a table (exactly, up to rounding of the thresholds).
+fn encode(x: f32) -> u8 {
+    const BUCKETS: usize = 1 << 14;
+    struct Table {
+        /// The code of the bucket's lower end.
+        start: Vec<u8>,
+        /// The linear value from which code k applies.
+        threshold: [f32; 256],
+    }
+    static TABLE: std::sync::OnceLock<Table> = std::sync::OnceLock::new();
+    let table = TABLE.get_or_init(|| {
+        let code = |x: f32| (x.powf(1.0 / 2.2) * 255.0).round() as u8;
+        Table {
+            start: (0..BUCKETS)
+                .map(|i| code(i as f32 / BUCKETS as f32))
+                .collect(),
+            threshold: std::array::from_fn(|k| ((k as f32 - 0.5).max(0.0) / 255.0).powf(2.2)),
+        }
+    });
+    let x = x.clamp(0.0, 1.0);
+    let mut k = table.start[((x * BUCKETS as f32) as usize).min(BUCKETS - 1)];
+    while k < 255 && x >= table.threshold[k as usize + 1] {
+        k += 1;
+    }
+    k
 }
 
 impl Default for Lighting {
@@ -474,8 +510,7 @@ pub fn render(
         }
         let n_view = Vec3::new(n.dot(view.right), n.dot(view.up), -n.dot(view.forward));
         let albedo = shader.colour(t as usize, bary, world);
-        let lit = options.lighting.shade(n_view, albedo);
-        rgb[i] = lit.map(|c| (c * 255.0).round() as u8);
+        rgb[i] = options.lighting.linear(n_view, albedo).map(encode);
     }
     let luminance = rgb.iter().map(|&c| luma(c)).collect();
     Frame {
@@ -507,5 +542,27 @@ fn ray_barycentric(origin: Vec3, dir: Vec3, p: [Vec3; 3]) -> [f32; 3] {
         b.map(|x| x / sum)
     } else {
         [1.0 / 3.0; 3]
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::encode;
+
+    #[test]
+    fn the_encoding_table_matches_the_power_law() {
+        for i in 0..=200_000 {
+            let x = i as f32 / 200_000.0;
+            let exact = x.powf(1.0 / 2.2) * 255.0;
+            let code = f32::from(encode(x));
+            // Equal, except within float noise of a rounding boundary.
+            assert!(
+                (code - exact.round()).abs() == 0.0 || (exact.fract() - 0.5).abs() < 1e-3,
+                "{x}: {code} vs {exact}"
+            );
+        }
+        assert_eq!(encode(-1.0), 0);
+        assert_eq!(encode(2.0), 255);
+        assert_eq!(encode(f32::NAN), 0);
     }
 }
