@@ -15,6 +15,7 @@
 #![forbid(unsafe_code)]
 
 mod base_mesh;
+pub mod colour_metric;
 mod decoder;
 mod encoder;
 mod entropy;

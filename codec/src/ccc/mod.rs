@@ -163,3 +163,109 @@ pub fn encode_with_ccc(
     let encoded = encode_guarded(&geometry_only, options, Some(&guard), progress)?;
     Ok((encoded, mapping))
 }
+
+/// How colour travels: the thesis' three approaches on one codec, or none.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum ColourMode {
+    /// Cubic cell complex texture shared by every level, guarded decimation.
+    Ccc,
+    /// Per-vertex colour in the stream.
+    Vertex,
+    /// Per-vertex colour plus the Lee–Lavoué–Dupont 2012 colour metric guard.
+    VertexMetric,
+    /// Geometry only.
+    None,
+}
+
+impl ColourMode {
+    pub const ALL: [ColourMode; 4] = [ColourMode::Ccc, ColourMode::Vertex, ColourMode::VertexMetric, ColourMode::None];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            ColourMode::Ccc => "ccc",
+            ColourMode::Vertex => "vertex",
+            ColourMode::VertexMetric => "vertex-metric",
+            ColourMode::None => "none",
+        }
+    }
+}
+
+impl std::fmt::Display for ColourMode {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl std::str::FromStr for ColourMode {
+    type Err = crate::Error;
+    fn from_str(s: &str) -> Result<Self> {
+        ColourMode::ALL
+            .into_iter()
+            .find(|m| m.name() == s)
+            .ok_or_else(|| crate::Error::Parameter(format!("colour mode must be ccc, vertex, vertex-metric or none, got {s:?}")))
+    }
+}
+
+/// The texture's colour at each mesh vertex (bilinear through the file's
+/// UVs), matched by position: welding and repair keep positions exactly.
+/// A vertex on a UV seam takes the first side's colour.
+pub fn vertex_colours_from_texture(mesh: &IndexedMesh, texture: &crate::import::TexturedSurface) -> Vec<[u8; 3]> {
+    let key = |p: [f32; 3]| p.map(f32::to_bits);
+    let mut by_position = std::collections::HashMap::with_capacity(texture.positions.len());
+    for (p, uv) in texture.positions.iter().zip(&texture.uvs) {
+        by_position.entry(key(*p)).or_insert(*uv);
+    }
+    mesh.positions
+        .iter()
+        .map(|p| match by_position.get(&key(*p)) {
+            Some(uv) => build::sample_bilinear(&texture.image, glam::DVec2::new(uv[0] as f64, uv[1] as f64))
+                .map(|c| c.round().clamp(0.0, 255.0) as u8),
+            None => [128, 128, 128],
+        })
+        .collect()
+}
+
+/// Encodes a mesh with its colour carried the way `mode` says. The colour
+/// comes from `texture` when given, else from the mesh's per-vertex colour.
+pub fn encode_coloured(
+    mesh: &IndexedMesh,
+    texture: Option<&crate::import::TexturedSurface>,
+    mode: ColourMode,
+    options: &EncodeOptions,
+    ccc: &CccOptions,
+    progress: impl FnMut(EncodeProgress),
+) -> Result<(Encoded, Option<TextureMapping>)> {
+    let no_colour = || {
+        crate::Error::Parameter(format!(
+            "colour mode {mode} needs colour, and the mesh has neither a texture nor per-vertex colour"
+        ))
+    };
+    let with_vertex_colours = || -> Result<IndexedMesh> {
+        let colors = match texture {
+            Some(t) => vertex_colours_from_texture(mesh, t),
+            None => mesh.colors.clone().ok_or_else(no_colour)?,
+        };
+        Ok(IndexedMesh { colors: Some(colors), ..mesh.clone() })
+    };
+    match mode {
+        ColourMode::Ccc => {
+            let source = match texture {
+                Some(t) => ColourSource::Texture(t),
+                None if mesh.colors.is_some() => ColourSource::PerVertex(mesh),
+                None => return Err(no_colour()),
+            };
+            let (encoded, mapping) = encode_with_ccc(mesh, options, source, ccc, progress)?;
+            Ok((encoded, Some(mapping)))
+        }
+        ColourMode::Vertex => Ok((crate::encode_with_progress(&with_vertex_colours()?, options, progress)?, None)),
+        ColourMode::VertexMetric => {
+            let guard = crate::colour_metric::ColourMetricGuard::default();
+            Ok((encode_guarded(&with_vertex_colours()?, options, Some(&guard), progress)?, None))
+        }
+        ColourMode::None => {
+            let geometry = IndexedMesh { colors: None, ..mesh.clone() };
+            Ok((crate::encode_with_progress(&geometry, options, progress)?, None))
+        }
+    }
+}
