@@ -1624,9 +1624,30 @@ mod textured {
                 [m[0] + p[0] as u64, m[1] + p[1] as u64, m[2] + p[2] as u64]
             });
             let px = (w as u64 * h as u64).max(1);
+            // Colour at the vertices' UVs (nearest texel): a wrong v
+            // convention samples the atlas's empty background instead.
+            let at_uvs = |flip: bool| {
+                let sum = tex.uvs.iter().fold([0u64; 3], |m, &[u, v]| {
+                    let v = if flip { 1.0 - v } else { v };
+                    let x = ((u * w as f32) as u32).min(w - 1);
+                    let y = ((v * h as f32) as u32).min(h - 1);
+                    let p = tex.image.get_pixel(x, y);
+                    [m[0] + p[0] as u64, m[1] + p[1] as u64, m[2] + p[2] as u64]
+                });
+                sum.map(|c| c / tex.uvs.len().max(1) as u64)
+            };
+            let (sampled, flipped) = (at_uvs(false), at_uvs(true));
+            let luma = |c: [u64; 3]| c[0] + c[1] + c[2];
+            // The banana's atlas is mostly black around the fruit; the mask's
+            // photograph fills its image, so the test tells nothing there.
+            assert!(
+                !name.starts_with("banana") || luma(sampled) > 2 * luma(flipped),
+                "{name}: UVs sample {sampled:?}, flipped {flipped:?}"
+            );
             eprintln!(
                 "{name}: mesh {} vertices / {} triangles; textured surface {} vertices \
-                 ({} UVs in [0,1]), {} triangles; image {w}×{h}, mean RGB {:?}; textured import {elapsed:.2?} (geometry alone {geometry:.2?})",
+                 ({} UVs in [0,1]), {} triangles; image {w}×{h}, mean RGB {:?}, at the UVs {sampled:?} \
+                 (v flipped: {flipped:?}); textured import {elapsed:.2?} (geometry alone {geometry:.2?})",
                 got.mesh.positions.len(),
                 got.mesh.triangles.len(),
                 tex.positions.len(),
