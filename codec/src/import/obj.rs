@@ -703,6 +703,28 @@ mod tests {
     }
 
     #[test]
+    fn map_statement_options_are_skipped() {
+        let f = |s: &str| map_file_name(s);
+        assert_eq!(f("tex.png").as_deref(), Some("tex.png"));
+        assert_eq!(f("-s 1 1 1 tex.png").as_deref(), Some("tex.png"));
+        assert_eq!(f("-o 0.5 tex.png").as_deref(), Some("tex.png"));
+        assert_eq!(
+            f("-mm 0 1 -clamp on \"a b.png\"").as_deref(),
+            Some("a b.png")
+        );
+        assert_eq!(f("-bm 0.5 my tex.jpg").as_deref(), Some("my tex.jpg"));
+        assert_eq!(f("-s 1 1 1"), None);
+        assert_eq!(f(""), None);
+        let mut maps = HashMap::new();
+        parse_mtl(
+            b"newmtl a b\r\nmap_Kd  one.png # c\nMAP_KD two.png\nnewmtl c\nmap_Ka x.png\n",
+            &mut maps,
+        );
+        assert_eq!(maps.len(), 1);
+        assert_eq!(maps["a b"], "one.png");
+    }
+
+    #[test]
     fn forward_references_are_allowed() {
         let m = read_str("f 1 2 3\nv 0 0 0\nv 1 0 0\nv 0 1 0\n").unwrap();
         assert_eq!(m.triangles, vec![[0, 1, 2]]);
