@@ -16,6 +16,7 @@
  */
 
 import { multiply } from './camera.js';
+import { GLSL_CCC, cccUniforms } from './ccc.js';
 import { BACKGROUND, CLAY, GLSL_SHADE, WIRE_ALPHA, WIRE_COLOUR } from './shading.js';
 
 const UPLOAD_BUDGET_MS = 6;
@@ -29,9 +30,11 @@ uniform mat4 u_view;
 uniform mat4 u_viewProjection;
 out vec3 v_normal;
 out vec3 v_colour;
+out vec3 v_world;
 void main() {
   v_normal = mat3(u_view) * a_normal;
   v_colour = a_colour;
+  v_world = a_position;
   gl_Position = u_viewProjection * vec4(a_position, 1.0);
 }`;
 
@@ -39,9 +42,12 @@ const FRAGMENT_SHADER = `#version 300 es
 precision highp float;
 in vec3 v_normal;
 in vec3 v_colour;
+in vec3 v_world;
 uniform bool u_wire;
+uniform bool u_ccc;
 out vec4 o_colour;
 ${GLSL_SHADE}
+${GLSL_CCC}
 void main() {
   if (u_wire) {
     o_colour = vec4(${WIRE_COLOUR.join(', ')}, ${WIRE_ALPHA});
@@ -51,7 +57,9 @@ void main() {
   vec3 n = dot(v_normal, v_normal) > 0.0 ? normalize(v_normal) : vec3(0.0, 0.0, 1.0);
   // Scans have holes: the inside is lit like the outside.
   if (!gl_FrontFacing) n = -n;
-  o_colour = vec4(shade(n, v_colour), 1.0);
+  // Colour from the cell complex (the same texture at every level) or per vertex.
+  vec3 albedo = u_ccc ? cccColour(v_world) : v_colour;
+  o_colour = vec4(shade(n, albedo), 1.0);
 }`;
 
 /** @typedef {import('./reconstruction.js').LevelMessage} LevelMessage */
@@ -65,6 +73,16 @@ void main() {
  * @property {WebGLBuffer | null} edgeBuffer
  * @property {Array<{ target: number, buffer: WebGLBuffer, data: ArrayBufferView, offset: number }>} uploads
  */
+
+/**
+ * A CCC colour mapping as the renderer holds it: the sources are kept so a
+ * lost context can be rebuilt.
+ * @typedef {object} ColourMapping
+ * @property {import('./ccc.js').CccParameters} parameters
+ * @property {import('./ccc.js').Pixels} cells the decoded cell texture
+ */
+
+/** @typedef {'low' | 'full'} AtlasResolution */
 
 export class Renderer {
   /** @type {WebGL2RenderingContext} */
@@ -85,6 +103,14 @@ export class Renderer {
   #program = null;
   /** @type {Record<string, WebGLUniformLocation | null>} */
   #uniforms = {};
+  /** @type {ColourMapping | null} */
+  #mapping = null;
+  /** @type {{ source: TexImageSource, width: number, height: number, resolution: AtlasResolution } | null} */
+  #atlas = null;
+  /** @type {WebGLTexture | null} */
+  #cellTexture = null;
+  /** @type {WebGLTexture | null} */
+  #atlasTexture = null;
 
   /**
    * @param {HTMLCanvasElement} canvas
@@ -128,9 +154,14 @@ export class Renderer {
       throw new Error(`program: ${gl.getProgramInfoLog(program)}`);
     }
     this.#program = program;
-    for (const name of ['u_view', 'u_viewProjection', 'u_wire']) {
+    const names = ['u_view', 'u_viewProjection', 'u_wire', 'u_ccc', 'u_cells', 'u_atlas'];
+    for (const name of [...names, ...Object.keys(cccUniforms(PLACEHOLDER, { width: 1, height: 1 }))]) {
       this.#uniforms[name] = gl.getUniformLocation(program, name);
     }
+    // Fixed texture units: an integer and a float sampler may not share one.
+    gl.useProgram(program);
+    gl.uniform1i(this.#uniforms.u_cells, 0);
+    gl.uniform1i(this.#uniforms.u_atlas, 1);
     gl.enable(gl.DEPTH_TEST);
     gl.clearColor(BACKGROUND[0], BACKGROUND[1], BACKGROUND[2], 1);
   }
@@ -138,7 +169,10 @@ export class Renderer {
   #restore() {
     this.lost = false;
     this.#fence = null;
+    this.#cellTexture = null;
+    this.#atlasTexture = null;
     this.#init();
+    this.#uploadColour();
     const newest = this.pending?.source ?? this.current?.source;
     this.current = null;
     this.pending = null;
@@ -179,6 +213,94 @@ export class Renderer {
       }
     }
     this.requestFrame();
+  }
+
+  /**
+   * Sets (or clears) the CCC colour mapping. It is drawn once a colour
+   * texture is set too (`setColourAtlas`); until then levels keep their
+   * per-vertex colour, or clay.
+   * @param {ColourMapping | null} mapping
+   */
+  setColourMapping(mapping) {
+    this.#mapping = mapping;
+    this.#atlas = null;
+    this.#uploadColour();
+    this.requestFrame();
+  }
+
+  /**
+   * Sets the colour texture: the low-resolution one first, the full one
+   * when it arrives. Uploaded at once (one texImage2D).
+   * @param {TexImageSource & { width: number, height: number }} source a decoded JPEG (ImageBitmap)
+   * @param {AtlasResolution} resolution
+   */
+  setColourAtlas(source, resolution) {
+    this.#atlas = { source, width: source.width, height: source.height, resolution };
+    this.#uploadColour();
+    this.requestFrame();
+  }
+
+  /** Which colour texture is drawn: null without a CCC mapping. */
+  get colourResolution() {
+    return this.#mapping && this.#atlas ? this.#atlas.resolution : null;
+  }
+
+  /** The largest texture side this GPU takes. */
+  get maxTextureSize() {
+    return /** @type {number} */ (this.gl.getParameter(this.gl.MAX_TEXTURE_SIZE));
+  }
+
+  /** (Re)creates the GPU textures from the kept sources. */
+  #uploadColour() {
+    if (this.lost) return;
+    const gl = this.gl;
+    if (!this.#mapping) {
+      if (this.#cellTexture) gl.deleteTexture(this.#cellTexture);
+      this.#cellTexture = null;
+    } else if (!this.#cellTexture) {
+      // RGBA8UI read with texelFetch: integers, no filtering, no colour
+      // conversion. RGB data is widened to RGBA (RGB8UI rows need not be
+      // 4-byte aligned, and RGBA8UI is the format every GPU renders to).
+      const { width, height, channels, data } = this.#mapping.cells;
+      let rgba = data;
+      if (channels !== 4) {
+        rgba = new Uint8Array(width * height * 4);
+        for (let i = 0, j = 0; i < width * height; i++, j += channels) {
+          rgba[4 * i] = data[j];
+          rgba[4 * i + 1] = data[j + 1];
+          rgba[4 * i + 2] = data[j + 2];
+          rgba[4 * i + 3] = 255;
+        }
+      }
+      this.#cellTexture = gl.createTexture();
+      gl.activeTexture(gl.TEXTURE0);
+      gl.bindTexture(gl.TEXTURE_2D, this.#cellTexture);
+      gl.pixelStorei(gl.UNPACK_ALIGNMENT, 1);
+      gl.texImage2D(gl.TEXTURE_2D, 0, gl.RGBA8UI, width, height, 0, gl.RGBA_INTEGER, gl.UNSIGNED_BYTE, rgba);
+      gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_MIN_FILTER, gl.NEAREST);
+      gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_MAG_FILTER, gl.NEAREST);
+      gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_WRAP_S, gl.CLAMP_TO_EDGE);
+      gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_WRAP_T, gl.CLAMP_TO_EDGE);
+    }
+    if (this.#atlasTexture) gl.deleteTexture(this.#atlasTexture);
+    this.#atlasTexture = null;
+    if (this.#atlas) {
+      this.#atlasTexture = gl.createTexture();
+      gl.activeTexture(gl.TEXTURE1);
+      gl.bindTexture(gl.TEXTURE_2D, this.#atlasTexture);
+      // Bytes as stored: no colour-space conversion, no premultiplication,
+      // row 0 at the top (the atlas layout's y grows downward, like t).
+      gl.pixelStorei(gl.UNPACK_COLORSPACE_CONVERSION_WEBGL, gl.NONE);
+      gl.pixelStorei(gl.UNPACK_PREMULTIPLY_ALPHA_WEBGL, false);
+      gl.pixelStorei(gl.UNPACK_FLIP_Y_WEBGL, false);
+      gl.texImage2D(gl.TEXTURE_2D, 0, gl.RGBA8, gl.RGBA, gl.UNSIGNED_BYTE, this.#atlas.source);
+      // Bilinear, no mipmaps: a mip level would blend neighbouring tiles.
+      gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_MIN_FILTER, gl.LINEAR);
+      gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_MAG_FILTER, gl.LINEAR);
+      gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_WRAP_S, gl.CLAMP_TO_EDGE);
+      gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_WRAP_T, gl.CLAMP_TO_EDGE);
+    }
+    gl.activeTexture(gl.TEXTURE0);
   }
 
   /** @param {boolean} on */
@@ -327,6 +449,31 @@ export class Renderer {
     gl.deleteVertexArray(mesh.vao);
   }
 
+  /** Switches the shader to the CCC lookup when a mapping and a colour texture are on the GPU. */
+  #bindColour() {
+    const gl = this.gl;
+    const on = Boolean(this.#mapping && this.#atlas && this.#cellTexture && this.#atlasTexture);
+    gl.uniform1i(this.#uniforms.u_ccc, on ? 1 : 0);
+    if (!on || !this.#mapping || !this.#atlas) return;
+    gl.activeTexture(gl.TEXTURE0);
+    gl.bindTexture(gl.TEXTURE_2D, this.#cellTexture);
+    gl.activeTexture(gl.TEXTURE1);
+    gl.bindTexture(gl.TEXTURE_2D, this.#atlasTexture);
+    gl.activeTexture(gl.TEXTURE0);
+    const u = this.#uniforms;
+    const values = cccUniforms(this.#mapping.parameters, this.#atlas);
+    gl.uniform3fv(u.u_origin, values.u_origin);
+    gl.uniform1f(u.u_cellSize, values.u_cellSize);
+    gl.uniform3iv(u.u_dims, values.u_dims);
+    gl.uniform1i(u.u_cellsOffset, values.u_cellsOffset);
+    gl.uniform1i(u.u_cellsWidth, values.u_cellsWidth);
+    gl.uniform1i(u.u_cellCount, values.u_cellCount);
+    gl.uniform2fv(u.u_tile, values.u_tile);
+    gl.uniform1i(u.u_tilesPerRow, values.u_tilesPerRow);
+    gl.uniform2fv(u.u_atlasScale, values.u_atlasScale);
+    gl.uniform3fv(u.u_fallback, values.u_fallback);
+  }
+
   #draw() {
     const gl = this.gl;
     gl.viewport(0, 0, this.canvas.width, this.canvas.height);
@@ -347,6 +494,7 @@ export class Renderer {
       gl.polygonOffset(1, 1);
     }
     gl.uniform1i(this.#uniforms.u_wire, 0);
+    this.#bindColour();
     gl.drawElements(gl.TRIANGLES, mesh.source.indices.length, gl.UNSIGNED_INT, 0);
     gl.disable(gl.POLYGON_OFFSET_FILL);
     if (wire && mesh.source.edges) {
@@ -364,6 +512,21 @@ export class Renderer {
     gl.bindVertexArray(null);
   }
 }
+
+/** Parameters that only name the uniforms (their values are not used). */
+const PLACEHOLDER = /** @type {import('./ccc.js').CccParameters} */ ({
+  version: 1,
+  origin: [0, 0, 0],
+  cell_size: 1,
+  dims: [1, 1, 1],
+  cells: 0,
+  cell_texture: { width: 1, height: 1, cells_offset: 1 },
+  tile_size: 1,
+  gutter: 0,
+  atlas: { width: 1, height: 1, tiles_per_row: 1, tiles: 0 },
+  low_res_factor: 1,
+  fallback_colour: [0, 0, 0],
+});
 
 /** @returns {Omit<GpuMesh, 'source'>} */
 function emptyMesh() {

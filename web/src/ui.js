@@ -29,6 +29,12 @@ button[aria-pressed="true"] { background: #5e81ac; border-color: #81a1c1; }
 .status { position: absolute; left: 10px; bottom: 12px; right: 10px; display: flex; flex-direction: column;
   align-items: flex-start; gap: 6px; pointer-events: none; }
 .notice { background: rgba(94, 72, 20, 0.88); border: 1px solid #ebcb8b; }
+.colour { font-size: 12px; color: #cfd5de; }
+.colour::before { content: ""; display: inline-block; width: 8px; height: 8px; border-radius: 50%;
+  margin-right: 6px; background: #4c566a; }
+.colour[data-colour="low"]::before { background: #ebcb8b; }
+.colour[data-colour="full"]::before { background: #a3be8c; }
+.colour[data-error]::before { background: #bf616a; }
 .bar { position: absolute; left: 0; bottom: 0; height: 3px; background: #88c0d0; transition: width 0.3s; }
 .error { position: absolute; inset: 0; display: grid; place-items: center; background: rgba(20, 22, 26, 0.6); }
 .error div { background: #3b2226; border: 1px solid #bf616a; border-radius: 8px; padding: 16px 20px;
@@ -61,6 +67,7 @@ export class ViewerUi {
   </div>
   <div class="status">
     <div class="notice pill" role="status" hidden></div>
+    <div class="colour pill" hidden></div>
     <div class="progress pill" aria-live="polite">Loading…</div>
   </div>
   <div class="bar" style="width: 0"></div>
@@ -72,6 +79,7 @@ export class ViewerUi {
     this.panel = $('.panel');
     this.progress = $('.progress');
     this.notice = $('.notice');
+    this.colour = $('.colour');
     this.bar = $('.bar');
     this.error = $('.error');
     this.wireButton = $('[data-action="wireframe"]');
@@ -129,6 +137,7 @@ export class ViewerUi {
 
   /** @param {import('./viewer.js').ViewerState} state */
   setProgress(state) {
+    this.#setColour(state);
     if (state.shownLevel < 0) {
       this.progress.textContent = `Loading… ${formatBytes(state.received)} received`;
       return;
@@ -137,6 +146,27 @@ export class ViewerUi {
     this.progress.textContent =
       `Level ${state.shownLevel} of ${state.lastLevel} · ${vertices} vertices · ${formatBytes(state.received)} received`;
     this.bar.style.width = `${(100 * state.shownLevel) / Math.max(1, state.lastLevel)}%`;
+  }
+
+  /**
+   * The colour texture's state: loading, low resolution (the full one on its
+   * way), full resolution, or why there is none.
+   * @param {import('./viewer.js').ViewerState} state
+   */
+  #setColour(state) {
+    const texts = {
+      loading: 'Colour texture loading…',
+      low: 'Colour: low resolution · full resolution loading…',
+      full: 'Colour: full resolution',
+    };
+    const text = state.colourError
+      ? `Colour: ${state.colourError}`
+      : texts[/** @type {keyof typeof texts} */ (state.colour)] ?? null;
+    this.colour.hidden = text === null;
+    this.colour.textContent = text ?? '';
+    this.colour.dataset.colour = state.colour;
+    if (state.colourError) this.colour.dataset.error = '';
+    else delete this.colour.dataset.error;
   }
 
   /** @param {string | null} text */

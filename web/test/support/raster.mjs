@@ -19,6 +19,9 @@ import { multiply } from '../../src/camera.js';
  * @property {Float32Array} projection
  * @property {number} width
  * @property {number} height
+ * @property {(position: [number, number, number]) => [number, number, number]} [albedoAt]
+ *   colour (sRGB 0–1) at a world position, instead of per-vertex colour: the
+ *   CCC lookup (src/ccc.js), evaluated per pixel like the fragment shader
  */
 
 /**
@@ -79,14 +82,18 @@ export function rasterize(scene) {
         const w = [pa / sum, pb / sum, pc / sum];
         const corners = [a, b, c];
         const normal = [0, 0, 0];
-        const albedo = colours ? [0, 0, 0] : [...CLAY];
+        let albedo = colours ? [0, 0, 0] : [...CLAY];
+        /** @type {[number, number, number]} */
+        const world = [0, 0, 0];
         for (let k = 0; k < 3; k++) {
           const v = corners[k];
           for (let i = 0; i < 3; i++) {
             normal[i] += (w[k] * normals[3 * v + i]) / 32767;
+            world[i] += w[k] * positions[3 * v + i];
             if (colours) albedo[i] += (w[k] * colours[3 * v + i]) / 255;
           }
         }
+        if (scene.albedoAt) albedo = scene.albedoAt(world);
         const viewNormal = [0, 1, 2].map(
           (r) => view[r] * normal[0] + view[4 + r] * normal[1] + view[8 + r] * normal[2],
         );
