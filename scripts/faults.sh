@@ -354,19 +354,19 @@ case_disconnects() {
 
 case_shutdown() {
     pg_setup || { report SKIP shutdown "no PostgreSQL binaries (requests need a slow database to be in flight)"; return; }
-    "$load" proxy --listen "127.0.0.1:$proxy_port" --to "127.0.0.1:$pg_port" --delay-ms 300 2>/dev/null &
+    "$load" proxy --listen "127.0.0.1:$proxy_port" --to "127.0.0.1:$pg_port" --delay-ms 200 2>/dev/null &
     pids+=("$!")
     local proxy=$!
     sleep 0.3
-    serve "postgres://postgres@127.0.0.1:$proxy_port/postgres" --cache-bytes 0 --record-ttl-ms 100 \
+    serve "postgres://postgres@127.0.0.1:$proxy_port/postgres" --cache-bytes 0 --record-ttl-ms 100 --db-max-connections 64 \
         --load-high-inflight 1000000000 --load-high-latency-ms 1000000000 --load-high-queue-ms 1000000000
     local pid=$server t0=$SECONDS
-    if "$load" crowd --url "$url" --slug sample --profile "$profile" --visitors 200 --pattern steady:6 \
+    if "$load" crowd --url "$url" --slug sample --profile "$profile" --visitors 80 --pattern steady:4 \
         --sigterm-pid "$pid" --sigterm-after-s 3 >"$work/shutdown.out" 2>&1; then
         wait "$pid"
         local status=$?
         server=""
-        report PASS shutdown "SIGTERM at 3 s into a crowd of 200 (database +300 ms): $(grep -m1 '^SIGTERM' "$work/shutdown.out"); server exit status $status after $((SECONDS - t0)) s"
+        report PASS shutdown "SIGTERM at 3 s into a crowd of 80 arriving over 4 s (database +200 ms, payload cache off): $(grep -m1 '^SIGTERM' "$work/shutdown.out"); server exit status $status after $((SECONDS - t0)) s"
     else
         report FAIL shutdown "$(tail -n 4 "$work/shutdown.out")"
         stop_server

@@ -578,16 +578,23 @@ async fn crowd(args: CrowdArgs) -> Result<()> {
             .iter()
             .filter(|r| r.start_us + 200_000 <= sig && r.start_us + r.dur_us > sig)
             .collect();
-        let bad = in_flight.iter().filter(|r| r.status != 200).count();
+        // Finished: an HTTP answer, 200 or a documented refusal, not a reset.
+        let bad = in_flight
+            .iter()
+            .filter(|r| !(matches!(r.status, 200 | 304) || allow.contains(&r.status)))
+            .count();
+        let ok = in_flight.iter().filter(|r| r.status == 200).count();
         let refused = outcome
             .requests
             .iter()
             .filter(|r| r.start_us > sig && r.status == 0)
             .count();
         println!(
-            "SIGTERM at {:.2} s: {} requests in flight (sent ≥ 200 ms before), {} of them not completed with 200; {} later requests found the server gone",
+            "SIGTERM at {:.2} s: {} requests in flight (sent ≥ 200 ms before): {} completed with 200, {} with 429/503, {} cut off; {} later requests found the server gone",
             at.as_secs_f64(),
             in_flight.len(),
+            ok,
+            in_flight.len() - ok - bad,
             bad,
             refused
         );
