@@ -9,11 +9,15 @@ import { readFileSync, mkdirSync, writeFileSync } from 'node:fs';
 import { createServer } from 'node:http';
 import { join } from 'node:path';
 import { launch } from '../test/support/browser.mjs';
-import { root } from '../test/support/fixtures.mjs';
+import { root, wasmPath } from '../test/support/fixtures.mjs';
+import { startService } from '../test/support/service.mjs';
 import { encodePng, quadComplex } from '../test/support/ccc-fixtures.mjs';
 import { foreground, rasterize } from '../test/support/raster.mjs';
 import { CellComplex } from '../src/ccc.js';
 import { OrbitCamera } from '../src/camera.js';
+import { VitrineCodec } from '../src/codec.js';
+import { vertexNormals } from '../src/geometry.js';
+import { decodePng } from '../src/png.js';
 
 /** @typedef {import('playwright-core').Page} Page */
 
@@ -23,14 +27,88 @@ const SCREENSHOTS = join(root, 'docs', 'screenshots');
 
 /** @type {Awaited<ReturnType<typeof launch>>} */
 let browser;
+/** @type {Awaited<ReturnType<typeof startService>>} */
+let service;
+/** @type {any} */
+let manifest;
 
 before(async () => {
+  service = await startService({
+    models: [
+      {
+        slug: 'painted',
+        title: 'Painted torus',
+        description: 'A generated torus; its colour lives in a cubic cell complex texture shared by every level.',
+        kind: 'torus',
+        kiloVertices: 30,
+        colour: true,
+        colourMode: 'ccc',
+        policy: 'open',
+      },
+    ],
+  });
   browser = await launch({ width: WIDTH, height: HEIGHT });
+  manifest = await (await fetch(`${service.url}/api/models/painted`)).json();
+  assert.equal(manifest.colour.mode, 'ccc');
+  assert.equal(manifest.has_colour, false, 'in ccc mode the stream carries geometry only');
+  assert.ok(manifest.last_level >= 4, 'the test model has several levels');
 });
 
 after(async () => {
   await browser?.close();
+  await service?.stop();
 });
+
+/**
+ * @param {Page} page
+ * @param {string} condition JS expression over `s` (the viewer's state)
+ * @param {number} [timeout]
+ */
+async function until(page, condition, timeout = 60_000) {
+  await page.waitForFunction(
+    (body) => {
+      const s = /** @type {any} */ (document.querySelector('vitrine-viewer'))?.viewer?.state;
+      return s ? new Function('s', `return (${body});`)(s) : false;
+    },
+    condition,
+    { timeout, polling: 50 },
+  );
+  return page.evaluate(() => /** @type {import('../src/viewer.js').ViewerState} */ (/** @type {any} */ (document.querySelector('vitrine-viewer')).viewer.state));
+}
+
+/**
+ * The canvas's pixels (RGBA, bottom-up), drawn and read in one task.
+ * @param {Page} page
+ */
+async function capture(page) {
+  const { width, height, data } = await page.evaluate(() => {
+    const { width, height, rgba } = /** @type {any} */ (document.querySelector('vitrine-viewer')).viewer.renderer.capture();
+    let binary = '';
+    for (let i = 0; i < rgba.length; i += 0x8000) binary += String.fromCharCode(...rgba.subarray(i, i + 0x8000));
+    return { width, height, data: btoa(binary) };
+  });
+  return { width, height, rgba: new Uint8Array(Buffer.from(data, 'base64')) };
+}
+
+/** @param {Page} page */
+function colourPill(page) {
+  return page.evaluate(() => {
+    const pill = /** @type {HTMLElement} */ (document.querySelector('vitrine-viewer')?.shadowRoot?.querySelector('.colour'));
+    return { text: pill.innerText, hidden: pill.hidden };
+  });
+}
+
+/**
+ * Chromaticity r/(r+g+b), g/(r+g+b) per pixel: the viewer's lighting scales
+ * a colour (albedo^2.2 · light, then ^(1/2.2)), so two levels whose normals
+ * differ still agree here where their colours agree.
+ * @param {Uint8Array} rgba
+ * @param {number} p pixel
+ */
+function chroma(rgba, p) {
+  const sum = rgba[4 * p] + rgba[4 * p + 1] + rgba[4 * p + 2] + 1e-9;
+  return [rgba[4 * p] / sum, rgba[4 * p + 1] / sum];
+}
 
 /**
  * Saves a capture (RGBA rows bottom-up, as gl.readPixels gives them) as a PNG.
@@ -185,4 +263,214 @@ window.draw = async (atlasUrl, resolution) => {
   } finally {
     site.close();
   }
+});
+
+test('ccc: the base mesh is drawn first; the cell and low-resolution colour textures follow, then the full one', async (t) => {
+  const page = await browser.context.newPage();
+  /** @type {string[]} */
+  const problems = [];
+  page.on('pageerror', (e) => problems.push(e.message));
+  /** @type {Map<string, () => void>} */
+  const held = new Map();
+  /** @type {string[]} */
+  const requested = [];
+  await page.route('**/api/textures/**', (route) => {
+    const url = route.request().url();
+    requested.push(url);
+    held.set(new URL(url).pathname, () => void route.continue());
+  });
+  await page.goto(`${service.url}/embed/painted`);
+  let s = await until(page, '0 in s.shownAtMs');
+  assert.equal(s.colour, 'loading', 'the base mesh is on screen before any colour texture arrives');
+  const clay = await capture(page);
+  assert.deepEqual(await colourPill(page), { text: 'Colour texture loading…', hidden: false });
+  // Requested only after the base mesh's first frame: they never compete with it.
+  s = await until(page, 's.colourAtMs.requested !== undefined');
+  assert.ok(/** @type {number} */ (s.colourAtMs.requested) >= /** @type {number} */ (s.firstFrameMs));
+  await page.waitForTimeout(200);
+  const { cell_texture: cell, colour_texture: full, colour_texture_low: low } = manifest.colour;
+  const path = (/** @type {{ url: string }} */ t) => new URL(t.url, service.url).pathname;
+  assert.deepEqual([...held.keys()].sort(), [path(cell), path(low)].sort(), 'cell and low-resolution textures first, in parallel');
+  held.get(path(cell))?.();
+  held.get(path(low))?.();
+  s = await until(page, `s.colour === 'low'`);
+  await page.waitForTimeout(200);
+  assert.ok(held.has(path(full)), 'the full-resolution texture is asked for once the low one is in');
+  assert.equal((await state(page)).colour, 'low', 'held back: still low resolution');
+  assert.match((await colourPill(page)).text, /low resolution/);
+  const lowImage = await capture(page);
+  mkdirSync(SCREENSHOTS, { recursive: true });
+  await page.screenshot({ path: join(SCREENSHOTS, 'viewer-ccc-low-resolution.png') });
+  held.get(path(full))?.();
+  s = await until(page, `s.colour === 'full' && s.status === 'complete'`);
+  assert.ok(/** @type {number} */ (s.colourAtMs.full) > /** @type {number} */ (s.colourAtMs.low));
+  assert.deepEqual(await colourPill(page), { text: 'Colour: full resolution', hidden: false });
+  // The same picture, sharper: low and full resolution agree in colour.
+  const fullImage = await capture(page);
+  const score = chromaDifference(lowImage.rgba, fullImage.rgba, WIDTH);
+  const control = chromaDifference(clay.rgba, fullImage.rgba, WIDTH);
+  t.diagnostic(`low vs full resolution ${JSON.stringify(score)}; clay base mesh vs full ${JSON.stringify(control)}`);
+  // The low-resolution atlas (1/4 of each side) blurs the pattern's edges; the colours are the same.
+  assert.ok(score.mean < 0.035 && score.far < 0.06, `low vs full resolution: ${JSON.stringify(score)}`);
+  assert.ok(control.far > 0.5, `the measure tells clay from paint: ${JSON.stringify(control)}`);
+  assert.equal(requested.length, 3);
+  assert.deepEqual(problems, []);
+  await page.close();
+});
+
+/** @param {Page} page */
+function state(page) {
+  return page.evaluate(() => /** @type {import('../src/viewer.js').ViewerState} */ (/** @type {any} */ (document.querySelector('vitrine-viewer')).viewer.state));
+}
+
+/**
+ * How far the colours of image `a` are from those of image `b`, pixel by
+ * pixel, over the interior of both silhouettes: the chromaticity distance to
+ * the nearest match in b's 3×3 neighbourhood (a level whose silhouette or
+ * texel edges sit a pixel away is not penalised for it). Dark pixels, whose
+ * chromaticity is noise, are left out.
+ * @param {Uint8Array} a
+ * @param {Uint8Array} b
+ * @param {number} width
+ * @returns {{ pixels: number, mean: number, far: number }} far: fraction off by more than 0.08
+ */
+function chromaDifference(a, b, width) {
+  const ma = foreground(a);
+  const mb = foreground(b);
+  const bright = (/** @type {Uint8Array} */ img, /** @type {number} */ p) => img[4 * p] + img[4 * p + 1] + img[4 * p + 2] > 60;
+  let n = 0;
+  let sum = 0;
+  let far = 0;
+  for (let p = width + 1; p < ma.length - width - 1; p++) {
+    const around = [p, p - 1, p + 1, p - width, p + width, p - width - 1, p - width + 1, p + width - 1, p + width + 1];
+    if (!around.every((q) => ma[q] && mb[q]) || !bright(a, p)) continue;
+    const [ra, ga] = chroma(a, p);
+    let d = Infinity;
+    for (const q of around) {
+      if (!bright(b, q)) continue;
+      const [rb, gb] = chroma(b, q);
+      d = Math.min(d, Math.max(Math.abs(ra - rb), Math.abs(ga - gb)));
+    }
+    if (d === Infinity) continue;
+    n++;
+    sum += d;
+    if (d > 0.08) far++;
+  }
+  return { pixels: n, mean: sum / Math.max(1, n), far: far / Math.max(1, n) };
+}
+
+test('ccc: every level shows the painted colours of the final level (screenshots of base and final)', async (t) => {
+  const n = manifest.last_level;
+  /** @type {Uint8Array[]} */
+  const images = [];
+  for (let k = 0; k <= n; k++) {
+    const page = await browser.context.newPage();
+    await page.goto(`${service.url}/embed/painted?level=${k}`);
+    await until(page, `s.status === 'complete' && s.colour === 'full' && s.shownLevel === ${k}`);
+    images.push((await capture(page)).rgba);
+    if (k === 0 || k === n) {
+      mkdirSync(SCREENSHOTS, { recursive: true });
+      await page.screenshot({ path: join(SCREENSHOTS, k === 0 ? 'viewer-ccc-base.png' : 'viewer-ccc-final.png') });
+    }
+    await page.close();
+  }
+  const last = images[n];
+  for (let k = 0; k < n; k++) {
+    const score = chromaDifference(images[k], last, WIDTH);
+    t.diagnostic(`level ${k} of ${n} (${manifest.levels[k].vertices} vertices) vs final: ${JSON.stringify(score)}`);
+    assert.ok(score.pixels > 0.1 * WIDTH * HEIGHT, `level ${k}: the model is in view`);
+    assert.ok(score.mean < 0.03 && score.far < 0.05, `level ${k} vs final: ${JSON.stringify(score)}`);
+  }
+});
+
+test('ccc: the final level matches a CPU rendering with the JavaScript lookup; the cell texture reaches it byte for byte', async (t) => {
+  const page = await browser.context.newPage();
+  await page.goto(`${service.url}/embed/painted`);
+  await until(page, `s.status === 'complete' && s.colour === 'full'`);
+  const gpu = await capture(page);
+  const view = await page.evaluate(() => {
+    const c = /** @type {any} */ (document.querySelector('vitrine-viewer')).viewer.camera;
+    return { state: structuredClone(c.state), radius: c.radius };
+  });
+  const { cell_texture: cell, colour_texture: full, parameters } = manifest.colour;
+  // The browser's own decoders, colour management off: the atlas as the GPU gets it, and the cell
+  // texture's PNG decoded by Chromium, to check src/png.js against.
+  const decoded = await page.evaluate(async (urls) => {
+    /** @param {string} url */
+    const pixels = async (url) => {
+      const blob = await (await fetch(url)).blob();
+      const bitmap = await createImageBitmap(blob, { colorSpaceConversion: 'none', premultiplyAlpha: 'none' });
+      const canvas = new OffscreenCanvas(bitmap.width, bitmap.height);
+      const context = /** @type {OffscreenCanvasRenderingContext2D} */ (canvas.getContext('2d'));
+      context.drawImage(bitmap, 0, 0);
+      const data = context.getImageData(0, 0, bitmap.width, bitmap.height).data;
+      let binary = '';
+      for (let i = 0; i < data.length; i += 0x8000) binary += String.fromCharCode(...data.subarray(i, i + 0x8000));
+      return { width: bitmap.width, height: bitmap.height, data: btoa(binary) };
+    };
+    return { atlas: await pixels(urls[0]), cells: await pixels(urls[1]) };
+  }, [full.url, cell.url]);
+  const rgba = (/** @type {{ width: number, height: number, data: string }} */ d) => ({
+    width: d.width,
+    height: d.height,
+    channels: 4,
+    data: new Uint8Array(Buffer.from(d.data, 'base64')),
+  });
+  const cellBytes = new Uint8Array(await (await fetch(`${service.url}${cell.url}`)).arrayBuffer());
+  const cells = await decodePng(cellBytes);
+  const browserCells = rgba(decoded.cells);
+  assert.deepEqual([cells.width, cells.height, cells.channels], [browserCells.width, browserCells.height, 3]);
+  for (let i = 0; i < cells.width * cells.height; i++) {
+    for (let k = 0; k < 3; k++) {
+      if (cells.data[3 * i + k] !== browserCells.data[4 * i + k]) assert.fail(`cell texel ${i} channel ${k} differs from Chromium's decoding`);
+    }
+  }
+  const complex = new CellComplex(parameters, cells);
+  const atlas = rgba(decoded.atlas);
+  const codec = await VitrineCodec.instantiate(readFileSync(wasmPath));
+  const bytes = async (/** @type {string} */ url) => new Uint8Array(await (await fetch(`${service.url}${url}`)).arrayBuffer());
+  const decoder = codec.decoder(await bytes(manifest.levels[0].url));
+  for (const level of manifest.levels.slice(1)) decoder.apply(await bytes(level.url));
+  const last = decoder.level();
+  decoder.free();
+  const reference = new OrbitCamera({ min: [0, 0, 0], max: [1, 1, 1] });
+  reference.radius = view.radius;
+  reference.state = view.state;
+  /** @type {Record<string, number>} */
+  const kinds = {};
+  const cpu = rasterize({
+    positions: last.positions,
+    normals: vertexNormals(last.positions, last.indices),
+    colours: null,
+    indices: last.indices,
+    view: reference.view(),
+    projection: reference.projection(WIDTH / HEIGHT),
+    width: WIDTH,
+    height: HEIGHT,
+    albedoAt: (point) => {
+      const kind = complex.lookup(point).kind;
+      kinds[kind] = (kinds[kind] ?? 0) + 1;
+      return complex.colourAt(point, atlas);
+    },
+  });
+  const diffs = differences(gpu.rgba, cpu, WIDTH);
+  const mean = diffs.reduce((s, d) => s + d, 0) / diffs.length;
+  const off = diffs.filter((d) => d > 24).length / diffs.length;
+  t.diagnostic(`GPU vs CPU reference: ${diffs.length} pixels, mean max-channel difference ${mean.toFixed(2)}, ${(100 * off).toFixed(2)} % off by more than 24; lookups ${JSON.stringify(kinds)}`);
+  assert.ok((kinds.tile ?? 0) > 0.95 * Object.values(kinds).reduce((a, b) => a + b, 0), `nearly every fragment finds a tile: ${JSON.stringify(kinds)}`);
+  assert.ok(mean < 3 && off < 0.01, `GPU vs CPU reference: mean ${mean}, off ${off}`);
+  await page.close();
+});
+
+test('ccc: a colour texture that cannot be loaded leaves the model on screen, with a note', async () => {
+  const page = await browser.context.newPage();
+  await page.route(`**${manifest.colour.cell_texture.url}`, (route) => route.fulfill({ status: 500, body: 'no' }));
+  await page.goto(`${service.url}/embed/painted`);
+  const s = await until(page, `s.status === 'complete' && s.colourError !== null`);
+  assert.equal(s.colour, 'none');
+  assert.equal(s.shownLevel, manifest.last_level);
+  const pill = await colourPill(page);
+  assert.equal(pill.hidden, false);
+  assert.match(pill.text, /could not be loaded: the server answered 500/);
+  await page.close();
 });

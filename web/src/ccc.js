@@ -107,9 +107,11 @@ export class CellComplex {
   /**
    * Where the colour of world position p comes from.
    * @param {ArrayLike<number>} point
+   * @param {number} [inset] how far inside the tile's interior the sample point stays, in
+   *   full-resolution texels: 0.5 (CCC.md) for the full atlas; see `sampleInset`
    * @returns {Lookup}
    */
-  lookup(point) {
+  lookup(point, inset = 0.5) {
     const p = this.p;
     const fallback = /** @type {[number, number, number]} */ (p.fallback_colour.map((c) => c / 255));
     const g = [0, 1, 2].map((a) => (point[a] - p.origin[a]) / p.cell_size);
@@ -134,7 +136,7 @@ export class CellComplex {
     const side = t + 2 * gutter;
     const col = tile % p.atlas.tiles_per_row;
     const row = Math.floor(tile / p.atlas.tiles_per_row);
-    const inTile = uv.map((c) => Math.min(Math.max(gutter + c * t, gutter + 0.5), gutter + t - 0.5));
+    const inTile = uv.map((c) => Math.min(Math.max(gutter + c * t, gutter + inset), gutter + t - inset));
     return { kind: 'tile', tile, face, uv, x: col * side + inTile[0], y: row * side + inTile[1] };
   }
 
@@ -146,11 +148,26 @@ export class CellComplex {
    * @returns {[number, number, number]}
    */
   colourAt(point, atlas) {
-    const found = this.lookup(point);
-    if (found.kind !== 'tile') return found.colour;
     const scale = atlas.width / this.p.atlas.width;
+    const found = this.lookup(point, sampleInset(this.p, scale));
+    if (found.kind !== 'tile') return found.colour;
     return bilinear(atlas, found.x * scale, found.y * scale);
   }
+}
+
+/**
+ * How far inside a tile's interior the sample point is kept, in
+ * full-resolution texels. Full atlas: half a texel, so bilinear filtering
+ * reads the tile and its gutter only (CCC.md, "Atlas"). Low-resolution atlas
+ * (scale 1/f): half a low-resolution texel, f/2, so the filter's footprint
+ * stays over the tile's interior rather than reaching across a gutter that
+ * the reduction has shrunk below one texel into the next tile (at most half
+ * the tile, for tiles smaller than f).
+ * @param {CccParameters} p
+ * @param {number} scale atlas texels per layout texel
+ */
+export function sampleInset(p, scale) {
+  return Math.min(Math.max(0.5, 0.5 / scale), p.tile_size / 2);
 }
 
 /**
@@ -228,7 +245,7 @@ uniform ivec3 u_dims;
 uniform int u_cellsOffset;
 uniform int u_cellsWidth;
 uniform int u_cellCount;
-uniform vec2 u_tile;       // tile_size, gutter
+uniform vec3 u_tile;       // tile_size, gutter, inset (sampleInset)
 uniform int u_tilesPerRow;
 uniform vec2 u_atlasScale; // layout texels -> normalized atlas coordinates
 uniform vec3 u_fallback;
@@ -274,7 +291,7 @@ vec3 cccColour(vec3 p) {
   float size = u_tile.x;
   float gutter = u_tile.y;
   vec2 corner = vec2(float(tile % u_tilesPerRow), float(tile / u_tilesPerRow)) * (size + 2.0 * gutter);
-  vec2 inTile = clamp(gutter + uv * size, gutter + 0.5, gutter + size - 0.5);
+  vec2 inTile = clamp(gutter + uv * size, gutter + u_tile.z, gutter + size - u_tile.z);
   return texture(u_atlas, (corner + inTile) * u_atlasScale).rgb;
 }`;
 
@@ -292,7 +309,7 @@ export function cccUniforms(p, atlas) {
     u_cellsOffset: p.cell_texture.cells_offset,
     u_cellsWidth: p.cell_texture.width,
     u_cellCount: p.cells,
-    u_tile: [p.tile_size, p.gutter],
+    u_tile: [p.tile_size, p.gutter, sampleInset(p, scale)],
     u_tilesPerRow: p.atlas.tiles_per_row,
     u_atlasScale: [scale / atlas.width, scale / atlas.height],
     u_fallback: p.fallback_colour.map((c) => c / 255),

@@ -468,7 +468,7 @@ export class Renderer {
     gl.uniform1i(u.u_cellsOffset, values.u_cellsOffset);
     gl.uniform1i(u.u_cellsWidth, values.u_cellsWidth);
     gl.uniform1i(u.u_cellCount, values.u_cellCount);
-    gl.uniform2fv(u.u_tile, values.u_tile);
+    gl.uniform3fv(u.u_tile, values.u_tile);
     gl.uniform1i(u.u_tilesPerRow, values.u_tilesPerRow);
     gl.uniform2fv(u.u_atlasScale, values.u_atlasScale);
     gl.uniform3fv(u.u_fallback, values.u_fallback);

@@ -3,7 +3,7 @@
 // complexes, and the PNG decoder the viewer reads cell textures with.
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
-import { CellComplex, CccError, bilinear, checkParameters, exitFace } from '../src/ccc.js';
+import { CellComplex, CccError, bilinear, checkParameters, exitFace, sampleInset } from '../src/ccc.js';
 import { PngError, decodePng } from '../src/png.js';
 import { cellTexture, encodePng, quadComplex } from './support/ccc-fixtures.mjs';
 
@@ -137,6 +137,22 @@ test('the low-resolution atlas is sampled at the same place, scaled', () => {
   const found = complex.lookup([p.origin[0] + 0.5 * p.cell_size, p.origin[1] + 0.5 * p.cell_size, p.origin[2] + 0.5 * p.cell_size]);
   assert.equal(found.kind, 'tile');
   assert.deepEqual(complex.colourAt([p.origin[0] + 0.5 * p.cell_size, p.origin[1] + 0.5 * p.cell_size, p.origin[2] + 0.5 * p.cell_size], low).map((c) => Math.round(c * 255)), [77, 77, 77]);
+});
+
+test('the low-resolution atlas keeps its samples half a low-resolution texel inside the tile', () => {
+  const { parameters } = quadComplex();
+  const p = { ...parameters, tile_size: 12, gutter: 1 };
+  assert.equal(sampleInset(p, 1), 0.5, 'full resolution: CCC.md\'s half texel');
+  assert.equal(sampleInset(p, 1 / 4), 2);
+  assert.equal(sampleInset({ ...p, tile_size: 2 }, 1 / 8), 1, 'never past the middle of the tile');
+  const fixture = quadComplex();
+  const complex = new CellComplex(fixture.parameters, fixture.cells);
+  const q = fixture.parameters;
+  // Near the −x wall, face coordinate u ≈ 0: clamped to the inset.
+  const point = [q.origin[0] + 0.02, q.origin[1] + 0.1, q.origin[2] + 0.5];
+  const found = complex.lookup(point, 1);
+  assert.equal(found.kind, 'tile');
+  if (found.kind === 'tile') assert.equal(found.x - (found.tile % q.atlas.tiles_per_row) * 4, q.gutter + 1);
 });
 
 test('bilinear sampling: texel centres exact, half-way blends, edges clamped', () => {

@@ -19,7 +19,8 @@ export const webDist = join(root, 'web', 'dist');
  * @property {string} [description]
  * @property {'torus' | 'sphere' | 'plate'} kind
  * @property {number} kiloVertices
- * @property {boolean} [colour]
+ * @property {boolean} [colour] paint a procedural pattern on the vertices
+ * @property {'vertex' | 'ccc' | 'none'} [colourMode] how `vitrine ingest` stores the colour (default vertex)
  * @property {string} [policy] exhibition, open or researchers
  */
 
@@ -39,6 +40,7 @@ export async function startService({ models, serveArgs = [] }) {
     execFileSync(vitrine, m.colour ? [...sample, '--colour'] : sample, { stdio: 'pipe' });
     const ingest = ['ingest', mesh, '--db', db, '--slug', m.slug, '--title', m.title];
     ingest.push('--description', m.description ?? '', '--policy', m.policy ?? 'open');
+    if (m.colourMode) ingest.push('--colour', m.colourMode);
     execFileSync(vitrine, ingest, { stdio: 'pipe', env });
   }
   // Chromium on SwiftShader keeps both cores of a small machine busy, which
