@@ -13,7 +13,11 @@ use vitrine_codec::{breakdown, encode, encode_guarded, EncodeOptions, IndexedMes
 fn connectivity_bits(stream: &[u8], vertices: usize) -> (f64, usize, u32) {
     let levels = breakdown(stream).expect("own stream");
     let bits: u64 = levels.iter().map(|l| l.connectivity as u64 * 8).sum();
-    (bits as f64 / vertices as f64, levels.len(), levels[0].vertices)
+    (
+        bits as f64 / vertices as f64,
+        levels.len(),
+        levels[0].vertices,
+    )
 }
 
 fn main() {
@@ -30,26 +34,43 @@ fn main() {
         None => ColourSource::PerVertex(&mesh),
     };
     let options = EncodeOptions::default();
-    let geometry = IndexedMesh { colors: None, ..mesh.clone() };
+    let geometry = IndexedMesh {
+        colors: None,
+        ..mesh.clone()
+    };
     let plain = encode(&geometry, &options).unwrap();
     let (pc, pl, pb) = connectivity_bits(&plain.bytes, mesh.positions.len());
     println!(
         "{}: {} vertices, texture {:?}; unguarded: conn {pc:.3} b/v, {pl} levels, base {pb}",
         path.display(),
         mesh.positions.len(),
-        textured.as_ref().map(|t| (t.image.width(), t.image.height()))
+        textured
+            .as_ref()
+            .map(|t| (t.image.width(), t.image.height()))
     );
     let q = Quantization::for_positions(&mesh.positions, 12).unwrap();
     let lo = q.min;
     let extent = (1u32 << 12) as f32 * q.step;
-    let mut sizes: Vec<Option<f32>> = args[1..].iter().map(|a| Some(extent / a.parse::<f32>().unwrap())).collect();
+    let mut sizes: Vec<Option<f32>> = args[1..]
+        .iter()
+        .map(|a| Some(extent / a.parse::<f32>().unwrap()))
+        .collect();
     if sizes.is_empty() {
         sizes.push(None);
     }
     let _ = lo;
     for cell_size in sizes {
         let t = Instant::now();
-        let (m, guard) = ccc::build(&mesh, &q, source, &CccOptions { cell_size, ..CccOptions::default() }).unwrap();
+        let (m, guard) = ccc::build(
+            &mesh,
+            &q,
+            source,
+            &CccOptions {
+                cell_size,
+                ..CccOptions::default()
+            },
+        )
+        .unwrap();
         let build = t.elapsed().as_secs_f64();
         let t = Instant::now();
         let guarded = encode_guarded(&geometry, &options, Some(&guard), |_| {}).unwrap();

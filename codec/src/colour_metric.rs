@@ -4,14 +4,18 @@
 //!
 //! - `E_colour`: CIE L\*a\*b\* distance (CIE76) between the removed vertex's
 //!   colour and the colour interpolated at the centre of the middle face of
-//!   the retriangulation (the mean of its three corners), divided by 100 (the
-//!   range of L\*) so it is about 0–1.
+//!   the retriangulation (the mean of its three corners), divided by
+//!   [`COLOUR_SCALE`].
 //! - `E_geo`: mean area of the patch's faces before decimation over the mean
 //!   face area of the current level.
-//! - `⊗` is taken as the product. The papers leave the normalisation of
-//!   `E_colour` and the combination open; these choices are ours.
+//! - `⊗` is taken as the product. The thesis leaves the normalisation of
+//!   `E_colour` and the combination open; these choices are ours, set so the
+//!   guard fires at visible colour borders (ΔE ≳ 12 on a patch of average area).
 
 use glam::DVec3;
+
+/// ΔE (CIE76) that counts as a colour error of 1.
+pub const COLOUR_SCALE: f64 = 25.0;
 
 use crate::{CandidatePatch, PatchGuard};
 
@@ -39,7 +43,11 @@ impl PatchGuard for ColourMetricGuard {
             (0..3).for_each(|k| mean[k] += lab[k] / 3.0);
         }
         let removed = srgb_to_lab(centre_colour);
-        let e_colour = (0..3).map(|k| (removed[k] - mean[k]).powi(2)).sum::<f64>().sqrt() / 100.0;
+        let e_colour = (0..3)
+            .map(|k| (removed[k] - mean[k]).powi(2))
+            .sum::<f64>()
+            .sqrt()
+            / COLOUR_SCALE;
         let centre = DVec3::from(p.centre.map(f64::from));
         let mut area = 0.0;
         for i in 0..p.valence {
@@ -90,6 +98,8 @@ mod tests {
         assert!((w[0] - 100.0).abs() < 0.01 && w[1].abs() < 0.01 && w[2].abs() < 0.01);
         assert!(srgb_to_lab([0, 0, 0])[0].abs() < 1e-9);
         let r = srgb_to_lab([255, 0, 0]);
-        assert!((r[0] - 53.24).abs() < 0.05 && (r[1] - 80.09).abs() < 0.1 && (r[2] - 67.20).abs() < 0.1);
+        assert!(
+            (r[0] - 53.24).abs() < 0.05 && (r[1] - 80.09).abs() < 0.1 && (r[2] - 67.20).abs() < 0.1
+        );
     }
 }

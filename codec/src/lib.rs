@@ -50,5 +50,7 @@ pub mod export;
 pub mod import;
 #[cfg(feature = "import")]
 pub mod metrics;
+#[cfg(feature = "import")]
+pub mod quality;
 pub mod repair;
 // --- end ---

@@ -31,6 +31,8 @@ enum Command {
     Inspect(cli::inspect::InspectArgs),
     /// Benchmark the codec on a folder of meshes and print a markdown table.
     Bench(cli::bench::BenchArgs),
+    /// Compare the colour modes (ccc, vertex, vertex-metric) on coloured meshes: sizes and quality per level.
+    ColourBench(cli::colour_bench::ColourBenchArgs),
     /// Write a generated sample mesh (torus, sphere, plate) as PLY.
     Sample(cli::sample::SampleArgs),
     /// Write the native decoder's buffers at every level (for cross-checks).
@@ -58,6 +60,7 @@ fn main() -> anyhow::Result<()> {
         Command::Bench(args) => cli::bench::run(args),
         Command::BenchOne(args) => cli::bench::run_one(args),
         Command::Sample(args) => cli::sample::run(args),
+        Command::ColourBench(args) => cli::colour_bench::run(args),
         Command::DumpLevels(args) => cli::dump::run(args),
     }
 }

@@ -417,7 +417,14 @@ fn render_cell(
     let local_min = |p: DVec3| (p - min) / s;
     let mut bins = TexelBins::default();
     for (face, slot) in tiles.iter_mut().enumerate() {
-        bins.fill(face, centre, t, local.iter().map(|r| [r.v0, r.v0 + r.e1, r.v0 + r.e2].map(local_min)));
+        bins.fill(
+            face,
+            centre,
+            t,
+            local
+                .iter()
+                .map(|r| [r.v0, r.v0 + r.e1, r.v0 + r.e2].map(local_min)),
+        );
         let mut texels: Vec<Option<[f64; 3]>> = vec![None; t * t];
         for j in 0..t {
             for i in 0..t {
@@ -481,10 +488,16 @@ struct TexelBins {
 
 impl TexelBins {
     /// `triangles`: corners in cube units.
-    fn fill(&mut self, face: usize, centre: DVec3, t: usize, triangles: impl Iterator<Item = [DVec3; 3]>) {
+    fn fill(
+        &mut self,
+        face: usize,
+        centre: DVec3,
+        t: usize,
+        triangles: impl Iterator<Item = [DVec3; 3]>,
+    ) {
         let axis = face / 2;
-        let sign = if face % 2 == 0 { 1.0 } else { -1.0 };
-        let plane = if face % 2 == 0 { 1.0 } else { 0.0 };
+        let sign = if face.is_multiple_of(2) { 1.0 } else { -1.0 };
+        let plane = if face.is_multiple_of(2) { 1.0 } else { 0.0 };
         let depth = sign * (plane - centre[axis]);
         let (b0, b1) = match axis {
             0 => (1, 2),

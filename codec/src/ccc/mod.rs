@@ -8,11 +8,13 @@ mod guard;
 mod images;
 mod lookup;
 mod projection;
+mod shaders;
 
 use serde::{Deserialize, Serialize};
 
 pub use guard::CellGuard;
 pub use lookup::CellComplex;
+pub use shaders::TextureShader;
 
 use crate::{
     encode_guarded, EncodeOptions, EncodeProgress, Encoded, IndexedMesh, Quantization, Result,
@@ -179,7 +181,12 @@ pub enum ColourMode {
 }
 
 impl ColourMode {
-    pub const ALL: [ColourMode; 4] = [ColourMode::Ccc, ColourMode::Vertex, ColourMode::VertexMetric, ColourMode::None];
+    pub const ALL: [ColourMode; 4] = [
+        ColourMode::Ccc,
+        ColourMode::Vertex,
+        ColourMode::VertexMetric,
+        ColourMode::None,
+    ];
 
     pub fn name(self) -> &'static str {
         match self {
@@ -203,14 +210,21 @@ impl std::str::FromStr for ColourMode {
         ColourMode::ALL
             .into_iter()
             .find(|m| m.name() == s)
-            .ok_or_else(|| crate::Error::Parameter(format!("colour mode must be ccc, vertex, vertex-metric or none, got {s:?}")))
+            .ok_or_else(|| {
+                crate::Error::Parameter(format!(
+                    "colour mode must be ccc, vertex, vertex-metric or none, got {s:?}"
+                ))
+            })
     }
 }
 
 /// The texture's colour at each mesh vertex (bilinear through the file's
 /// UVs), matched by position: welding and repair keep positions exactly.
 /// A vertex on a UV seam takes the first side's colour.
-pub fn vertex_colours_from_texture(mesh: &IndexedMesh, texture: &crate::import::TexturedSurface) -> Vec<[u8; 3]> {
+pub fn vertex_colours_from_texture(
+    mesh: &IndexedMesh,
+    texture: &crate::import::TexturedSurface,
+) -> Vec<[u8; 3]> {
     let key = |p: [f32; 3]| p.map(f32::to_bits);
     let mut by_position = std::collections::HashMap::with_capacity(texture.positions.len());
     for (p, uv) in texture.positions.iter().zip(&texture.uvs) {
@@ -219,8 +233,10 @@ pub fn vertex_colours_from_texture(mesh: &IndexedMesh, texture: &crate::import::
     mesh.positions
         .iter()
         .map(|p| match by_position.get(&key(*p)) {
-            Some(uv) => build::sample_bilinear(&texture.image, glam::DVec2::new(uv[0] as f64, uv[1] as f64))
-                .map(|c| c.round().clamp(0.0, 255.0) as u8),
+            Some(uv) => {
+                build::sample_bilinear(&texture.image, glam::DVec2::new(uv[0] as f64, uv[1] as f64))
+                    .map(|c| c.round().clamp(0.0, 255.0) as u8)
+            }
             None => [128, 128, 128],
         })
         .collect()
@@ -246,7 +262,10 @@ pub fn encode_coloured(
             Some(t) => vertex_colours_from_texture(mesh, t),
             None => mesh.colors.clone().ok_or_else(no_colour)?,
         };
-        Ok(IndexedMesh { colors: Some(colors), ..mesh.clone() })
+        Ok(IndexedMesh {
+            colors: Some(colors),
+            ..mesh.clone()
+        })
     };
     match mode {
         ColourMode::Ccc => {
@@ -258,14 +277,26 @@ pub fn encode_coloured(
             let (encoded, mapping) = encode_with_ccc(mesh, options, source, ccc, progress)?;
             Ok((encoded, Some(mapping)))
         }
-        ColourMode::Vertex => Ok((crate::encode_with_progress(&with_vertex_colours()?, options, progress)?, None)),
+        ColourMode::Vertex => Ok((
+            crate::encode_with_progress(&with_vertex_colours()?, options, progress)?,
+            None,
+        )),
         ColourMode::VertexMetric => {
             let guard = crate::colour_metric::ColourMetricGuard::default();
-            Ok((encode_guarded(&with_vertex_colours()?, options, Some(&guard), progress)?, None))
+            Ok((
+                encode_guarded(&with_vertex_colours()?, options, Some(&guard), progress)?,
+                None,
+            ))
         }
         ColourMode::None => {
-            let geometry = IndexedMesh { colors: None, ..mesh.clone() };
-            Ok((crate::encode_with_progress(&geometry, options, progress)?, None))
+            let geometry = IndexedMesh {
+                colors: None,
+                ..mesh.clone()
+            };
+            Ok((
+                crate::encode_with_progress(&geometry, options, progress)?,
+                None,
+            ))
         }
     }
 }

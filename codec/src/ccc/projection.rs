@@ -33,7 +33,7 @@ pub fn exit_face(centre: DVec3, point: DVec3) -> Option<(usize, [f64; 2])> {
 pub fn face_point(face: usize, uv: [f64; 2]) -> DVec3 {
     let axis = face / 2;
     let mut p = DVec3::ZERO;
-    p[axis] = if face % 2 == 0 { 1.0 } else { 0.0 };
+    p[axis] = if face.is_multiple_of(2) { 1.0 } else { 0.0 };
     let (b0, b1) = other_axes(axis);
     p[b0] = uv[0];
     p[b1] = uv[1];

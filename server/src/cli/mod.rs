@@ -1,6 +1,7 @@
 //! The codec commands: encode, decode, inspect, bench.
 
 pub mod bench;
+pub mod colour_bench;
 pub mod decode;
 pub mod dump;
 pub mod encode;
