@@ -4,8 +4,9 @@ use crate::ingest::{ingest_mesh, ColourMode, IngestOptions, ModelMeta, SourceInf
 use crate::storage::{ConnectOptions, OnExisting};
 use anyhow::Context;
 use std::path::PathBuf;
+use std::sync::Arc;
 use std::time::Duration;
-use vitrine_codec::import::{import_path, ImportOptions};
+use vitrine_codec::import::{import_path, import_path_textured, ImportOptions};
 use vitrine_codec::repair::{prepare, RepairOptions};
 use vitrine_codec::EncodeOptions;
 
@@ -39,7 +40,8 @@ pub struct IngestArgs {
     pub quantization_bits: u8,
     /// How colour travels: `vertex` (per-vertex colour in the stream),
     /// `ccc` (a cubic cell complex: a cell texture and a colour texture
-    /// shared by every level, built from the per-vertex colour) or `none`.
+    /// shared by every level, sampled from the file's colour texture (OBJ,
+    /// glTF) or else from its per-vertex colour) or `none`.
     #[arg(long, default_value = "vertex", value_parser = ["vertex", "ccc", "none"])]
     pub colour: String,
     /// Test hook: pause inside the transaction before committing.
@@ -50,9 +52,21 @@ pub struct IngestArgs {
 pub async fn run_ingest(args: IngestArgs) -> anyhow::Result<()> {
     super::init_tracing();
     let path = args.mesh.clone();
-    let (mesh, source) = tokio::task::spawn_blocking(move || -> anyhow::Result<_> {
-        let mesh = import_path(&path, &ImportOptions::default())
-            .with_context(|| format!("reading {}", path.display()))?;
+    let ccc = args.colour == "ccc";
+    let (mesh, texture, source) = tokio::task::spawn_blocking(move || -> anyhow::Result<_> {
+        // In ccc mode the photographic texture, if the file has one, is the colour source.
+        let (mesh, texture) = if ccc {
+            let imported = import_path_textured(&path, &ImportOptions::default())
+                .with_context(|| format!("reading {}", path.display()))?;
+            for warning in &imported.warnings {
+                eprintln!("vitrine: {}: {warning}", path.display());
+            }
+            (imported.mesh, imported.texture)
+        } else {
+            let mesh = import_path(&path, &ImportOptions::default())
+                .with_context(|| format!("reading {}", path.display()))?;
+            (mesh, None)
+        };
         let (vertices, faces) = (mesh.vertex_count() as u64, mesh.face_count() as u64);
         let (mesh, report) =
             prepare(mesh, &RepairOptions::default()).context("repairing the mesh")?;
@@ -62,6 +76,7 @@ pub async fn run_ingest(args: IngestArgs) -> anyhow::Result<()> {
             .unwrap_or_default();
         Ok((
             mesh,
+            texture,
             SourceInfo {
                 name,
                 vertices,
@@ -90,8 +105,14 @@ pub async fn run_ingest(args: IngestArgs) -> anyhow::Result<()> {
             quantization_bits: args.quantization_bits,
             ..EncodeOptions::default()
         },
-        colour: ColourMode::parse(&args.colour)
-            .with_context(|| format!("unknown colour mode {:?}", args.colour))?,
+        colour: match ColourMode::parse(&args.colour) {
+            Some(ColourMode::Ccc { options, .. }) => ColourMode::Ccc {
+                options,
+                texture: texture.map(Arc::new),
+            },
+            Some(mode) => mode,
+            None => anyhow::bail!("unknown colour mode {:?}", args.colour),
+        },
         pause_before_commit: args.pause_before_commit_ms.map(Duration::from_millis),
     };
     let slug = meta.slug.clone();
