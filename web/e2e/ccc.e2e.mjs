@@ -386,7 +386,11 @@ test('ccc: every level shows the painted colours of the final level (screenshots
 test('ccc: the final level matches a CPU rendering with the JavaScript lookup; the cell texture reaches it byte for byte', async (t) => {
   const page = await browser.context.newPage();
   await page.goto(`${service.url}/embed/painted`);
-  await until(page, `s.status === 'complete' && s.colour === 'full'`);
+  const s = await until(page, `s.status === 'complete' && s.colour === 'full'`);
+  const since = (/** @type {number | undefined} */ ms) => Math.round(/** @type {number} */ (ms) - /** @type {number} */ (s.firstFrameMs));
+  t.diagnostic(
+    `after the base mesh's first frame: textures requested +${since(s.colourAtMs.requested)} ms, low-resolution colour drawn +${since(s.colourAtMs.low)} ms, full +${since(s.colourAtMs.full)} ms; last level drawn +${since(s.shownAtMs[manifest.last_level])} ms`,
+  );
   const gpu = await capture(page);
   const view = await page.evaluate(() => {
     const c = /** @type {any} */ (document.querySelector('vitrine-viewer')).viewer.camera;
@@ -472,5 +476,30 @@ test('ccc: a colour texture that cannot be loaded leaves the model on screen, wi
   const pill = await colourPill(page);
   assert.equal(pill.hidden, false);
   assert.match(pill.text, /could not be loaded: the server answered 500/);
+  await page.close();
+});
+
+test('ccc: a lost WebGL context is restored with its colour textures', async () => {
+  const page = await browser.context.newPage();
+  await page.goto(`${service.url}/embed/painted`);
+  await until(page, `s.status === 'complete' && s.colour === 'full'`);
+  const before = await capture(page);
+  await page.evaluate(() => {
+    const canvas = /** @type {HTMLCanvasElement} */ (document.querySelector('vitrine-viewer')?.shadowRoot?.querySelector('canvas'));
+    const ext = /** @type {any} */ (canvas.getContext('webgl2'))?.getExtension('WEBGL_lose_context');
+    /** @type {any} */ (window).loseContext = ext;
+    ext.loseContext();
+  });
+  await page.waitForFunction(() => /** @type {any} */ (document.querySelector('vitrine-viewer')).viewer.renderer.lost);
+  await page.evaluate(() => /** @type {any} */ (window).loseContext.restoreContext());
+  await page.waitForFunction(() => {
+    const r = /** @type {any} */ (document.querySelector('vitrine-viewer')).viewer.renderer;
+    return !r.lost && r.current && r.current.uploads.length === 0 && !r.pending;
+  });
+  const restored = await capture(page);
+  const diffs = differences(before.rgba, restored.rgba, WIDTH);
+  const mean = diffs.reduce((s, d) => s + d, 0) / diffs.length;
+  assert.ok(diffs.length > 0.1 * WIDTH * HEIGHT && mean < 0.5, `restored vs before: mean ${mean} over ${diffs.length} pixels`);
+  assert.equal(await page.evaluate(() => /** @type {any} */ (document.querySelector('vitrine-viewer')).viewer.renderer.colourResolution), 'full');
   await page.close();
 });
