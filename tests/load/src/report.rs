@@ -65,6 +65,9 @@ pub struct Summary {
     pub harness_cpu_s: f64,
     pub wall_s: f64,
     pub pressure_max: u8,
+    /// Each run's p99, p95 × lone visitor and load-capped visitors.
+    #[serde(default)]
+    pub per_run: String,
 }
 
 pub fn percentile(sorted: &[f64], p: f64) -> f64 {
@@ -157,31 +160,22 @@ pub fn summarize(outcome: &CrowdOutcome, baselines: &Baselines) -> Summary {
     }
 }
 
-/// Column-wise medians of several runs of one scenario.
+/// Several runs of one scenario as one row: the run with the median p99,
+/// whole (so that its columns agree), and every run's key numbers.
 pub fn median_of(runs: &[Summary]) -> Summary {
-    let mut m = runs[runs.len() / 2].clone();
-    if runs.len() < 2 {
-        return m;
-    }
-    let med = |f: &dyn Fn(&Summary) -> f64| percentile(&sorted(runs.iter().map(f).collect()), 50.0);
-    m.p50_ms = med(&|s| s.p50_ms);
-    m.p95_ms = med(&|s| s.p95_ms);
-    m.p99_ms = med(&|s| s.p99_ms);
-    m.max_ms = med(&|s| s.max_ms);
-    m.recon_median_s = med(&|s| s.recon_median_s);
-    m.recon_p95_s = med(&|s| s.recon_p95_s);
-    m.ratio_median = med(&|s| s.ratio_median);
-    m.ratio_p95 = med(&|s| s.ratio_p95);
-    m.ratio_max = med(&|s| s.ratio_max);
-    m.server_cpu_s = med(&|s| s.server_cpu_s);
-    m.server_cpu_pct = med(&|s| s.server_cpu_pct);
-    m.server_peak_rss_mib = med(&|s| s.server_peak_rss_mib);
-    m.harness_cpu_s = med(&|s| s.harness_cpu_s);
-    m.wall_s = med(&|s| s.wall_s);
-    m.bytes = med(&|s| s.bytes as f64) as u64;
-    m.load_capped = med(&|s| s.load_capped as f64) as usize;
-    m.failed = med(&|s| s.failed as f64) as usize;
-    m.run = 0;
+    let mut order: Vec<&Summary> = runs.iter().collect();
+    order.sort_by(|a, b| a.p99_ms.total_cmp(&b.p99_ms));
+    let mut m = order[order.len() / 2].clone();
+    m.per_run = runs
+        .iter()
+        .map(|r| {
+            format!(
+                "{:.0} ms, ×{:.2}, {} capped",
+                r.p99_ms, r.ratio_p95, r.load_capped
+            )
+        })
+        .collect::<Vec<_>>()
+        .join("; ");
     m
 }
 
@@ -197,14 +191,14 @@ fn map(m: &BTreeMap<impl std::fmt::Display, usize>) -> String {
 
 pub fn markdown(rows: &[Summary]) -> String {
     let mut s = String::new();
-    s.push_str("| caps | visitors | arrivals | requests | p50 ms | p95 ms | p99 ms | reconstruction median / p95 s | × lone visitor, median / p95 | public desktop level (median) | load-capped visitors (at level: n) | failed visitors | non-2xx answers | bytes served | server CPU s (% of a core) | server peak RSS MiB | harness CPU s | max pressure |\n");
+    s.push_str("| caps | visitors | arrivals | requests | p50 ms | p95 ms | p99 ms | reconstruction median / p95 s | × lone visitor, median / p95 | public desktop level (median) | load-capped visitors (at level: n) | failed visitors | non-2xx answers | bytes served | server CPU s (% of a core) | server peak RSS MiB | harness CPU s | max pressure | every run: p99, p95 × lone, load-capped |\n");
     s.push_str(
         "|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---|---:|---|---:|---:|---:|---:|---:|\n",
     );
     for r in rows {
         let _ = writeln!(
             s,
-            "| {} | {} | {} | {} | {:.1} | {:.1} | {:.1} | {:.2} / {:.2} | {:.2} / {:.2} | {} | {} ({}) | {} | {} | {:.1} MB | {:.1} ({:.0} %) | {:.0} | {:.1} | {} |",
+            "| {} | {} | {} | {} | {:.1} | {:.1} | {:.1} | {:.2} / {:.2} | {:.2} / {:.2} | {} | {} ({}) | {} | {} | {:.1} MB | {:.1} ({:.0} %) | {:.0} | {:.1} | {} | {} |",
             r.caps,
             r.visitors,
             r.pattern,
@@ -227,6 +221,7 @@ pub fn markdown(rows: &[Summary]) -> String {
             r.server_peak_rss_mib,
             r.harness_cpu_s,
             r.pressure_max,
+            r.per_run,
         );
     }
     s
