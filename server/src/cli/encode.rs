@@ -3,7 +3,8 @@ use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
 use std::path::PathBuf;
 use std::time::Instant;
-use vitrine_codec::{encode_with_progress, BaseTarget, EncodeOptions};
+use vitrine_codec::ccc::{encode_coloured, CccOptions, ColourMode};
+use vitrine_codec::{BaseTarget, EncodeOptions};
 
 #[derive(Args, Debug)]
 pub struct EncodeArgs {
@@ -24,6 +25,12 @@ pub struct EncodeArgs {
     /// Allow retriangulations that fold (slightly smaller, uglier low levels).
     #[arg(long)]
     pub no_geometric_guard: bool,
+    /// How colour travels: `ccc` (cell-complex texture, written beside the
+    /// stream as OUTPUT.ccc.json, .cell.png, .colour.jpg, .colour-low.jpg),
+    /// `vertex`, `vertex-metric` or `none`. Default: `vertex` when the mesh
+    /// has colour or a texture, else `none`.
+    #[arg(long)]
+    pub colour: Option<ColourMode>,
 }
 
 impl EncodeArgs {
@@ -45,7 +52,14 @@ pub fn run(args: EncodeArgs) -> anyhow::Result<()> {
         .output
         .clone()
         .unwrap_or_else(|| args.input.with_extension("vtr"));
-    let (mesh, report) = super::load_mesh(&args.input)?;
+    let (mesh, texture, report) = super::load_coloured_mesh(&args.input)?;
+    let mode = args
+        .colour
+        .unwrap_or(if mesh.colors.is_some() || texture.is_some() {
+            ColourMode::Vertex
+        } else {
+            ColourMode::None
+        });
     if let Some(text) = super::describe_repair(&report) {
         eprintln!("repair: {text}");
     }
@@ -59,14 +73,45 @@ pub fn run(args: EncodeArgs) -> anyhow::Result<()> {
         .progress_chars("=> "),
     );
     let start = Instant::now();
-    let encoded = encode_with_progress(&mesh, &args.options(), |p| {
-        bar.set_message(p.layer.to_string());
-        bar.set_position((p.input_vertices - p.vertices) as u64);
-    })?;
+    let (encoded, mapping) = encode_coloured(
+        &mesh,
+        texture.as_ref(),
+        mode,
+        &args.options(),
+        &CccOptions::default(),
+        |p| {
+            bar.set_message(p.layer.to_string());
+            bar.set_position((p.input_vertices - p.vertices) as u64);
+        },
+    )?;
     bar.finish_and_clear();
     let elapsed = start.elapsed();
     std::fs::write(&output, &encoded.bytes)
         .with_context(|| format!("writing {}", output.display()))?;
+    if let Some(m) = &mapping {
+        let files = super::CccFiles::beside(&output);
+        let write = |path: &std::path::Path, bytes: &[u8]| {
+            std::fs::write(path, bytes).with_context(|| format!("writing {}", path.display()))
+        };
+        write(
+            &files.parameters,
+            &serde_json::to_vec_pretty(&m.parameters)?,
+        )?;
+        write(&files.cell, &m.cell_png)?;
+        write(&files.colour, &m.colour_jpeg)?;
+        write(&files.colour_low, &m.colour_low_jpeg)?;
+        let r = &m.report;
+        eprintln!(
+            "cell complex: {} cells, {} tiles of {}², cell texture {} B, colour {} B (low {} B), ambiguous texels {:.2} %",
+            r.cells,
+            r.tiles,
+            m.parameters.tile_size,
+            r.cell_texture_bytes,
+            r.colour_texture_bytes,
+            r.colour_texture_low_bytes,
+            r.ambiguous_texels as f64 * 100.0 / r.covered_texels.max(1) as f64
+        );
+    }
     let h = &encoded.header;
     eprintln!(
         "{}: {} vertices, {} faces → {} bytes ({:.2} bits/vertex), {} levels, base {} vertices, {:.2} s",

@@ -9,8 +9,8 @@ pub mod inspect;
 pub mod sample;
 
 use anyhow::Context;
-use std::path::Path;
-use vitrine_codec::import::{import_path, ImportOptions};
+use std::path::{Path, PathBuf};
+use vitrine_codec::import::{import_path, import_path_textured, ImportOptions, TexturedSurface};
 use vitrine_codec::repair::{prepare, RepairOptions, RepairReport};
 use vitrine_codec::IndexedMesh;
 
@@ -20,6 +20,45 @@ pub fn load_mesh(path: &Path) -> anyhow::Result<(IndexedMesh, RepairReport)> {
         .with_context(|| format!("reading {}", path.display()))?;
     prepare(mesh, &RepairOptions::default())
         .with_context(|| format!("repairing {}", path.display()))
+}
+
+/// Reads a mesh file with its colour texture when it has one (OBJ+MTL,
+/// glTF), repaired; texture problems are warnings, not errors.
+pub fn load_coloured_mesh(
+    path: &Path,
+) -> anyhow::Result<(IndexedMesh, Option<TexturedSurface>, RepairReport)> {
+    let imported = import_path_textured(path, &ImportOptions::default())
+        .with_context(|| format!("reading {}", path.display()))?;
+    for w in &imported.warnings {
+        eprintln!("warning: {}: {w}", path.display());
+    }
+    let (mesh, report) = prepare(imported.mesh, &RepairOptions::default())
+        .with_context(|| format!("repairing {}", path.display()))?;
+    Ok((mesh, imported.texture, report))
+}
+
+/// Where `vitrine encode --colour ccc` puts the complex beside a stream.
+pub struct CccFiles {
+    pub parameters: PathBuf,
+    pub cell: PathBuf,
+    pub colour: PathBuf,
+    pub colour_low: PathBuf,
+}
+
+impl CccFiles {
+    pub fn beside(stream: &Path) -> CccFiles {
+        let with = |suffix: &str| {
+            let mut name = stream.as_os_str().to_owned();
+            name.push(suffix);
+            PathBuf::from(name)
+        };
+        CccFiles {
+            parameters: with(".ccc.json"),
+            cell: with(".cell.png"),
+            colour: with(".colour.jpg"),
+            colour_low: with(".colour-low.jpg"),
+        }
+    }
 }
 
 /// Human summary of what repair changed, or `None` when nothing did.
