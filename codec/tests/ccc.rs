@@ -179,3 +179,206 @@ fn corrupt_or_mismatched_textures_are_errors() {
     )
     .is_err());
 }
+
+/// A torus with a procedurally painted photograph: a 512² image of checks
+/// and soft bands, reached through the torus' angular UVs (unwrapped per
+/// triangle, the sampler repeats).
+fn textured_torus() -> (IndexedMesh, vitrine_codec::import::TexturedSurface) {
+    let (rings, sides) = (96u32, 48u32);
+    let mesh = samples::torus(rings, sides, 1.0, 0.35);
+    let image = image::RgbImage::from_fn(512, 512, |x, y| {
+        let check = ((x / 64) + (y / 64)) % 2 == 0;
+        let band = 0.5 + 0.5 * (y as f32 / 512.0 * std::f32::consts::TAU).sin();
+        if check {
+            image::Rgb([220, (80.0 + 150.0 * band) as u8, 40])
+        } else {
+            image::Rgb([30, 60, (120.0 + 130.0 * band) as u8])
+        }
+    });
+    let uv_of = |v: u32| {
+        [
+            (v / sides) as f32 / rings as f32,
+            (v % sides) as f32 / sides as f32,
+        ]
+    };
+    let (mut positions, mut uvs, mut triangles) = (Vec::new(), Vec::new(), Vec::new());
+    for t in &mesh.triangles {
+        let corner = t.map(uv_of);
+        let base = positions.len() as u32;
+        for (k, &v) in t.iter().enumerate() {
+            let mut uv = corner[k];
+            // Unwrap across the seam so the triangle's UVs stay contiguous.
+            for d in 0..2 {
+                if corner[0][d] - uv[d] > 0.5 {
+                    uv[d] += 1.0;
+                }
+                if uv[d] - corner[0][d] > 0.5 {
+                    uv[d] -= 1.0;
+                }
+            }
+            positions.push(mesh.positions[v as usize]);
+            uvs.push(uv);
+        }
+        triangles.push([base, base + 1, base + 2]);
+    }
+    let surface = vitrine_codec::import::TexturedSurface {
+        positions,
+        uvs,
+        triangles,
+        image,
+    };
+    (mesh, surface)
+}
+
+#[test]
+fn every_level_shows_the_painted_texture() {
+    use vitrine_codec::ccc::{encode_coloured, ColourMode, TextureShader};
+    use vitrine_codec::metrics::{render, views, Frame, Lighting, RenderOptions};
+    let (mesh, surface) = textured_torus();
+    let (encoded, mapping) = encode_coloured(
+        &mesh,
+        Some(&surface),
+        ColourMode::Ccc,
+        &EncodeOptions::default(),
+        &CccOptions::default(),
+        |_| {},
+    )
+    .unwrap();
+    let m = mapping.unwrap();
+    let complex = CellComplex::from_images(&m.parameters, &m.cell_png, &m.colour_jpeg).unwrap();
+    let reference = surface.as_mesh();
+    let (centre, radius) = views::bounding_sphere(&reference);
+    let cameras = views::rhombicuboctahedron(centre, radius);
+    // Unlit: the albedo alone, so coarse normals do not count against colour.
+    let options = RenderOptions {
+        lighting: Lighting::headlight(1.0),
+        ..RenderOptions::square(192)
+    };
+    let index = StreamIndex::parse(&encoded.bytes).unwrap();
+    let mut decoder =
+        vitrine_codec::Decoder::new(&encoded.bytes[index.base.clone()], Limits::default()).unwrap();
+    for level in 0..=index.batches.len() {
+        if level > 0 {
+            decoder
+                .apply_batch(&encoded.bytes[index.batches[level - 1].clone()])
+                .unwrap();
+        }
+        let level_mesh = decoder.to_mesh();
+        let (mut sum, mut n, mut foreign) = (0.0f64, 0usize, 0usize);
+        for camera in [&cameras[0], &cameras[9], &cameras[17]] {
+            let want = render(&reference, &TextureShader(&surface), camera, &options);
+            let got = render(&level_mesh, &complex, camera, &options);
+            if let Ok(dir) = std::env::var("VITRINE_SNAPSHOTS") {
+                want.write_png(format!("{dir}/torus-reference.png"))
+                    .unwrap();
+                got.write_png(format!("{dir}/torus-level{level}.png"))
+                    .unwrap();
+            }
+            // The painted palette: colour bins (16 levels a channel) the reference shows.
+            let bin = |c: [u8; 3]| c.map(|v| (v / 16) as i32);
+            let mut palette = std::collections::HashSet::new();
+            for (i, c) in want.rgb.iter().enumerate() {
+                if want.triangle[i] != Frame::BACKGROUND {
+                    palette.insert(bin(*c));
+                }
+            }
+            let painted = |c: [u8; 3]| {
+                let b = bin(c);
+                (-1..=1).any(|x| {
+                    (-1..=1).any(|y| {
+                        (-1..=1).any(|z| palette.contains(&[b[0] + x, b[1] + y, b[2] + z]))
+                    })
+                })
+            };
+            for i in 0..want.rgb.len() {
+                if got.triangle[i] == Frame::BACKGROUND {
+                    continue;
+                }
+                foreign += usize::from(!painted(got.rgb[i]));
+                // Where both show the surface, the same colour (the coarse surface
+                // sits elsewhere than the fine one, so this only tightens with level).
+                if want.triangle[i] != Frame::BACKGROUND {
+                    sum += (0..3)
+                        .map(|k| (want.rgb[i][k] as f64 - got.rgb[i][k] as f64).abs())
+                        .sum::<f64>()
+                        / 3.0;
+                    n += 1;
+                }
+            }
+        }
+        let mean = sum / n as f64;
+        let foreign = foreign as f64 / n as f64;
+        eprintln!(
+            "level {level}: {} vertices, mean pixel difference {mean:.1}, {:.2} % pixels off the painted palette",
+            level_mesh.positions.len(),
+            foreign * 100.0
+        );
+        // Every level shows the painted colours, not blends of them...
+        assert!(
+            foreign < 0.03,
+            "level {level}: {:.1} % of pixels are not painted colours",
+            foreign * 100.0
+        );
+        // ...in about the right places, converging to the photograph.
+        assert!(
+            mean < 40.0,
+            "level {level}: mean colour difference {mean:.1}"
+        );
+        if level == index.batches.len() {
+            assert!(mean < 4.0, "final level: mean colour difference {mean:.1}");
+        }
+    }
+}
+
+#[test]
+fn every_mode_is_lossless() {
+    use vitrine_codec::ccc::{encode_coloured, ColourMode};
+    let mesh = painted_torus();
+    for mode in ColourMode::ALL {
+        let (encoded, mapping) = encode_coloured(
+            &mesh,
+            None,
+            mode,
+            &EncodeOptions::default(),
+            &CccOptions::default(),
+            |_| {},
+        )
+        .unwrap();
+        assert_eq!(mapping.is_some(), mode == ColourMode::Ccc);
+        let d = decode(&encoded.bytes, None, Limits::default()).unwrap();
+        let expected = match mode {
+            ColourMode::Vertex | ColourMode::VertexMetric => mesh.clone(),
+            _ => IndexedMesh {
+                colors: None,
+                ..mesh.clone()
+            },
+        };
+        assert_eq!(
+            common::final_level_mismatch(&expected, 12, &d, &encoded.vertex_order),
+            None,
+            "{mode}"
+        );
+    }
+    // The colour metric refuses some decimations on a painted mesh.
+    let plain = encode_coloured(
+        &mesh,
+        None,
+        ColourMode::Vertex,
+        &EncodeOptions::default(),
+        &CccOptions::default(),
+        |_| {},
+    )
+    .unwrap()
+    .0;
+    let metric = encode_coloured(
+        &mesh,
+        None,
+        ColourMode::VertexMetric,
+        &EncodeOptions::default(),
+        &CccOptions::default(),
+        |_| {},
+    )
+    .unwrap()
+    .0;
+    assert_ne!(plain.bytes, metric.bytes);
+}
