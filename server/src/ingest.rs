@@ -8,10 +8,9 @@ use crate::storage::{
 };
 use anyhow::{bail, Context};
 use serde_json::json;
-use std::sync::Arc;
 use std::time::{Duration, Instant};
 use vitrine_codec::ccc::{
-    encode_with_ccc, CccOptions, CccParameters, CccReport, ColourSource, TextureMapping,
+    encode_coloured, CccOptions, CccParameters, CccReport, ColourMode, TextureMapping,
 };
 use vitrine_codec::import::TexturedSurface;
 use vitrine_codec::{BaseTarget, EncodeOptions, Encoded, IndexedMesh, StreamIndex};
@@ -58,44 +57,14 @@ pub struct SourceInfo {
 #[derive(Clone, Debug, Default)]
 pub struct IngestOptions {
     pub encode: EncodeOptions,
-    /// How the model's colour travels.
-    pub colour: ColourMode,
+    /// How colour travels (`ccc`, `vertex`, `vertex-metric`, `none`; see
+    /// `vitrine_codec::ccc::ColourMode`). `None`: `vertex` when the mesh has
+    /// colour or a texture, else `none`.
+    pub colour: Option<ColourMode>,
+    /// The cell complex's options, in `ccc` mode.
+    pub ccc: CccOptions,
     /// Test hook: wait this long inside the open transaction before committing.
     pub pause_before_commit: Option<Duration>,
-}
-
-/// How a model's colour is stored.
-#[derive(Clone, Debug, Default)]
-pub enum ColourMode {
-    /// Per-vertex colour in the stream, if the mesh has any (`vertex`).
-    #[default]
-    Vertex,
-    /// No colour at all (`none`): the viewer shows clay.
-    None,
-    /// A cubic cell complex (`ccc`, `codec/CCC.md`): colour in a cell and a
-    /// colour texture shared by every level, the stream geometry only, and
-    /// decimation kept inside the complex. The colour comes from `texture`
-    /// (a photographic texture through the file's UVs) or, without one, from
-    /// the mesh's per-vertex colour.
-    Ccc {
-        options: CccOptions,
-        texture: Option<Arc<TexturedSurface>>,
-    },
-}
-
-impl ColourMode {
-    /// `vertex`, `none` or `ccc` (default complex options).
-    pub fn parse(name: &str) -> Option<ColourMode> {
-        match name {
-            "vertex" => Some(ColourMode::Vertex),
-            "none" => Some(ColourMode::None),
-            "ccc" => Some(ColourMode::Ccc {
-                options: CccOptions::default(),
-                texture: None,
-            }),
-            _ => None,
-        }
-    }
 }
 
 #[derive(Clone, Debug)]
@@ -112,42 +81,48 @@ pub struct IngestReport {
 }
 
 /// Encodes `mesh` (already repaired: see `vitrine_codec::repair::prepare`)
-/// in the chosen colour mode and stores it as a new model or model version.
+/// and stores it as a new model or model version.
 pub async fn ingest_mesh(
     storage: &dyn Storage,
-    mut mesh: IndexedMesh,
+    mesh: IndexedMesh,
+    meta: ModelMeta,
+    options: &IngestOptions,
+) -> anyhow::Result<IngestReport> {
+    ingest_coloured(storage, mesh, None, meta, options).await
+}
+
+/// [`ingest_mesh`] for a mesh with its file's colour texture, if any: in
+/// `ccc` mode the complex samples the texture (else the per-vertex colour),
+/// stores its three images and parameters in the same transaction as the
+/// model, and the stream carries geometry only; the vertex modes sample the
+/// texture at the vertices (`vitrine_codec::ccc::encode_coloured`).
+pub async fn ingest_coloured(
+    storage: &dyn Storage,
+    mesh: IndexedMesh,
+    texture: Option<TexturedSurface>,
     meta: ModelMeta,
     options: &IngestOptions,
 ) -> anyhow::Result<IngestReport> {
     check_slug(&meta.slug)?;
     let source = source_info(&meta, &mesh);
-    let encode_options = options.encode.clone();
-    let colour = options.colour.clone();
-    if let ColourMode::Ccc { texture: None, .. } = &colour {
-        if mesh.colors.is_none() {
-            bail!("colour mode ccc needs colour: the mesh has no per-vertex colour and no texture was given");
-        }
-    }
+    let mode = options
+        .colour
+        .unwrap_or(if mesh.colors.is_some() || texture.is_some() {
+            ColourMode::Vertex
+        } else {
+            ColourMode::None
+        });
+    let (encode_options, ccc) = (options.encode.clone(), options.ccc.clone());
     let started = Instant::now();
-    let (encoded, mapping) = tokio::task::spawn_blocking(move || match colour {
-        ColourMode::Vertex => vitrine_codec::encode(&mesh, &encode_options).map(|e| (e, None)),
-        ColourMode::None => {
-            mesh.colors = None;
-            vitrine_codec::encode(&mesh, &encode_options).map(|e| (e, None))
-        }
-        ColourMode::Ccc { options, texture } => {
-            let source = match &texture {
-                Some(t) => ColourSource::Texture(t),
-                None => ColourSource::PerVertex(&mesh),
-            };
-            encode_with_ccc(&mesh, &encode_options, source, &options, |_| {})
-                .map(|(e, m)| (e, Some(m)))
-        }
+    let (encoded, mapping) = tokio::task::spawn_blocking(move || {
+        encode_coloured(&mesh, texture.as_ref(), mode, &encode_options, &ccc, |_| {})
     })
     .await
     .context("encoder task failed")?
     .context("encoding failed")?;
     let encode_time = started.elapsed();
+    let mut options = options.clone();
+    options.colour = Some(mode);
     store(
         storage,
         &encoded,
@@ -155,7 +130,7 @@ pub async fn ingest_mesh(
         mapping.as_ref(),
         meta,
         source,
-        options,
+        &options,
     )
     .await
 }
@@ -251,7 +226,7 @@ async fn store(
         source_faces: source.faces,
         compression: NewCompression {
             codec_version: index.header.version,
-            options: encode_options_json(&options.encode, &options.colour).to_string(),
+            options: encode_options_json(&options.encode, options.colour, &options.ccc).to_string(),
             stats: json!({
                 "bits_per_vertex": encoded.bytes.len() as f64 * 8.0 / f64::from(full.vertices.max(1)),
                 "encode_ms": encode_time.as_millis() as u64,
@@ -296,7 +271,11 @@ async fn store(
     })
 }
 
-fn encode_options_json(o: &EncodeOptions, colour: &ColourMode) -> serde_json::Value {
+fn encode_options_json(
+    o: &EncodeOptions,
+    colour: Option<ColourMode>,
+    ccc: &CccOptions,
+) -> serde_json::Value {
     let base = match o.base {
         BaseTarget::Vertices(n) => json!({ "vertices": n }),
         BaseTarget::Fraction(f) => json!({ "fraction": f }),
@@ -308,19 +287,14 @@ fn encode_options_json(o: &EncodeOptions, colour: &ColourMode) -> serde_json::Va
         "max_layers": o.max_layers,
         "min_layer_fraction": o.min_layer_fraction,
         "geometric_guard": o.geometric_guard,
-        "colour": match colour {
-            ColourMode::Vertex => json!("vertex"),
-            ColourMode::None => json!("none"),
-            ColourMode::Ccc { options, texture } => json!({
-                "mode": "ccc",
-                "source": if texture.is_some() { "texture" } else { "vertex" },
-                "cell_size": options.cell_size,
-                "tile_size": options.tile_size,
-                "jpeg_quality": options.jpeg_quality,
-                "low_res_factor": options.low_res_factor,
-                "max_atlas_side": options.max_atlas_side,
-            }),
-        },
+        "colour": colour.map(ColourMode::name),
+        "ccc": (colour == Some(ColourMode::Ccc)).then(|| json!({
+            "cell_size": ccc.cell_size,
+            "tile_size": ccc.tile_size,
+            "jpeg_quality": ccc.jpeg_quality,
+            "low_res_factor": ccc.low_res_factor,
+            "max_atlas_side": ccc.max_atlas_side,
+        })),
     })
 }
 

@@ -1,12 +1,12 @@
 //! `vitrine ingest <mesh> --db … --slug … --title …`
 
-use crate::ingest::{ingest_mesh, ColourMode, IngestOptions, ModelMeta, SourceInfo};
+use crate::ingest::{ingest_coloured, IngestOptions, ModelMeta, SourceInfo};
 use crate::storage::{ConnectOptions, OnExisting};
 use anyhow::Context;
 use std::path::PathBuf;
-use std::sync::Arc;
 use std::time::Duration;
-use vitrine_codec::import::{import_path, import_path_textured, ImportOptions};
+use vitrine_codec::ccc::{CccOptions, ColourMode};
+use vitrine_codec::import::{import_path_textured, ImportOptions};
 use vitrine_codec::repair::{prepare, RepairOptions};
 use vitrine_codec::EncodeOptions;
 
@@ -38,12 +38,15 @@ pub struct IngestArgs {
     /// Position quantization, 8–16 bits.
     #[arg(long, default_value_t = 12)]
     pub quantization_bits: u8,
-    /// How colour travels: `vertex` (per-vertex colour in the stream),
-    /// `ccc` (a cubic cell complex: a cell texture and a colour texture
-    /// shared by every level, sampled from the file's colour texture (OBJ,
-    /// glTF) or else from its per-vertex colour) or `none`.
-    #[arg(long, default_value = "vertex", value_parser = ["vertex", "ccc", "none"])]
-    pub colour: String,
+    /// How colour travels: `ccc` (a cubic cell complex: a cell texture and
+    /// a colour texture shared by every level, sampled from the file's
+    /// colour texture (OBJ, glTF) or else its per-vertex colour; the stream
+    /// carries geometry only), `vertex`, `vertex-metric` (per-vertex colour
+    /// in the stream, the latter with the colour-metric decimation guard) or
+    /// `none`. Default: `vertex` when the mesh has colour or a texture, else
+    /// `none`.
+    #[arg(long)]
+    pub colour: Option<ColourMode>,
     /// Test hook: pause inside the transaction before committing.
     #[arg(long, hide = true, env = "VITRINE_TEST_PAUSE_BEFORE_COMMIT_MS")]
     pub pause_before_commit_ms: Option<u64>,
@@ -52,21 +55,14 @@ pub struct IngestArgs {
 pub async fn run_ingest(args: IngestArgs) -> anyhow::Result<()> {
     super::init_tracing();
     let path = args.mesh.clone();
-    let ccc = args.colour == "ccc";
     let (mesh, texture, source) = tokio::task::spawn_blocking(move || -> anyhow::Result<_> {
-        // In ccc mode the photographic texture, if the file has one, is the colour source.
-        let (mesh, texture) = if ccc {
-            let imported = import_path_textured(&path, &ImportOptions::default())
-                .with_context(|| format!("reading {}", path.display()))?;
-            for warning in &imported.warnings {
-                eprintln!("vitrine: {}: {warning}", path.display());
-            }
-            (imported.mesh, imported.texture)
-        } else {
-            let mesh = import_path(&path, &ImportOptions::default())
-                .with_context(|| format!("reading {}", path.display()))?;
-            (mesh, None)
-        };
+        // The colour texture, when the file has one, is the colour source.
+        let imported = import_path_textured(&path, &ImportOptions::default())
+            .with_context(|| format!("reading {}", path.display()))?;
+        for warning in &imported.warnings {
+            eprintln!("vitrine: {}: {warning}", path.display());
+        }
+        let (mesh, texture) = (imported.mesh, imported.texture);
         let (vertices, faces) = (mesh.vertex_count() as u64, mesh.face_count() as u64);
         let (mesh, report) =
             prepare(mesh, &RepairOptions::default()).context("repairing the mesh")?;
@@ -105,18 +101,12 @@ pub async fn run_ingest(args: IngestArgs) -> anyhow::Result<()> {
             quantization_bits: args.quantization_bits,
             ..EncodeOptions::default()
         },
-        colour: match ColourMode::parse(&args.colour) {
-            Some(ColourMode::Ccc { options, .. }) => ColourMode::Ccc {
-                options,
-                texture: texture.map(Arc::new),
-            },
-            Some(mode) => mode,
-            None => anyhow::bail!("unknown colour mode {:?}", args.colour),
-        },
+        colour: args.colour,
+        ccc: CccOptions::default(),
         pause_before_commit: args.pause_before_commit_ms.map(Duration::from_millis),
     };
     let slug = meta.slug.clone();
-    let report = ingest_mesh(&*storage, mesh, meta, &options).await?;
+    let report = ingest_coloured(&*storage, mesh, texture, meta, &options).await?;
     println!(
         "ingested {slug} version {} (compression {}): {} levels, {} → {} vertices, {} bytes, encoded in {:.1} s",
         report.stored.version,

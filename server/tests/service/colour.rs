@@ -7,11 +7,12 @@ use axum::http::{header, StatusCode};
 use glam::Vec3;
 use serde_json::Value;
 use std::time::Duration;
-use vitrine::ingest::{ingest_encoded, ingest_mesh, ColourMode, IngestOptions, ModelMeta};
+use vitrine::ingest::{ingest_encoded, ingest_mesh, IngestOptions, ModelMeta};
 use vitrine::storage::sha256_hex;
 use vitrine::{app, AppState};
 use vitrine_codec::ccc::{
-    AtlasLayout, CccParameters, CccReport, CellComplex, CellTextureLayout, TextureMapping,
+    AtlasLayout, CccParameters, CccReport, CellComplex, CellTextureLayout, ColourMode,
+    TextureMapping,
 };
 use vitrine_codec::samples::torus;
 use vitrine_codec::{Decoder, Limits};
@@ -239,7 +240,19 @@ pub async fn ccc_mapping_stored_and_served(db: TestDb) {
     )
     .await
     .unwrap();
-    for (slug, mode) in [("vertex", "vertex"), ("clay", "none")] {
+    let metric = IngestOptions {
+        colour: Some(ColourMode::VertexMetric),
+        ..IngestOptions::default()
+    };
+    ingest_mesh(
+        s,
+        sample_mesh(),
+        ModelMeta::new("metric", "Metric"),
+        &metric,
+    )
+    .await
+    .unwrap();
+    for (slug, mode) in [("vertex", "vertex"), ("metric", "vertex"), ("clay", "none")] {
         let m = get(&app, &format!("/api/models/{slug}"), &[]).await.json();
         assert_eq!(m["colour"], serde_json::json!({ "mode": mode }), "{slug}");
         assert_eq!(m["textures"], Value::Array(vec![]));
@@ -301,7 +314,7 @@ pub async fn inconsistent_mappings_are_refused(db: TestDb) {
 pub async fn ccc_ingest_from_vertex_colour(db: TestDb) {
     let mesh = sample_mesh();
     let options = IngestOptions {
-        colour: ColourMode::parse("ccc").unwrap(),
+        colour: Some(ColourMode::Ccc),
         ..IngestOptions::default()
     };
     let mut meta = ModelMeta::new("ccc", "CCC");
