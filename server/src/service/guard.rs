@@ -7,11 +7,15 @@
 //! is then moved around (memmove was 9 % of a cached batch's CPU under perf).
 
 use super::error::{AppError, LoggedError};
+use super::load::InflightGuard;
 use super::AppState;
+use axum::body::{Body, Bytes, HttpBody};
 use axum::extract::{Request, State};
 use axum::http::{header, HeaderValue};
 use axum::middleware::Next;
 use axum::response::{IntoResponse, Response};
+use std::pin::Pin;
+use std::task::{Context, Poll};
 use std::time::Instant;
 
 /// Routes that serve data and so count as load; operations routes do not.
@@ -36,9 +40,19 @@ pub async fn admit(State(state): State<AppState>, request: Request, next: Next) 
             AppError::PayloadTooLarge.into_response()
         }
         Ok(_permit) => {
-            let _inflight = is_data_route(route).then(|| state.load().begin());
+            let inflight = is_data_route(route).then(|| state.load().begin());
             match tokio::time::timeout(limits.timeout, next.run(request)).await {
-                Ok(response) => response,
+                // The request stays in flight for the load monitor until its
+                // body has gone out: with a crowd, sending is the load, and a
+                // count that ended when the handler returned never saw it.
+                // (The concurrency permit is released now, so a client that
+                // reads slowly cannot hold the service's capacity.)
+                Ok(response) => response.map(|body| {
+                    Body::new(Tracked {
+                        body,
+                        _inflight: inflight,
+                    })
+                }),
                 Err(_) => AppError::Timeout.into_response(),
             }
         }
@@ -69,4 +83,32 @@ fn body_too_large(request: &Request, max: usize) -> bool {
         .and_then(|v| v.to_str().ok())
         .map(|v| v.parse::<u64>().map_or(true, |n| n > max as u64));
     declared.unwrap_or_else(|| headers.contains_key(header::TRANSFER_ENCODING))
+}
+
+/// A response body that keeps its request counted in flight until the body
+/// is sent or dropped (client gone). Size hints pass through, so
+/// `Content-Length` is kept.
+struct Tracked {
+    body: Body,
+    _inflight: Option<InflightGuard>,
+}
+
+impl HttpBody for Tracked {
+    type Data = Bytes;
+    type Error = axum::Error;
+
+    fn poll_frame(
+        mut self: Pin<&mut Self>,
+        cx: &mut Context<'_>,
+    ) -> Poll<Option<Result<http_body::Frame<Bytes>, axum::Error>>> {
+        Pin::new(&mut self.body).poll_frame(cx)
+    }
+
+    fn is_end_stream(&self) -> bool {
+        self.body.is_end_stream()
+    }
+
+    fn size_hint(&self) -> http_body::SizeHint {
+        self.body.size_hint()
+    }
 }
