@@ -13,6 +13,15 @@ vitrine=target/release/vitrine
 rm -f "$db" "$db-wal" "$db-shm"
 $vitrine ingest data/torus.ply --db "sqlite:$db" --slug painted-torus --policy open \
     --title "Painted torus" --description "A generated, painted torus with scan-like noise (300k vertices)."
+$vitrine ingest data/torus.ply --db "sqlite:$db" --slug painted-torus-ccc --policy open --colour ccc \
+    --title "Painted torus (cell-complex texture)" \
+    --description "The same torus with its colour in a cubic-cell-complex texture shared by every level."
+# A real textured scan, when the shared data folder is there (it is never committed).
+mask=../shared/data/meshes/mask/mask-gltf-2.0_separated-valid.gltf
+if [ -f "$mask" ]; then
+    $vitrine ingest "$mask" --db "sqlite:$db" --slug bali-mask --policy open --colour ccc \
+        --title "Bali mask" --description "Badisches Landesmuseum, CC BY-SA 4.0; photographic texture through a cubic cell complex."
+fi
 $vitrine ingest data/plate.ply --db "sqlite:$db" --slug tunnel-plate --policy open \
     --title "Tunnel plate" --description "A genus-3 plate with sharp edges and tunnels."
 echo "Vitrine: open http://127.0.0.1:${PORT:-8080}/"

@@ -133,7 +133,10 @@ impl CellComplex {
             (tile % a.atlas.tiles_per_row) as f64,
             (tile / a.atlas.tiles_per_row) as f64,
         );
-        let local = uv.map(|c| (g + c * t).clamp(g + 0.5, g + t - 0.5));
+        // Half a texel of the atlas being sampled inside the tile, so the
+        // bilinear footprint stays in the tile at either resolution.
+        let inset = (0.5 / self.scale).max(0.5).min(t / 2.0);
+        let local = uv.map(|c| (g + c * t).clamp(g + inset, g + t - inset));
         let x = (col * side + local[0]) * self.scale;
         let y = (row * side + local[1]) * self.scale;
         bilinear(&self.atlas, x, y)
