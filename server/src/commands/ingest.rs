@@ -7,6 +7,7 @@ use std::path::PathBuf;
 use std::time::Duration;
 use vitrine_codec::ccc::{CccOptions, ColourMode};
 use vitrine_codec::import::{import_path_textured, ImportOptions};
+use vitrine_codec::quality::QualityOptions;
 use vitrine_codec::repair::{prepare, RepairOptions};
 use vitrine_codec::EncodeOptions;
 
@@ -47,6 +48,17 @@ pub struct IngestArgs {
     /// `none`.
     #[arg(long)]
     pub colour: Option<ColourMode>,
+    /// Measure every level against the original before storing and store the
+    /// curve with the model version (symmetric Hausdorff over the bounding-box
+    /// diagonal, Roy colour RMSE, Lindstrom–Turk image RMSE over 24 views; the
+    /// manifest's `quality`, the model page's chart). Off by default: it costs
+    /// about a second per level at 50k vertices.
+    #[arg(long)]
+    pub quality: bool,
+    /// Side in pixels of the image metric's 24 snapshots with --quality. The
+    /// default, 256, keeps ingest fast; `vitrine inspect --original` uses 512.
+    #[arg(long, default_value_t = 256, value_parser = clap::value_parser!(u32).range(16..=4096))]
+    pub quality_image_size: u32,
     /// Test hook: pause inside the transaction before committing.
     #[arg(long, hide = true, env = "VITRINE_TEST_PAUSE_BEFORE_COMMIT_MS")]
     pub pause_before_commit_ms: Option<u64>,
@@ -103,6 +115,10 @@ pub async fn run_ingest(args: IngestArgs) -> anyhow::Result<()> {
         },
         colour: args.colour,
         ccc: CccOptions::default(),
+        quality: args.quality.then(|| QualityOptions {
+            image_size: args.quality_image_size,
+            ..QualityOptions::default()
+        }),
         pause_before_commit: args.pause_before_commit_ms.map(Duration::from_millis),
     };
     let slug = meta.slug.clone();
@@ -126,6 +142,22 @@ pub async fn run_ingest(args: IngestArgs) -> anyhow::Result<()> {
             ccc.cell_texture_bytes,
             ccc.colour_texture_bytes,
             ccc.colour_texture_low_bytes,
+        );
+    }
+    if let Some(q) = &report.quality {
+        let (first, last) = (&q.levels[0], &q.levels[q.levels.len() - 1]);
+        let roy = |r: Option<f64>| r.map_or_else(|| "—".to_string(), |r| format!("{r:.2}"));
+        println!(
+            "quality of {} levels measured in {:.1} s ({} px views): image RMSE {:.2} → {:.2}, Roy colour RMSE {} → {}, Hausdorff/diagonal {:.6} → {:.6}",
+            q.levels.len(),
+            q.time.as_secs_f64(),
+            q.options.image_size,
+            first.image_rmse,
+            last.image_rmse,
+            roy(first.roy_rmse),
+            roy(last.roy_rmse),
+            first.hausdorff,
+            last.hausdorff,
         );
     }
     Ok(())

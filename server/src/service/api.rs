@@ -94,6 +94,10 @@ struct Manifest<'a> {
     last_level: u32,
     good_enough_level: u32,
     levels: Vec<ManifestLevel>,
+    /// Every level's quality against the original, when it was measured at
+    /// ingest (`vitrine ingest --quality`); absent otherwise.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    quality: Option<Vec<ManifestQuality>>,
     /// How the model is coloured: `ccc` (textures through a cubic cell
     /// complex, shared by every level), `vertex` (colour in the stream) or
     /// `none`.
@@ -114,6 +118,19 @@ struct ManifestLevel {
     /// The payload that produces this level: the base for level 0.
     url: String,
     allowed: bool,
+}
+
+/// One point of the quality curve.
+#[derive(Serialize)]
+struct ManifestQuality {
+    level: u32,
+    vertices: u32,
+    /// Symmetric Hausdorff distance over the bounding-box diagonal.
+    hausdorff: f64,
+    /// Roy et al. colour RMSE (0–255); null without colour.
+    roy_rmse: Option<f64>,
+    /// Lindstrom–Turk luma RMSE (0–255) over 24 views.
+    image_rmse: f64,
 }
 
 #[derive(Serialize)]
@@ -214,6 +231,20 @@ fn build_manifest<'a>(
             allowed: k as u32 <= cap.level,
         })
         .collect();
+    let quality = record
+        .levels
+        .iter()
+        .enumerate()
+        .map(|(k, l)| {
+            l.metrics().map(|m| ManifestQuality {
+                level: k as u32,
+                vertices: l.vertices,
+                hausdorff: m.hausdorff,
+                roy_rmse: m.roy_rmse,
+                image_rmse: m.image_rmse,
+            })
+        })
+        .collect();
     let texture = |t: &'a TextureRef| ManifestTexture {
         id: t.id,
         kind: &t.kind,
@@ -254,6 +285,7 @@ fn build_manifest<'a>(
         last_level: record.batch_count(),
         good_enough_level: good_enough_level(record, &state.config().caps),
         levels,
+        quality,
         colour,
         textures,
         visitor: ManifestVisitor {

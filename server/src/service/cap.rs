@@ -210,6 +210,7 @@ mod tests {
                     sha256: String::new(),
                     hausdorff: None,
                     rmse: None,
+                    roy_rmse: None,
                 })
                 .collect(),
             mapping: None,

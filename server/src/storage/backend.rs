@@ -91,6 +91,7 @@ macro_rules! sql_storage {
                         sha256: row.try_get("sha256").map_err(c)?,
                         hausdorff: row.try_get("hausdorff").map_err(c)?,
                         rmse: row.try_get("rmse").map_err(c)?,
+                        roy_rmse: row.try_get("roy_rmse").map_err(c)?,
                     });
                 }
                 if record.levels.is_empty() {

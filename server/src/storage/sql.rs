@@ -26,9 +26,9 @@ pub(super) const RECORD_BY_SLUG: &str = concat!(
 pub(super) const RECORD_BY_COMPRESSION: &str =
     concat!(record_select!(), "WHERE c.id = $1 AND m.status = 'ready'");
 pub(super) const LEVELS: &str =
-    "SELECT 0 AS iteration, vertices, faces, byte_len, sha256, hausdorff, rmse \
+    "SELECT 0 AS iteration, vertices, faces, byte_len, sha256, hausdorff, rmse, roy_rmse \
      FROM base_mesh WHERE compression_id = $1 \
-     UNION ALL SELECT iteration, vertices, faces, byte_len, sha256, hausdorff, rmse \
+     UNION ALL SELECT iteration, vertices, faces, byte_len, sha256, hausdorff, rmse, roy_rmse \
      FROM refinement_batch WHERE compression_id = $1 ORDER BY iteration";
 /// The images of mapping `$1` and which of its columns names each.
 pub(super) const TEXTURES: &str = "SELECT t.id, t.kind, t.media_type, t.byte_len, t.width, t.height, \
@@ -66,8 +66,8 @@ pub(super) const INSERT_COMPRESSION: &str = "INSERT INTO compression (model_id, 
      quantization_bits, has_colour, batch_count, final_vertices, final_faces, stream_bytes, encode_ms, created_at, \
      mapping_id) VALUES ($1, $2, $3, $4, $5, $6, $7, $8, $9, $10, $11, $12, $13) RETURNING id";
 pub(super) const INSERT_BASE: &str =
-    "INSERT INTO base_mesh (compression_id, vertices, faces, byte_len, sha256, bytes) \
-     VALUES ($1, $2, $3, $4, $5, $6)";
+    "INSERT INTO base_mesh (compression_id, vertices, faces, byte_len, sha256, bytes, \
+     hausdorff, rmse, roy_rmse) VALUES ($1, $2, $3, $4, $5, $6, $7, $8, $9)";
 pub(super) const INSERT_TEXTURE: &str = "INSERT INTO texture \
      (kind, media_type, width, height, byte_len, sha256, bytes, created_at) \
      VALUES ($1, $2, $3, $4, $5, $6, $7, $8) RETURNING id";
@@ -75,7 +75,8 @@ pub(super) const INSERT_MAPPING: &str = "INSERT INTO texture_mapping \
      (model_id, cell_texture_id, colour_texture_id, colour_low_texture_id, parameters, created_at) \
      VALUES ($1, $2, $3, $4, $5, $6) RETURNING id";
 pub(super) const INSERT_BATCH: &str = "INSERT INTO refinement_batch \
-     (compression_id, iteration, vertices, faces, byte_len, sha256, bytes) VALUES ($1, $2, $3, $4, $5, $6, $7)";
+     (compression_id, iteration, vertices, faces, byte_len, sha256, bytes, hausdorff, rmse, roy_rmse) \
+     VALUES ($1, $2, $3, $4, $5, $6, $7, $8, $9, $10)";
 
 /// A model version written inside a transaction that is still open.
 pub(super) struct Staged<DB: sqlx::Database> {

@@ -97,6 +97,9 @@ macro_rules! stage_body {
             .bind(comp.base.bytes.len() as i64)
             .bind(sha256_hex(&comp.base.bytes))
             .bind(comp.base.bytes.as_slice())
+            .bind(comp.base.metrics.map(|m| m.hausdorff))
+            .bind(comp.base.metrics.map(|m| m.image_rmse))
+            .bind(comp.base.metrics.and_then(|m| m.roy_rmse))
             .execute(&mut *$tx)
             .await
             .map_err(c)?;
@@ -109,6 +112,9 @@ macro_rules! stage_body {
                 .bind(batch.bytes.len() as i64)
                 .bind(sha256_hex(&batch.bytes))
                 .bind(batch.bytes.as_slice())
+                .bind(batch.metrics.map(|m| m.hausdorff))
+                .bind(batch.metrics.map(|m| m.image_rmse))
+                .bind(batch.metrics.and_then(|m| m.roy_rmse))
                 .execute(&mut *$tx)
                 .await
                 .map_err(c)?;

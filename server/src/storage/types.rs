@@ -24,8 +24,35 @@ pub struct LevelRecord {
     pub bytes: u64,
     /// Hex SHA-256 of that payload: its strong ETag.
     pub sha256: String,
+    /// Quality against the original, when measured at ingest (`--quality`):
+    /// symmetric Hausdorff distance over the bounding-box diagonal.
     pub hausdorff: Option<f64>,
+    /// Lindstrom–Turk image RMSE (0–255) over 24 views (column `rmse`).
     pub rmse: Option<f64>,
+    /// Roy et al. colour RMSE (0–255), when both sides have colour.
+    pub roy_rmse: Option<f64>,
+}
+
+impl LevelRecord {
+    /// The level's measured quality, if it was measured.
+    pub fn metrics(&self) -> Option<LevelMetrics> {
+        Some(LevelMetrics {
+            hausdorff: self.hausdorff?,
+            image_rmse: self.rmse?,
+            roy_rmse: self.roy_rmse,
+        })
+    }
+}
+
+/// One level's quality against the original (`vitrine_codec::quality`).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct LevelMetrics {
+    /// Symmetric Hausdorff distance over the bounding-box diagonal.
+    pub hausdorff: f64,
+    /// Lindstrom–Turk luma RMSE (0–255) over 24 views.
+    pub image_rmse: f64,
+    /// Roy et al. colour RMSE (0–255), when both sides have colour.
+    pub roy_rmse: Option<f64>,
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -137,6 +164,8 @@ pub struct NewLevel {
     pub vertices: u32,
     pub faces: u32,
     pub bytes: Vec<u8>,
+    /// Quality against the original, when measured before storing.
+    pub metrics: Option<LevelMetrics>,
 }
 
 /// Everything one ingest writes.
@@ -183,7 +212,8 @@ pub struct NewCompression {
     pub codec_version: u8,
     /// Encoder options as JSON.
     pub options: String,
-    /// Statistics as JSON (bits per vertex, timings, repair report).
+    /// Statistics as JSON (bits per vertex, timings, repair report, how
+    /// quality was measured).
     pub stats: String,
     pub quantization_bits: u8,
     pub has_colour: bool,

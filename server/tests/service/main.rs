@@ -8,6 +8,7 @@ mod harness;
 mod http;
 mod kill;
 mod proxy;
+mod quality;
 mod slow;
 mod story;
 
@@ -61,6 +62,7 @@ on_both_backends!(
     colour::restricted_textures_need_a_token,
     colour::inconsistent_mappings_are_refused,
     colour::ccc_ingest_from_vertex_colour,
+    quality::quality_curve_stored_and_served,
 );
 
 #[test]
