@@ -125,7 +125,10 @@ impl LoadMonitor {
 
     /// Counts a request in flight until the guard drops, then records its latency.
     pub fn begin(self: &Arc<Self>) -> InflightGuard {
-        self.inflight.fetch_add(1, Ordering::Relaxed);
+        let inflight = self.inflight.fetch_add(1, Ordering::Relaxed) + 1;
+        if inflight >= self.config.high_inflight {
+            self.surge(inflight);
+        }
         InflightGuard {
             monitor: Arc::clone(self),
             started: Instant::now(),
@@ -148,6 +151,27 @@ impl LoadMonitor {
             queue_ms: s.1 / 1000.0,
             pressure: self.pressure().level,
             forced: self.forced.load(Ordering::Relaxed) >= 0,
+        }
+    }
+
+    /// Fast attack: a crowd arriving at once outruns a sampler that climbs one
+    /// step per period, so past `high_inflight` the pressure jumps at once,
+    /// one step per further `high_inflight / steps` requests. It falls back
+    /// through the sampler's usual cooldown.
+    fn surge(&self, inflight: u64) {
+        let c = &self.config;
+        let steps = c.steps.max(1);
+        let per_step = (c.high_inflight / u64::from(steps)).max(1);
+        let target = (1 + (inflight - c.high_inflight) / per_step).min(u64::from(steps)) as u8;
+        let Ok(mut s) = self.smoothed.lock() else {
+            return;
+        };
+        if target > s.pressure {
+            s.pressure = target;
+            s.calm_samples = 0;
+            if self.forced.load(Ordering::Relaxed) < 0 {
+                self.pressure.store(i32::from(target), Ordering::Relaxed);
+            }
         }
     }
 
@@ -239,8 +263,10 @@ mod tests {
     fn pressure_rises_under_load_and_falls_slowly_after() {
         let m = monitor();
         let guards: Vec<_> = (0..5).map(|_| m.begin()).collect();
-        let rising: Vec<u8> = (0..6).map(|_| m.sample(Duration::ZERO).level).collect();
-        assert_eq!(rising, vec![1, 2, 3, 4, 4, 4]);
+        // Fast attack: 4 in flight (the threshold) is step 1, the fifth step 2.
+        assert_eq!(m.pressure().level, 2);
+        let rising: Vec<u8> = (0..4).map(|_| m.sample(Duration::ZERO).level).collect();
+        assert_eq!(rising, vec![3, 4, 4, 4]);
         drop(guards);
         let falling: Vec<u8> = (0..8).map(|_| m.sample(Duration::ZERO).level).collect();
         assert_eq!(falling, vec![4, 3, 3, 2, 2, 1, 1, 0]);
@@ -250,11 +276,12 @@ mod tests {
     fn between_thresholds_pressure_holds() {
         let m = monitor();
         let guards: Vec<_> = (0..4).map(|_| m.begin()).collect();
+        assert_eq!(m.pressure().level, 1, "fast attack at the threshold");
         m.sample(Duration::ZERO);
         drop(guards);
         let _two: Vec<_> = (0..2).map(|_| m.begin()).collect(); // between the thresholds 1 and 4
         let held: Vec<u8> = (0..5).map(|_| m.sample(Duration::ZERO).level).collect();
-        assert_eq!(held, vec![1; 5]);
+        assert_eq!(held, vec![2; 5]);
     }
 
     #[test]
