@@ -1,9 +1,10 @@
 // Builds web/dist from web/src and the WebAssembly decoder:
 //   node build.mjs            (expects the wasm to be built, see README)
 //   VITRINE_WASM=path node build.mjs
-// esbuild bundles three entries: app.js (the pages), vitrine.js (the
-// <vitrine-viewer> element for other sites) and worker.js (a classic worker,
-// so another origin can start it from a blob URL).
+// esbuild bundles four entries: app.js (the pages), vitrine.js (the
+// <vitrine-viewer> element for other sites), worker.js (the decoder) and
+// render-worker.js (WebGL on an OffscreenCanvas) — classic workers, so
+// another origin can start them from blob URLs.
 import { build } from 'esbuild';
 import { copyFileSync, existsSync, mkdirSync, rmSync, statSync } from 'node:fs';
 import { dirname, join } from 'node:path';
@@ -25,10 +26,15 @@ mkdirSync(dist, { recursive: true });
 /** @type {import('esbuild').BuildOptions} */
 const common = { bundle: true, minify: true, sourcemap: true, target: ['chrome111', 'firefox113', 'safari16.4'], logLevel: 'warning' };
 await build({ ...common, entryPoints: { app: join(src, 'app.js'), vitrine: join(src, 'element.js') }, format: 'esm', outdir: dist });
-await build({ ...common, entryPoints: { worker: join(src, 'worker.js') }, format: 'iife', outdir: dist });
+await build({
+  ...common,
+  entryPoints: { worker: join(src, 'worker.js'), 'render-worker': join(src, 'render-worker.js') },
+  format: 'iife',
+  outdir: dist,
+});
 for (const file of ['index.html', 'style.css']) copyFileSync(join(src, file), join(dist, file));
 copyFileSync(wasm, join(dist, 'vitrine_wasm.wasm'));
 
-for (const file of ['app.js', 'vitrine.js', 'worker.js', 'vitrine_wasm.wasm']) {
+for (const file of ['app.js', 'vitrine.js', 'worker.js', 'render-worker.js', 'vitrine_wasm.wasm']) {
   console.log(`dist/${file.padEnd(18)} ${(statSync(join(dist, file)).size / 1024).toFixed(1)} KB`);
 }

@@ -77,12 +77,13 @@ async function until(page, condition, timeout = 60_000) {
 }
 
 /**
- * The canvas's pixels (RGBA, bottom-up), drawn and read in one task.
+ * The canvas's pixels (RGBA, bottom-up), drawn and read in one task (of the thread that draws).
  * @param {Page} page
  */
 async function capture(page) {
-  const { width, height, data } = await page.evaluate(() => {
-    const { width, height, rgba } = /** @type {any} */ (document.querySelector('vitrine-viewer')).viewer.renderer.capture();
+  const { width, height, data } = await page.evaluate(async () => {
+    // Drawn and read in the render worker, or on the main thread (the fallback).
+    const { width, height, rgba } = await /** @type {any} */ (document.querySelector('vitrine-viewer')).viewer.renderer.capture();
     let binary = '';
     for (let i = 0; i < rgba.length; i += 0x8000) binary += String.fromCharCode(...rgba.subarray(i, i + 0x8000));
     return { width, height, data: btoa(binary) };
@@ -293,7 +294,8 @@ test('ccc: the base mesh is drawn first; the cell and low-resolution colour text
   assert.deepEqual([...held.keys()].sort(), [path(cell), path(low)].sort(), 'cell and low-resolution textures first, in parallel');
   held.get(path(cell))?.();
   held.get(path(low))?.();
-  s = await until(page, `s.colour === 'low'`);
+  // Drawn with the low-resolution texture (frames are drawn by the render worker, on its own clock).
+  s = await until(page, `s.colour === 'low' && s.colourAtMs.low !== undefined`);
   await page.waitForTimeout(200);
   assert.ok(held.has(path(full)), 'the full-resolution texture is asked for once the low one is in');
   assert.equal((await state(page)).colour, 'low', 'held back: still low resolution');
@@ -302,7 +304,7 @@ test('ccc: the base mesh is drawn first; the cell and low-resolution colour text
   mkdirSync(SCREENSHOTS, { recursive: true });
   await page.screenshot({ path: join(SCREENSHOTS, 'viewer-ccc-low-resolution.png') });
   held.get(path(full))?.();
-  s = await until(page, `s.colour === 'full' && s.status === 'complete'`);
+  s = await until(page, `s.colour === 'full' && s.status === 'complete' && s.colourAtMs.full !== undefined`);
   assert.ok(/** @type {number} */ (s.colourAtMs.full) > /** @type {number} */ (s.colourAtMs.low));
   assert.deepEqual(await colourPill(page), { text: 'Colour: full resolution', hidden: false });
   // The same picture, sharper: low and full resolution agree in colour.
@@ -484,17 +486,13 @@ test('ccc: a lost WebGL context is restored with its colour textures', async () 
   await page.goto(`${service.url}/embed/painted`);
   await until(page, `s.status === 'complete' && s.colour === 'full'`);
   const before = await capture(page);
-  await page.evaluate(() => {
-    const canvas = /** @type {HTMLCanvasElement} */ (document.querySelector('vitrine-viewer')?.shadowRoot?.querySelector('canvas'));
-    const ext = /** @type {any} */ (canvas.getContext('webgl2'))?.getExtension('WEBGL_lose_context');
-    /** @type {any} */ (window).loseContext = ext;
-    ext.loseContext();
-  });
+  // WEBGL_lose_context on the context, wherever it lives (render worker or page).
+  await page.evaluate(() => /** @type {any} */ (document.querySelector('vitrine-viewer')).viewer.renderer.loseContext());
   await page.waitForFunction(() => /** @type {any} */ (document.querySelector('vitrine-viewer')).viewer.renderer.lost);
-  await page.evaluate(() => /** @type {any} */ (window).loseContext.restoreContext());
+  await page.evaluate(() => /** @type {any} */ (document.querySelector('vitrine-viewer')).viewer.renderer.restoreContext());
   await page.waitForFunction(() => {
     const r = /** @type {any} */ (document.querySelector('vitrine-viewer')).viewer.renderer;
-    return !r.lost && r.current && r.current.uploads.length === 0 && !r.pending;
+    return !r.lost && r.settled;
   });
   const restored = await capture(page);
   const diffs = differences(before.rgba, restored.rgba, WIDTH);

@@ -86,12 +86,13 @@ function state(page) {
 }
 
 /**
- * The canvas's pixels (RGBA, bottom-up), drawn and read in one task.
+ * The canvas's pixels (RGBA, bottom-up), drawn and read in one task (of the thread that draws).
  * @param {Page} page
  */
 async function capture(page) {
-  const { width, height, data } = await page.evaluate(() => {
-    const { width, height, rgba } = /** @type {any} */ (document.querySelector('vitrine-viewer')).viewer.renderer.capture();
+  const { width, height, data } = await page.evaluate(async () => {
+    // Drawn and read in the render worker, or on the main thread (the fallback).
+    const { width, height, rgba } = await /** @type {any} */ (document.querySelector('vitrine-viewer')).viewer.renderer.capture();
     let binary = '';
     for (let i = 0; i < rgba.length; i += 0x8000) binary += String.fromCharCode(...rgba.subarray(i, i + 0x8000));
     return { width, height, data: btoa(binary) };
@@ -269,6 +270,98 @@ test('a load cap is retried and refinement resumes when it rises', async () => {
   assert.equal(done.shownLevel, manifest.last_level);
   assert.equal(await shadowHidden(page, '.notice'), true);
   assert.ok(manifests >= 2);
+  // The vertex buffers were sized for level 2 and grew when the cap rose: the picture is the direct load's.
+  await page.waitForFunction(() => /** @type {any} */ (document.querySelector('vitrine-viewer')).viewer.renderer.settled);
+  const resumed = await capture(page);
+  const direct = await open(`/m/torus?level=${manifest.last_level}`);
+  await until(direct.page, `s.status === 'complete'`);
+  const score = compareImages(resumed.rgba, (await capture(direct.page)).rgba);
+  assert.ok(score.iou > 0.999 && score.meanDiff < 0.5, `resumed vs direct: ${JSON.stringify(score)}`);
+  await page.close();
+  await direct.page.close();
+});
+
+/** @param {Page} page */
+function thread(page) {
+  return page.evaluate(() => /** @type {any} */ (document.querySelector('vitrine-viewer')).viewer.renderer.thread);
+}
+
+/**
+ * What the page's canvas gives the main thread: a context (it draws there)
+ * or the error of a canvas whose control went to a worker.
+ * @param {Page} page
+ */
+function canvasOnMainThread(page) {
+  return page.evaluate(() => {
+    const canvas = /** @type {HTMLCanvasElement} */ (document.querySelector('vitrine-viewer')?.shadowRoot?.querySelector('canvas'));
+    try {
+      return canvas.getContext('webgl2') ? 'webgl2' : 'none';
+    } catch (error) {
+      return /** @type {Error} */ (error).name;
+    }
+  });
+}
+
+test('the render worker draws the canvas where OffscreenCanvas has WebGL2; ?offscreen=off draws the same on the main thread', async () => {
+  const worker = await open('/embed/torus');
+  await until(worker.page, `s.status === 'complete'`);
+  assert.equal(await thread(worker.page), 'worker');
+  // The canvas was handed over: the page cannot draw on it any more.
+  assert.equal(await canvasOnMainThread(worker.page), 'InvalidStateError');
+  const inWorker = await capture(worker.page);
+  assert.ok(coverage(inWorker, [0.3, 0.3, 0.7, 0.7]) > 0.2, 'model pixels in the middle');
+
+  const main = await open('/embed/torus?offscreen=off');
+  await until(main.page, `s.status === 'complete'`);
+  assert.equal(await thread(main.page), 'main');
+  assert.equal(await canvasOnMainThread(main.page), 'webgl2');
+  const onMain = await capture(main.page);
+  const score = compareImages(inWorker.rgba, onMain.rgba);
+  assert.ok(score.iou > 0.999 && score.meanDiff < 0.5, `worker vs main thread: ${JSON.stringify(score)}`);
+  assert.deepEqual([...worker.problems, ...main.problems], []);
+  await worker.page.close();
+  await main.page.close();
+});
+
+test('where workers have no WebGL2, the viewer keeps its canvas and draws on the main thread', async () => {
+  const page = await browser.context.newPage();
+  /** @type {string[]} */
+  const problems = [];
+  page.on('pageerror', (e) => problems.push(e.message));
+  await page.addInitScript(() => {
+    // A render worker that answers as one without WebGL2 would (Safari 16.4: OffscreenCanvas, 2D only).
+    const Original = window.Worker;
+    /** @type {any} */ (window).Worker = function (/** @type {string | URL} */ url, /** @type {any} */ options) {
+      if (!String(url).includes('render-worker')) return new Original(url, options);
+      const stub = `postMessage({ type: 'ready', webgl2: false });`;
+      return new Original(URL.createObjectURL(new Blob([stub], { type: 'text/javascript' })));
+    };
+  });
+  await page.goto(`${service.url}/embed/torus`);
+  const s = await until(page, `s.status === 'complete'`);
+  assert.equal(s.shownLevel, manifest.last_level);
+  assert.equal(await thread(page), 'main');
+  assert.equal(await canvasOnMainThread(page), 'webgl2');
+  const image = await capture(page);
+  assert.ok(coverage(image, [0.3, 0.3, 0.7, 0.7]) > 0.2, 'model pixels in the middle');
+  assert.deepEqual(problems, []);
+  await page.close();
+});
+
+test('a lost WebGL context is restored with the model on the main thread too (fallback)', async () => {
+  const { page } = await open('/embed/torus?offscreen=off');
+  await until(page, `s.status === 'complete'`);
+  assert.equal(await thread(page), 'main');
+  const before = await capture(page);
+  await page.evaluate(() => /** @type {any} */ (document.querySelector('vitrine-viewer')).viewer.renderer.loseContext());
+  await page.waitForFunction(() => /** @type {any} */ (document.querySelector('vitrine-viewer')).viewer.renderer.lost);
+  await page.evaluate(() => /** @type {any} */ (document.querySelector('vitrine-viewer')).viewer.renderer.restoreContext());
+  await page.waitForFunction(() => {
+    const r = /** @type {any} */ (document.querySelector('vitrine-viewer')).viewer.renderer;
+    return !r.lost && r.settled;
+  });
+  const score = compareImages(before.rgba, (await capture(page)).rgba);
+  assert.ok(score.iou > 0.999 && score.meanDiff < 0.5, JSON.stringify(score));
   await page.close();
 });
 
@@ -326,7 +419,9 @@ test('a damaged batch becomes a visible message, and retry recovers', async () =
     await route.fulfill({ response, body });
   });
   await page.goto(`${service.url}/m/torus`);
-  const s = await until(page, `s.status === 'error'`);
+  // Levels decoded before the damaged one still reach the screen (the render
+  // worker may finish uploading level 2 after the error is reported).
+  const s = await until(page, `s.status === 'error' && s.shownLevel >= 2`);
   assert.equal(s.shownLevel, 2);
   assert.equal(await shadowHidden(page, '.error'), false);
   assert.match(await shadowText(page, '.error p'), /^Could not show this model: could not decode level 3: the stream is damaged/);
@@ -345,7 +440,7 @@ test('a failed download becomes a visible message', async () => {
   const page = await browser.context.newPage();
   await page.route('**/batches/2*', (route) => route.abort('connectionreset'));
   await page.goto(`${service.url}/m/torus`);
-  const s = await until(page, `s.status === 'error'`);
+  const s = await until(page, `s.status === 'error' && s.shownLevel >= 1`);
   assert.equal(s.shownLevel, 1);
   assert.match(await shadowText(page, '.error p'), /^Could not show this model: a download failed: could not fetch the batch 2/);
   await page.close();
@@ -354,6 +449,8 @@ test('a failed download becomes a visible message', async () => {
 test('a browser without WebGL2 gets a message, not a blank box', async () => {
   const page = await browser.context.newPage();
   await page.addInitScript(() => {
+    // Without WebGL2 a browser has none in workers either: no OffscreenCanvas hand-over.
+    /** @type {any} */ (HTMLCanvasElement.prototype).transferControlToOffscreen = undefined;
     const original = HTMLCanvasElement.prototype.getContext;
     /** @type {any} */ (HTMLCanvasElement.prototype).getContext = function (/** @type {string} */ type, /** @type {any} */ options) {
       return type === 'webgl2' ? null : original.call(this, type, options);
@@ -369,17 +466,13 @@ test('a lost WebGL context is restored with the model', async () => {
   const { page } = await open('/embed/torus');
   await until(page, `s.status === 'complete'`);
   const before = await capture(page);
-  await page.evaluate(() => {
-    const canvas = /** @type {HTMLCanvasElement} */ (document.querySelector('vitrine-viewer')?.shadowRoot?.querySelector('canvas'));
-    const ext = /** @type {any} */ (canvas.getContext('webgl2'))?.getExtension('WEBGL_lose_context');
-    /** @type {any} */ (window).loseContext = ext;
-    ext.loseContext();
-  });
+  // WEBGL_lose_context on the context, wherever it lives (render worker or page).
+  await page.evaluate(() => /** @type {any} */ (document.querySelector('vitrine-viewer')).viewer.renderer.loseContext());
   await page.waitForFunction(() => /** @type {any} */ (document.querySelector('vitrine-viewer')).viewer.renderer.lost);
-  await page.evaluate(() => /** @type {any} */ (window).loseContext.restoreContext());
+  await page.evaluate(() => /** @type {any} */ (document.querySelector('vitrine-viewer')).viewer.renderer.restoreContext());
   await page.waitForFunction(() => {
     const r = /** @type {any} */ (document.querySelector('vitrine-viewer')).viewer.renderer;
-    return !r.lost && r.current && r.current.uploads.length === 0 && !r.pending;
+    return !r.lost && r.settled;
   });
   const restored = await capture(page);
   const score = compareImages(before.rgba, restored.rgba);
@@ -394,10 +487,7 @@ test('keyboard: W toggles the wireframe, arrows turn, R resets', async () => {
   await canvas.focus();
   const shaded = await capture(page);
   await page.keyboard.press('w');
-  await page.waitForFunction(() => {
-    const r = /** @type {any} */ (document.querySelector('vitrine-viewer')).viewer.renderer;
-    return r.current?.edgeBuffer && r.current.uploads.length === 0;
-  });
+  await page.waitForFunction(() => /** @type {any} */ (document.querySelector('vitrine-viewer')).viewer.renderer.edges);
   const wired = await capture(page);
   assert.equal(await page.locator('vitrine-viewer button[data-action="wireframe"]').getAttribute('aria-pressed'), 'true');
   assert.ok(compareImages(shaded.rgba, wired.rgba).meanDiff > 5, 'wire lines drawn');
@@ -431,6 +521,11 @@ test('the drawing buffer follows devicePixelRatio and resizes', async () => {
   await page.waitForFunction(() => /** @type {HTMLCanvasElement} */ (document.querySelector('vitrine-viewer')?.shadowRoot?.querySelector('canvas')).width === 800);
   [w, h, cw, ch] = await size();
   assert.deepEqual([w, h, cw, ch], [800, 600, 400, 300]);
+  // The drawing buffer itself (the render worker's OffscreenCanvas) followed.
+  await page.waitForFunction(() => /** @type {any} */ (document.querySelector('vitrine-viewer')).viewer.renderer.settled);
+  const image = await capture(page);
+  assert.deepEqual([image.width, image.height], [800, 600]);
+  assert.ok(coverage(image, [0.3, 0.3, 0.7, 0.7]) > 0.2, 'model pixels in the middle');
   await page.close();
 });
 

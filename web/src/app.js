@@ -2,8 +2,8 @@
 /**
  * The pages `vitrine serve` maps to one index.html: the gallery at `/`, a
  * model page at `/m/{slug}` (viewer, description, embed snippets) and the
- * bare viewer at `/embed/{slug}` for iframes. `?device=`, `?token=` and
- * `?level=` on a page's URL are passed to the viewer.
+ * bare viewer at `/embed/{slug}` for iframes. `?device=`, `?token=`,
+ * `?level=` and `?offscreen=off` on a page's URL are passed to the viewer.
  */
 
 import './element.js';
@@ -31,7 +31,7 @@ function el(tag, attributes = {}, children = []) {
 /** @param {string} slug */
 function viewerElement(slug) {
   const viewer = el('vitrine-viewer', { src: `/api/models/${slug}` });
-  for (const key of ['device', 'token', 'level']) {
+  for (const key of ['device', 'token', 'level', 'offscreen']) {
     const value = params.get(key);
     if (value !== null) viewer.setAttribute(key, value);
   }

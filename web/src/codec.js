@@ -78,6 +78,19 @@ export class VitrineCodec {
   }
 
   /**
+   * A view on a level buffer inside the WebAssembly memory (no copy): valid
+   * only until the next call into the decoder, which may move or grow it.
+   * @param {number} handle
+   * @param {number} kind
+   * @returns {{ ptr: number, len: number } | null}
+   */
+  span(handle, kind) {
+    const ptr = this.exports.buffer_ptr(handle, kind);
+    const len = this.exports.buffer_len(handle, kind);
+    return ptr === 0 && len === 0 ? null : { ptr, len };
+  }
+
+  /**
    * @param {number} handle
    * @param {number} kind
    * @param {number} bytesPerElement
@@ -117,6 +130,28 @@ export class StreamDecoder {
       positions: new Float32Array(/** @type {ArrayBuffer} */ (positions)),
       colours: colours ? new Uint8Array(colours) : null,
       indices: new Uint32Array(/** @type {ArrayBuffer} */ (indices)),
+    };
+  }
+
+  /**
+   * The current level as views into the decoder's memory, not copies: read
+   * them (or copy parts out) before the next call into the decoder. Lets the
+   * worker compute normals and send only what changed without copying whole
+   * levels first.
+   * @returns {Level}
+   */
+  view() {
+    const e = this.codec.exports;
+    const buffer = e.memory.buffer;
+    const positions = this.codec.span(this.handle, POSITIONS);
+    const colours = this.codec.span(this.handle, COLOURS);
+    const indices = this.codec.span(this.handle, INDICES);
+    return {
+      level: e.decoder_level(this.handle),
+      vertices: e.decoder_vertices(this.handle),
+      positions: positions ? new Float32Array(buffer, positions.ptr, positions.len) : new Float32Array(0),
+      colours: colours ? new Uint8Array(buffer, colours.ptr, colours.len) : null,
+      indices: indices ? new Uint32Array(buffer, indices.ptr, indices.len) : new Uint32Array(0),
     };
   }
 

@@ -6,7 +6,9 @@
  * Attributes: `src` (a model page `/m/{slug}`, an embed page `/embed/{slug}`
  * or a manifest `/api/models/{slug}`, on the Vitrine server), `chrome`
  * (`full` or `minimal`), `device` (`phone`, `tablet`, `desktop`: overrides
- * the server's guess), `level` (stop at this level; for comparisons). The
+ * the server's guess), `level` (stop at this level; for comparisons),
+ * `offscreen="off"` (draw on the main thread even where a worker could:
+ * comparisons and tests of the fallback). The
  * worker and the decoder are loaded from beside this script, so the element
  * works on another origin (the service answers CORS).
  */
@@ -53,6 +55,8 @@ export class VitrineViewerElement extends HTMLElement {
       level: level === null || level === '' ? null : Number(level),
       workerUrl: new URL('./worker.js', import.meta.url).href,
       wasmUrl: new URL('./vitrine_wasm.wasm', import.meta.url).href,
+      renderWorkerUrl: new URL('./render-worker.js', import.meta.url).href,
+      offscreen: this.getAttribute('offscreen') !== 'off',
     });
     void this.viewer.start();
   }

@@ -20,6 +20,8 @@ import { bounds, edgeIndices, vertexNormals } from './geometry.js';
  *   does not step back through levels already on screen)
  * @property {boolean} wireframe also build the edge list of each posted level
  * @property {Record<string, string>} [headers] sent with every request
+ * @property {number} [capacity] vertices of the last level (from the manifest): the
+ *   renderer sizes its position and colour buffers once for it
  */
 
 /**
@@ -28,9 +30,14 @@ import { bounds, edgeIndices, vertexNormals } from './geometry.js';
  * @property {number} level
  * @property {number} vertices
  * @property {number} faces
- * @property {Float32Array} positions
- * @property {Int16Array} normals normalised int16 x, y, z
- * @property {Uint8Array | null} colours
+ * @property {number} [firstVertex] `positions` and `colours` hold the vertices from
+ *   this one on; the ones before it were posted with an earlier level and have
+ *   not changed (0 or absent: the whole level)
+ * @property {number} [capacity] vertices the renderer should make room for
+ *   (the last level's), so later levels append without reallocating
+ * @property {Float32Array} positions x, y, z of vertices firstVertex…vertices − 1
+ * @property {Int16Array} normals normalised int16 x, y, z of every vertex
+ * @property {Uint8Array | null} colours r, g, b of vertices firstVertex…vertices − 1
  * @property {Uint32Array} indices
  * @property {Uint32Array | null} edges
  * @property {import('./geometry.js').Bounds} baseBounds bounds of the base mesh: the
@@ -75,6 +82,8 @@ export class Reconstruction {
   #decodeMs = 0;
   #deriveMs = 0;
   #lastProgress = 0;
+  /** Vertices whose positions and colours have been posted (they never change). */
+  #sentVertices = 0;
   /** @type {import('./geometry.js').Bounds} */
   #baseBounds = { min: [0, 0, 0], max: [0, 0, 0] };
   /** Levels applied so far; -1 before the base mesh. */
@@ -107,7 +116,7 @@ export class Reconstruction {
     this.request.wireframe = on;
     if (on && this.#decoder && this.level >= 0) {
       const t0 = performance.now();
-      const { indices, vertices } = this.#decoder.level();
+      const { indices, vertices } = this.#decoder.view();
       const edges = edgeIndices(indices, vertices);
       this.#deriveMs += performance.now() - t0;
       this.post({ type: 'edges', level: this.level, edges }, [edges.buffer]);
@@ -140,7 +149,7 @@ export class Reconstruction {
     const t0 = performance.now();
     this.#decoder = this.codec.decoder(base.bytes);
     this.#decodeMs += performance.now() - t0;
-    this.#baseBounds = bounds(this.#decoder.level().positions);
+    this.#baseBounds = bounds(this.#decoder.view().positions);
     this.level = 0;
     if (this.#shows(0)) this.#postLevel();
     while (!this.#cancelled) {
@@ -197,29 +206,45 @@ export class Reconstruction {
     return pending;
   }
 
+  /**
+   * Posts the current level. Vertices are only ever appended (codec/FORMAT.md:
+   * each pass appends the vertices it inserts), so positions and colours
+   * carry only the vertices not posted before (from `firstVertex`); normals
+   * and indices change everywhere and go whole. Normals and edges are
+   * computed on views into the decoder's memory, so nothing is copied out
+   * except what is sent.
+   */
   #postLevel() {
     const decoder = /** @type {import('./codec.js').StreamDecoder} */ (this.#decoder);
     const t0 = performance.now();
-    const level = decoder.level();
+    const view = decoder.view();
     const t1 = performance.now();
-    const normals = vertexNormals(level.positions, level.indices);
-    const edges = this.request.wireframe ? edgeIndices(level.indices, level.vertices) : null;
-    this.#decodeMs += t1 - t0;
-    this.#deriveMs += performance.now() - t1;
+    const normals = vertexNormals(view.positions, view.indices);
+    const edges = this.request.wireframe ? edgeIndices(view.indices, view.vertices) : null;
+    const t2 = performance.now();
+    const first = Math.min(this.#sentVertices, view.vertices);
+    const positions = view.positions.slice(3 * first);
+    const colours = view.colours ? view.colours.slice(3 * first) : null;
+    const indices = view.indices.slice();
+    this.#sentVertices = view.vertices;
+    this.#decodeMs += t1 - t0 + (performance.now() - t2);
+    this.#deriveMs += t2 - t1;
     /** @type {Transferable[]} */
-    const transfer = [level.positions.buffer, normals.buffer, level.indices.buffer];
-    if (level.colours) transfer.push(level.colours.buffer);
+    const transfer = [positions.buffer, normals.buffer, indices.buffer];
+    if (colours) transfer.push(colours.buffer);
     if (edges) transfer.push(edges.buffer);
     this.post(
       {
         type: 'level',
-        level: level.level,
-        vertices: level.vertices,
-        faces: level.indices.length / 3,
-        positions: level.positions,
+        level: view.level,
+        vertices: view.vertices,
+        faces: indices.length / 3,
+        firstVertex: first,
+        capacity: Math.max(view.vertices, this.request.capacity ?? 0),
+        positions,
         normals,
-        colours: level.colours,
-        indices: level.indices,
+        colours,
+        indices,
         edges,
         baseBounds: this.#baseBounds,
         received: this.#received,

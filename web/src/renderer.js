@@ -5,14 +5,22 @@
  * a tablet to fetch and parse before the base mesh could appear; this file,
  * the camera and the controls are a few KB.
  *
- * A new level is uploaded into fresh buffers a slice per frame (at most
- * UPLOAD_BUDGET_MS of bufferSubData), while the previous level keeps being
- * drawn; the two are swapped when the upload is complete. So a 40 MB level
- * never becomes one long main-thread task. A fence after each frame's
+ * Vertices are only ever appended from one level to the next, so positions
+ * and colours live in one pair of buffers sized once for the last level
+ * (the manifest's count): each level uploads only its new vertices there.
+ * Normals and indices change everywhere; a new level gets fresh ones,
+ * uploaded a slice per frame (at most `uploadBudgetMs` of bufferSubData)
+ * while the previous level keeps being drawn; the two are swapped when the
+ * upload is complete. So a 40 MB level never becomes one long task (on the
+ * main thread, or in the render worker where it would delay the camera). A fence after each frame's
  * commands holds the next slice back until the GPU has caught up: otherwise
  * a slow GPU (a tablet's, or SwiftShader) fills the command buffer and the
- * next bufferSubData blocks the main thread until it drains. The level's arrays are kept so a
- * lost WebGL context can be rebuilt without asking the worker again.
+ * next bufferSubData blocks the thread until it drains. The level's arrays
+ * (and every vertex received) are kept so a lost WebGL context can be
+ * rebuilt without asking the worker again.
+ *
+ * The same class draws on the page's canvas (the fallback) or, in the render
+ * worker, on the OffscreenCanvas the page handed over (render-worker.js).
  */
 
 import { multiply } from './camera.js';
@@ -21,6 +29,16 @@ import { BACKGROUND, CLAY, GLSL_SHADE, WIRE_ALPHA, WIRE_COLOUR } from './shading
 
 const UPLOAD_BUDGET_MS = 6;
 const UPLOAD_CHUNK_BYTES = 256 << 10;
+
+/**
+ * requestAnimationFrame where the thread has one (pages; Chromium's and
+ * Firefox's workers), else a timer.
+ * @type {(callback: () => void) => number}
+ */
+const nextFrame =
+  typeof requestAnimationFrame === 'function' ? (f) => requestAnimationFrame(f) : (f) => Number(setTimeout(f, 16));
+/** @type {(id: number) => void} */
+const cancelFrame = typeof cancelAnimationFrame === 'function' ? (id) => cancelAnimationFrame(id) : (id) => clearTimeout(id);
 
 const VERTEX_SHADER = `#version 300 es
 layout(location = 0) in vec3 a_position;
@@ -64,15 +82,42 @@ void main() {
 
 /** @typedef {import('./reconstruction.js').LevelMessage} LevelMessage */
 
+/** @typedef {{ target: number, buffer: WebGLBuffer, data: ArrayBufferView, offset: number }} Upload */
+
 /**
+ * One level on the GPU: its own normals, indices and edges; positions and
+ * colours from the shared vertex store.
  * @typedef {object} GpuMesh
  * @property {LevelMessage} source
  * @property {WebGLVertexArrayObject} vao
  * @property {WebGLBuffer[]} buffers
  * @property {WebGLBuffer} indexBuffer
  * @property {WebGLBuffer | null} edgeBuffer
- * @property {Array<{ target: number, buffer: WebGLBuffer, data: ArrayBufferView, offset: number }>} uploads
+ * @property {Upload[]} uploads
  */
+
+/**
+ * Every vertex received so far (positions and colours never change once
+ * sent), on the CPU and in two GPU buffers of `capacity` vertices;
+ * `uploaded` vertices of them are on the GPU.
+ * @typedef {object} VertexStore
+ * @property {number} capacity vertices the CPU arrays hold
+ * @property {number} count vertices received
+ * @property {number} uploaded vertices on the GPU
+ * @property {number} gpuCapacity vertices the GPU buffers hold
+ * @property {Float32Array} positions
+ * @property {Uint8Array | null} colours
+ * @property {WebGLBuffer | null} positionBuffer
+ * @property {WebGLBuffer | null} colourBuffer
+ */
+
+/**
+ * @typedef {object} RendererOptions
+ * @property {number} [uploadBudgetMs] bufferSubData per frame (default 6 ms)
+ * @property {number} [uploadChunkBytes] bytes per bufferSubData (default 256 KB)
+ */
+
+/** @typedef {HTMLCanvasElement | OffscreenCanvas} AnyCanvas */
 
 /**
  * A CCC colour mapping as the renderer holds it: the sources are kept so a
@@ -111,27 +156,63 @@ export class Renderer {
   #cellTexture = null;
   /** @type {WebGLTexture | null} */
   #atlasTexture = null;
+  /** @type {VertexStore} */
+  #store = {
+    capacity: 0,
+    count: 0,
+    uploaded: 0,
+    gpuCapacity: 0,
+    positions: new Float32Array(0),
+    colours: null,
+    positionBuffer: null,
+    colourBuffer: null,
+  };
+  /** @type {any} WEBGL_lose_context, for tests */
+  #loseContext = null;
 
   /**
-   * @param {HTMLCanvasElement} canvas
+   * @param {AnyCanvas} canvas
    * @param {import('./camera.js').OrbitCamera | null} camera
-   * @param {{ onSwap?: (level: LevelMessage) => void, onFrame?: () => void }} hooks
+   * @param {{ onSwap?: (level: LevelMessage) => void, onFrame?: () => void, onTick?: () => void }} hooks
+   *   onSwap: a level is complete on the GPU and replaces the previous one;
+   *   onFrame: a frame was drawn; onTick: after every animation frame's work
+   * @param {RendererOptions} [options]
    */
-  constructor(canvas, camera, hooks = {}) {
+  constructor(canvas, camera, hooks = {}, options = {}) {
     this.canvas = canvas;
     this.camera = camera;
     this.hooks = hooks;
-    const gl = canvas.getContext('webgl2', { antialias: true, powerPreference: 'high-performance' });
+    this.uploadBudgetMs = options.uploadBudgetMs ?? UPLOAD_BUDGET_MS;
+    this.uploadChunkBytes = options.uploadChunkBytes ?? UPLOAD_CHUNK_BYTES;
+    const gl = /** @type {WebGL2RenderingContext | null} */ (
+      canvas.getContext('webgl2', { antialias: true, powerPreference: 'high-performance' })
+    );
     if (!gl) throw new Error('this browser has no WebGL2');
     this.gl = gl;
     canvas.addEventListener('webglcontextlost', (event) => {
       event.preventDefault();
       this.lost = true;
-      if (this.#raf !== null) cancelAnimationFrame(this.#raf);
+      if (this.#raf !== null) cancelFrame(this.#raf);
       this.#raf = null;
     });
     canvas.addEventListener('webglcontextrestored', () => this.#restore());
     this.#init();
+  }
+
+  /** Loses the WebGL context on purpose (tests of the recovery). */
+  loseContext() {
+    this.#loseContext = this.gl.getExtension('WEBGL_lose_context');
+    this.#loseContext?.loseContext();
+  }
+
+  /** Restores a context lost by loseContext(). */
+  restoreContext() {
+    this.#loseContext?.restoreContext();
+  }
+
+  /** Nothing waiting to be uploaded: the newest level is complete on the GPU. */
+  get settled() {
+    return !this.lost && !this.pending && Boolean(this.current) && this.current?.uploads.length === 0;
   }
 
   #init() {
@@ -171,6 +252,10 @@ export class Renderer {
     this.#fence = null;
     this.#cellTexture = null;
     this.#atlasTexture = null;
+    this.#store.positionBuffer = null;
+    this.#store.colourBuffer = null;
+    this.#store.uploaded = 0;
+    this.#store.gpuCapacity = 0;
     this.#init();
     this.#uploadColour();
     const newest = this.pending?.source ?? this.current?.source;
@@ -185,6 +270,7 @@ export class Renderer {
    * @param {LevelMessage} level
    */
   show(level) {
+    this.#receive(level);
     if (this.lost) {
       this.pending = { ...emptyMesh(), source: level };
       return;
@@ -330,7 +416,7 @@ export class Renderer {
   }
 
   #schedule() {
-    if (this.#raf === null && !this.lost) this.#raf = requestAnimationFrame(() => this.#frame());
+    if (this.#raf === null && !this.lost) this.#raf = nextFrame(() => this.#frame());
   }
 
   /**
@@ -347,7 +433,7 @@ export class Renderer {
     const pending = this.pending;
     if (pending && caughtUp) {
       issued = true;
-      if (this.#upload(pending)) {
+      if (this.#upload(pending, pending.source.vertices)) {
         if (this.current) this.#release(this.current);
         this.current = pending;
         this.pending = null;
@@ -356,7 +442,7 @@ export class Renderer {
       }
     } else if (this.current?.uploads.length && caughtUp) {
       issued = true;
-      if (this.#upload(this.current)) this.#dirty = true;
+      if (this.#upload(this.current, this.current.source.vertices)) this.#dirty = true;
     }
     if (this.#dirty) {
       this.#dirty = false;
@@ -371,6 +457,7 @@ export class Renderer {
       gl.flush();
     }
     if (this.pending || this.current?.uploads.length) this.#schedule();
+    this.hooks.onTick?.();
   }
 
   /**
@@ -379,6 +466,7 @@ export class Renderer {
    */
   #allocate(level) {
     const gl = this.gl;
+    const store = this.#ensureStore();
     const vao = /** @type {WebGLVertexArrayObject} */ (gl.createVertexArray());
     gl.bindVertexArray(vao);
     /** @type {GpuMesh['uploads']} */
@@ -397,14 +485,14 @@ export class Renderer {
       buffers.push(b);
       return b;
     };
-    buffer(gl.ARRAY_BUFFER, level.positions);
+    gl.bindBuffer(gl.ARRAY_BUFFER, store.positionBuffer);
     gl.enableVertexAttribArray(0);
     gl.vertexAttribPointer(0, 3, gl.FLOAT, false, 0, 0);
     buffer(gl.ARRAY_BUFFER, level.normals);
     gl.enableVertexAttribArray(1);
     gl.vertexAttribPointer(1, 3, gl.SHORT, true, 0, 0);
-    if (level.colours) {
-      buffer(gl.ARRAY_BUFFER, level.colours);
+    if (level.colours && store.colourBuffer) {
+      gl.bindBuffer(gl.ARRAY_BUFFER, store.colourBuffer);
       gl.enableVertexAttribArray(2);
       gl.vertexAttribPointer(2, 3, gl.UNSIGNED_BYTE, true, 0, 0);
     } else {
@@ -421,24 +509,110 @@ export class Renderer {
   }
 
   /**
-   * Uploads slices until the frame's budget is spent.
+   * Keeps a level's new vertices (positions and colours never change once
+   * sent, so a level carries only those from `firstVertex` on).
+   * @param {LevelMessage} level
+   */
+  #receive(level) {
+    const store = this.#store;
+    const first = level.firstVertex ?? 0;
+    if (first > store.count) throw new Error(`level ${level.level} starts at vertex ${first}, but only ${store.count} were received`);
+    const end = first + level.positions.length / 3;
+    const needed = Math.max(end, level.vertices, level.capacity ?? 0);
+    if (needed > store.capacity) {
+      const positions = new Float32Array(3 * needed);
+      positions.set(store.positions.subarray(0, 3 * store.count));
+      store.positions = positions;
+      if (store.colours) {
+        const colours = new Uint8Array(3 * needed);
+        colours.set(store.colours.subarray(0, 3 * store.count));
+        store.colours = colours;
+      }
+      store.capacity = needed;
+    }
+    if (level.colours && !store.colours) store.colours = new Uint8Array(3 * store.capacity);
+    store.positions.set(level.positions, 3 * first);
+    if (level.colours && store.colours) store.colours.set(level.colours, 3 * first);
+    store.count = Math.max(store.count, end);
+    // Vertices sent again (a retry's new worker starts from 0) are the same; upload them again anyway.
+    store.uploaded = Math.min(store.uploaded, first);
+  }
+
+  /**
+   * GPU buffers for the vertex store, as large as its CPU arrays. Normally
+   * made once, at the last level's size; if a level outgrows them (no
+   * capacity hint), they are remade and what was uploaded is copied over at
+   * once, and the meshes' vertex arrays point at the new ones.
+   */
+  #ensureStore() {
+    const gl = this.gl;
+    const store = this.#store;
+    const colours = Boolean(store.colours);
+    if (store.gpuCapacity >= store.capacity && Boolean(store.colourBuffer) === colours && store.positionBuffer) return store;
+    const old = [store.positionBuffer, store.colourBuffer];
+    gl.bindVertexArray(null);
+    store.positionBuffer = gl.createBuffer();
+    gl.bindBuffer(gl.ARRAY_BUFFER, store.positionBuffer);
+    gl.bufferData(gl.ARRAY_BUFFER, store.positions.byteLength, gl.STATIC_DRAW);
+    if (store.uploaded > 0) gl.bufferSubData(gl.ARRAY_BUFFER, 0, store.positions, 0, 3 * store.uploaded);
+    store.colourBuffer = null;
+    if (store.colours) {
+      store.colourBuffer = gl.createBuffer();
+      gl.bindBuffer(gl.ARRAY_BUFFER, store.colourBuffer);
+      gl.bufferData(gl.ARRAY_BUFFER, store.colours.byteLength, gl.STATIC_DRAW);
+      if (store.uploaded > 0) gl.bufferSubData(gl.ARRAY_BUFFER, 0, store.colours, 0, 3 * store.uploaded);
+    }
+    store.gpuCapacity = store.capacity;
+    for (const mesh of [this.current, this.pending]) {
+      if (!mesh?.vao) continue;
+      gl.bindVertexArray(mesh.vao);
+      gl.bindBuffer(gl.ARRAY_BUFFER, store.positionBuffer);
+      gl.vertexAttribPointer(0, 3, gl.FLOAT, false, 0, 0);
+      if (mesh.source.colours && store.colourBuffer) {
+        gl.bindBuffer(gl.ARRAY_BUFFER, store.colourBuffer);
+        gl.vertexAttribPointer(2, 3, gl.UNSIGNED_BYTE, true, 0, 0);
+      }
+    }
+    gl.bindVertexArray(null);
+    for (const b of old) if (b) gl.deleteBuffer(b);
+    return store;
+  }
+
+  /**
+   * Uploads slices until the frame's budget is spent: first the vertex
+   * store up to the mesh's vertex count, then the mesh's own buffers.
    * @param {GpuMesh} mesh
+   * @param {number} vertices
    * @returns {boolean} whether the mesh is complete
    */
-  #upload(mesh) {
+  #upload(mesh, vertices) {
     const gl = this.gl;
     const start = performance.now();
+    const store = this.#ensureStore();
+    const chunk = this.uploadChunkBytes;
+    const inBudget = () => performance.now() - start < this.uploadBudgetMs;
     gl.bindVertexArray(null);
-    while (mesh.uploads.length > 0 && performance.now() - start < UPLOAD_BUDGET_MS) {
+    while (store.uploaded < vertices && inBudget()) {
+      // The same vertex range of positions (12 bytes each) and colours (3).
+      const end = Math.min(vertices, store.uploaded + Math.max(1, Math.floor(chunk / 12)));
+      gl.bindBuffer(gl.ARRAY_BUFFER, store.positionBuffer);
+      gl.bufferSubData(gl.ARRAY_BUFFER, 12 * store.uploaded, store.positions, 3 * store.uploaded, 3 * (end - store.uploaded));
+      if (store.colours && store.colourBuffer) {
+        gl.bindBuffer(gl.ARRAY_BUFFER, store.colourBuffer);
+        gl.bufferSubData(gl.ARRAY_BUFFER, 3 * store.uploaded, store.colours, 3 * store.uploaded, 3 * (end - store.uploaded));
+      }
+      store.uploaded = end;
+    }
+    while (mesh.uploads.length > 0 && inBudget()) {
       const job = mesh.uploads[0];
       const bytes = new Uint8Array(job.data.buffer, job.data.byteOffset, job.data.byteLength);
-      const end = Math.min(bytes.length, job.offset + UPLOAD_CHUNK_BYTES);
+      const end = Math.min(bytes.length, job.offset + chunk);
       gl.bindBuffer(job.target, job.buffer);
       gl.bufferSubData(job.target, job.offset, bytes, job.offset, end - job.offset);
       job.offset = end;
       if (end === bytes.length) mesh.uploads.shift();
     }
-    return mesh.uploads.length === 0;
+    return mesh.uploads.length === 0 && store.uploaded >= vertices;
   }
 
   /** @param {GpuMesh} mesh */

@@ -9,7 +9,7 @@ import { OrbitCamera } from './camera.js';
 import { checkParameters } from './ccc.js';
 import { OrbitControls } from './controls.js';
 import { decodePng } from './png.js';
-import { Renderer } from './renderer.js';
+import { openRenderer } from './render-host.js';
 
 /**
  * @typedef {object} ViewerOptions
@@ -18,6 +18,9 @@ import { Renderer } from './renderer.js';
  * @property {number | null} level load up to this level and show only it (tests, comparisons)
  * @property {string} workerUrl absolute URL of the bundled decode worker
  * @property {string} wasmUrl absolute URL of the decoder's WebAssembly
+ * @property {string} renderWorkerUrl absolute URL of the bundled render worker
+ * @property {boolean} offscreen draw in the render worker when the browser can
+ *   (false: always on the main thread)
  */
 
 /**
@@ -120,12 +123,16 @@ export class Viewer {
   /** @type {OrbitCamera | null} */
   camera = null;
   /**
-   * Created by start() once the requests are on their way: the first WebGL
-   * context of a page can hold the main thread for a while (a GPU process
-   * to start; ~1 s with SwiftShader), and the network need not wait for it.
-   * @type {Renderer | null}
+   * Opened by start() once the requests are on their way: a render worker
+   * drawing on the canvas handed to it where the browser can, else the
+   * main thread (render-host.js). The first WebGL context of a page can
+   * take a while (a GPU process to start; ~1 s with SwiftShader), and the
+   * network need not wait for it.
+   * @type {import('./render-host.js').RenderHost | null}
    */
   renderer = null;
+  /** @type {Promise<import('./render-host.js').RenderHost> | null} */
+  #rendering = null;
   /** @type {Worker | null} */
   #worker = null;
   /** @type {ReturnType<typeof setTimeout> | null} */
@@ -167,12 +174,12 @@ export class Viewer {
     this.ui.showNotice(null);
     try {
       // Manifest, decoder and worker script load in parallel.
-      const loading = Promise.all([this.#fetchManifest(), compileDecoder(this.options.wasmUrl), this.#createWorker()]);
-      loading.catch(() => {}); // awaited below; this only keeps a failure while the context is made from going unhandled
-      this.renderer ??= new Renderer(this.ui.canvas, null, {
-        onSwap: (level) => this.#shown(level),
-        onFrame: () => this.#framed(),
-      });
+      const loading = Promise.all([
+        this.#fetchManifest(),
+        compileDecoder(this.options.wasmUrl),
+        this.#createWorker(this.options.workerUrl),
+        this.#openRenderer(),
+      ]);
       const [manifest, module, worker] = await loading;
       if (attempt !== this.#attempt) {
         worker.terminate();
@@ -232,6 +239,8 @@ export class Viewer {
     const url = (/** @type {string} */ path) => this.#apiUrl(path);
     /** @type {import('./reconstruction.js').LoadRequest} */
     const request = {
+      // The renderer sizes its vertex buffers once for the level it is heading for.
+      capacity: manifest.levels[target]?.vertices,
       baseUrl: url(manifest.levels[0].url),
       batchUrls: manifest.levels.slice(1).map((l) => url(l.url)),
       upTo: target,
@@ -239,7 +248,25 @@ export class Viewer {
       showFrom: Math.min(this.state.shownLevel + 1, target),
       wireframe: this.#wireframe,
     };
-    worker.postMessage({ type: 'load', module, request });
+    // With a render worker, levels go to it directly; the page gets a notice without the buffers.
+    const port = /** @type {import('./render-host.js').RenderHost} */ (this.renderer).connect();
+    worker.postMessage({ type: 'load', module, request, port }, port ? [port] : []);
+  }
+
+  /** The renderer, opened once per viewer (a retry keeps it); a failure is tried again on retry. */
+  #openRenderer() {
+    this.#rendering ??= openRenderer(
+      this.ui.canvas,
+      { onSwap: (level) => this.#shown(level), onFrame: (frame) => this.#framed(frame) },
+      { offscreen: this.options.offscreen, createWorker: () => this.#createWorker(this.options.renderWorkerUrl) },
+    ).then(
+      (renderer) => (this.renderer = renderer),
+      (error) => {
+        this.#rendering = null;
+        throw error;
+      },
+    );
+    return this.#rendering;
   }
 
   /** @param {number} cap */
@@ -249,7 +276,7 @@ export class Viewer {
 
   /** @param {import('./reconstruction.js').WorkerMessage} message */
   #message(message) {
-    const renderer = /** @type {Renderer} */ (this.renderer);
+    const renderer = /** @type {import('./render-host.js').RenderHost} */ (this.renderer);
     switch (message.type) {
       case 'level':
         if (!this.camera) {
@@ -287,7 +314,7 @@ export class Viewer {
     }
   }
 
-  /** @param {import('./reconstruction.js').LevelMessage} level */
+  /** @param {{ level: number, vertices: number }} level */
   #shown(level) {
     this.#set({ shownLevel: level.level, vertices: level.vertices });
     if (level.level < this.state.targetLevel || this.state.status !== 'refining') return;
@@ -296,15 +323,16 @@ export class Viewer {
     else this.#set({ status: 'complete' });
   }
 
-  #framed() {
-    const resolution = this.renderer?.colourResolution;
+  /** @param {{ level: number | null, colourResolution: 'low' | 'full' | null, at: number }} frame */
+  #framed(frame) {
+    const resolution = frame.colourResolution;
     if (resolution && !(resolution in this.state.colourAtMs)) {
-      this.state.colourAtMs[resolution] = performance.now();
+      this.state.colourAtMs[resolution] = frame.at;
       performance.mark(`vitrine:colour-${resolution}`);
     }
-    const level = this.renderer?.current?.source.level;
-    if (level === undefined || level in this.state.shownAtMs) return;
-    const now = performance.now();
+    const level = frame.level;
+    if (level === null || level in this.state.shownAtMs) return;
+    const now = frame.at;
     // Visible in DevTools and traces; the benchmark reads them.
     performance.mark(`vitrine:level-${level}`);
     this.state.shownAtMs[level] = now;
@@ -473,9 +501,12 @@ export class Viewer {
     return url.href;
   }
 
-  /** A worker from the same origin, or via a blob URL when the page is another site's. */
-  async #createWorker() {
-    const url = new URL(this.options.workerUrl);
+  /**
+   * A worker from the same origin, or via a blob URL when the page is another site's.
+   * @param {string} href
+   */
+  async #createWorker(href) {
+    const url = new URL(href);
     if (url.origin === location.origin) return new Worker(url);
     const response = await fetch(url);
     if (!response.ok) throw new Error(`the decode worker could not be loaded (${response.status})`);

@@ -86,13 +86,22 @@ test('every level arrives in order, equal to a direct decode, with unit normals'
   const got = levels(messages);
   assert.deepEqual(got.map((l) => l.level), [...Array(last + 1).keys()]);
   const direct = codec.decoder(parts.base);
+  // Vertices are sent once: each level carries those after the previous level's.
+  let positions = new Float32Array(0);
+  let colours = new Uint8Array(0);
+  let sent = 0;
   for (const level of got) {
     if (level.level > 0) direct.apply(parts.batches[level.level - 1]);
     const expected = direct.level();
-    assert.deepEqual(level.positions, expected.positions);
+    assert.equal(level.firstVertex, sent, `level ${level.level} starts after the vertices already sent`);
+    assert.equal(level.positions.length, 3 * (level.vertices - sent));
+    positions = Float32Array.of(...positions, ...level.positions);
+    colours = Uint8Array.of(...colours, ...(level.colours ?? []));
+    sent = level.vertices;
+    assert.deepEqual(positions, expected.positions);
     assert.deepEqual(level.indices, expected.indices);
-    assert.deepEqual(level.colours, expected.colours);
-    assert.equal(level.normals.length, level.positions.length);
+    assert.deepEqual(colours, expected.colours);
+    assert.equal(level.normals.length, 3 * level.vertices);
     for (let i = 0; i < level.normals.length; i += 3) {
       const length = Math.hypot(level.normals[i], level.normals[i + 1], level.normals[i + 2]) / 32767;
       assert.ok(Math.abs(length - 1) < 1e-3, `normal ${i / 3} of level ${level.level} has length ${length}`);
@@ -156,6 +165,15 @@ test('a batch refused by the server (cap fell) is reported and fetched again on 
 test('show: last posts only the level asked for', async () => {
   const { messages } = await reconstruct({ show: 'last', upTo: 5 }, service(), has('done'));
   assert.deepEqual(levels(messages).map((l) => l.level), [5]);
+  // Whole: no level was sent before it.
+  const [level] = levels(messages);
+  assert.equal(level.firstVertex, 0);
+  assert.equal(level.positions.length, 3 * level.vertices);
+});
+
+test('capacity: the requested vertex count reaches every level, for buffers sized once', async () => {
+  const { messages } = await reconstruct({ capacity: 123_456 }, service(), has('done'));
+  for (const level of levels(messages)) assert.equal(level.capacity, Math.max(123_456, level.vertices));
 });
 
 test('showFrom: a retry does not step back through levels already shown', async () => {

@@ -1,0 +1,349 @@
+// @ts-check
+/**
+ * Where the viewer draws: in a render worker on an OffscreenCanvas when the
+ * browser can (the main thread then only handles input and the interface),
+ * else on the page's canvas on the main thread (the fallback: browsers whose
+ * workers have no WebGL2, or `offscreen: false`).
+ *
+ * Both give the viewer one interface ({@link RenderHost}); on the worker side
+ * it is a proxy that forwards the camera, size and colour textures, and
+ * mirrors what the worker reports (levels swapped in, frames drawn, lost
+ * context, pending uploads).
+ */
+
+import { Renderer } from './renderer.js';
+
+/** @typedef {import('./reconstruction.js').LevelMessage} LevelMessage */
+/** @typedef {import('./renderer.js').AtlasResolution} AtlasResolution */
+/** @typedef {{ width: number, height: number, rgba: Uint8Array }} Capture */
+
+/**
+ * @typedef {object} RenderHooks
+ * @property {(level: { level: number, vertices: number }) => void} onSwap a level is complete on the GPU
+ * @property {(frame: { level: number | null, colourResolution: AtlasResolution | null, at: number }) => void} onFrame
+ *   a frame was drawn: the level and colour texture in it, at (performance.now() of this page)
+ */
+
+/**
+ * @typedef {object} RenderHost
+ * @property {'worker' | 'main'} thread where WebGL runs
+ * @property {import('./camera.js').OrbitCamera | null} camera
+ * @property {boolean} lost the WebGL context is lost
+ * @property {boolean} settled the newest level is complete on the GPU
+ * @property {boolean} edges the level on screen has its wire edges on the GPU
+ * @property {AtlasResolution | null} colourResolution
+ * @property {number} maxTextureSize
+ * @property {(level: LevelMessage) => void} show main thread only: the worker's levels go straight to the render worker
+ * @property {(level: number, edges: Uint32Array) => void} addEdges
+ * @property {(on: boolean) => void} setWireframe
+ * @property {() => void} requestFrame
+ * @property {(mapping: import('./renderer.js').ColourMapping | null) => void} setColourMapping
+ * @property {(source: ImageBitmap, resolution: AtlasResolution) => void} setColourAtlas
+ * @property {() => Promise<Capture>} capture draws and reads the pixels (rows bottom-up)
+ * @property {() => MessagePort | null} connect a port for a new decode worker to post levels to (null: post them to the page)
+ * @property {() => void} loseContext tests
+ * @property {() => void} restoreContext tests
+ */
+
+/**
+ * Whether this page can hand a canvas to a worker at all.
+ * @param {HTMLCanvasElement} canvas
+ */
+export function canTransfer(canvas) {
+  return typeof OffscreenCanvas === 'function' && typeof canvas.transferControlToOffscreen === 'function';
+}
+
+/**
+ * Starts drawing on `canvas`: in a render worker when `offscreen` and the
+ * worker reports WebGL2, else on the main thread.
+ * @param {HTMLCanvasElement} canvas
+ * @param {RenderHooks} hooks
+ * @param {{ offscreen: boolean, createWorker: () => Promise<Worker> }} options
+ * @returns {Promise<RenderHost>}
+ */
+export async function openRenderer(canvas, hooks, options) {
+  if (options.offscreen && canTransfer(canvas)) {
+    const worker = await options.createWorker().catch(() => null);
+    if (worker) {
+      const ready = await new Promise((resolve) => {
+        worker.onmessage = (event) => resolve(event.data?.type === 'ready' && event.data.webgl2 === true);
+        worker.onerror = () => resolve(false);
+      });
+      if (ready) return WorkerRenderer.start(canvas, worker, hooks);
+      worker.terminate();
+    }
+  }
+  return new MainRenderer(canvas, hooks);
+}
+
+/** The fallback: the renderer on the page's own canvas. */
+class MainRenderer {
+  thread = /** @type {const} */ ('main');
+
+  /**
+   * @param {HTMLCanvasElement} canvas
+   * @param {RenderHooks} hooks
+   */
+  constructor(canvas, hooks) {
+    this.renderer = new Renderer(canvas, null, {
+      onSwap: (level) => hooks.onSwap(level),
+      onFrame: () =>
+        hooks.onFrame({
+          level: this.renderer.current?.source.level ?? null,
+          colourResolution: this.renderer.colourResolution,
+          at: performance.now(),
+        }),
+    });
+  }
+
+  get camera() {
+    return this.renderer.camera;
+  }
+
+  set camera(camera) {
+    this.renderer.camera = camera;
+  }
+
+  get lost() {
+    return this.renderer.lost;
+  }
+
+  get settled() {
+    return this.renderer.settled;
+  }
+
+  get edges() {
+    const current = this.renderer.current;
+    return Boolean(current?.edgeBuffer && current.uploads.length === 0);
+  }
+
+  get colourResolution() {
+    return this.renderer.colourResolution;
+  }
+
+  get maxTextureSize() {
+    return this.renderer.maxTextureSize;
+  }
+
+  /** @param {LevelMessage} level */
+  show(level) {
+    this.renderer.show(level);
+  }
+
+  /** @param {number} level @param {Uint32Array} edges */
+  addEdges(level, edges) {
+    this.renderer.addEdges(level, edges);
+  }
+
+  /** @param {boolean} on */
+  setWireframe(on) {
+    this.renderer.setWireframe(on);
+  }
+
+  requestFrame() {
+    this.renderer.requestFrame();
+  }
+
+  /** @param {import('./renderer.js').ColourMapping | null} mapping */
+  setColourMapping(mapping) {
+    this.renderer.setColourMapping(mapping);
+  }
+
+  /** @param {ImageBitmap} source @param {AtlasResolution} resolution */
+  setColourAtlas(source, resolution) {
+    this.renderer.setColourAtlas(source, resolution);
+  }
+
+  async capture() {
+    return this.renderer.capture();
+  }
+
+  connect() {
+    return null;
+  }
+
+  loseContext() {
+    this.renderer.loseContext();
+  }
+
+  restoreContext() {
+    this.renderer.restoreContext();
+  }
+}
+
+/**
+ * The page's side of the render worker. The canvas element stays in the
+ * page for input and layout; its drawing buffer belongs to the worker, and
+ * the canvas's width and height are forwarded there (after the transfer the
+ * element's own size may no longer be set).
+ */
+class WorkerRenderer {
+  thread = /** @type {const} */ ('worker');
+  /** @type {import('./camera.js').OrbitCamera | null} */
+  camera = null;
+  lost = false;
+  settled = false;
+  edges = false;
+  frames = 0;
+  /** @type {AtlasResolution | null} */
+  colourResolution = null;
+  maxTextureSize = 4096;
+  #captures = new Map();
+  #nextCapture = 1;
+
+  /**
+   * @param {HTMLCanvasElement} canvas
+   * @param {Worker} worker
+   * @param {RenderHooks} hooks
+   */
+  constructor(canvas, worker, hooks) {
+    this.canvas = canvas;
+    this.worker = worker;
+    this.hooks = hooks;
+  }
+
+  /**
+   * Hands the canvas over; resolves once the worker has a context, rejects
+   * with its reason (no WebGL2) otherwise.
+   * @param {HTMLCanvasElement} canvas
+   * @param {Worker} worker
+   * @param {RenderHooks} hooks
+   * @returns {Promise<RenderHost>}
+   */
+  static start(canvas, worker, hooks) {
+    const host = new WorkerRenderer(canvas, worker, hooks);
+    const { width, height } = canvas;
+    const offscreen = canvas.transferControlToOffscreen();
+    host.#forwardSize(width, height);
+    return new Promise((resolve, reject) => {
+      worker.onmessage = (event) => {
+        const message = /** @type {import('./render-worker.js').RenderReport} */ (event.data);
+        if (message.type === 'started') {
+          host.maxTextureSize = message.maxTextureSize;
+          resolve(host);
+        } else if (message.type === 'failed') {
+          worker.terminate();
+          reject(new Error(message.message));
+        } else {
+          host.#report(message);
+        }
+      };
+      worker.onerror = (event) => reject(new Error(`the render worker failed: ${event.message}`));
+      worker.postMessage({ type: 'canvas', canvas: offscreen, width, height }, [offscreen]);
+    });
+  }
+
+  /**
+   * The canvas's width and height setters throw once its control is
+   * transferred; ui.js keeps setting them to follow the element's size in
+   * device pixels. Own properties on this element take those values and send
+   * them to the worker, where the OffscreenCanvas is resized.
+   * @param {number} width
+   * @param {number} height
+   */
+  #forwardSize(width, height) {
+    const size = { width, height };
+    for (const key of /** @type {const} */ (['width', 'height'])) {
+      Object.defineProperty(this.canvas, key, {
+        configurable: true,
+        get: () => size[key],
+        set: (value) => {
+          const v = Math.max(1, Math.round(Number(value)) || 1);
+          if (v === size[key]) return;
+          size[key] = v;
+          // Both setters run in one task (ui.js): send the pair once, after it.
+          this.#sizePosted ??= Promise.resolve().then(() => {
+            this.#sizePosted = null;
+            this.worker.postMessage({ type: 'size', ...size });
+          });
+        },
+      });
+    }
+  }
+
+  /** @type {Promise<void> | null} */
+  #sizePosted = null;
+
+  /** @param {import('./render-worker.js').RenderReport} message */
+  #report(message) {
+    switch (message.type) {
+      case 'swap':
+        this.hooks.onSwap(message);
+        break;
+      case 'frame':
+        this.colourResolution = message.colourResolution;
+        this.hooks.onFrame({
+          level: message.level,
+          colourResolution: message.colourResolution,
+          at: message.at - performance.timeOrigin,
+        });
+        break;
+      case 'status':
+        this.lost = message.lost;
+        this.settled = message.settled;
+        this.edges = message.edges;
+        this.frames = message.frames;
+        break;
+      case 'captured': {
+        const done = this.#captures.get(message.id);
+        this.#captures.delete(message.id);
+        done?.({ width: message.width, height: message.height, rgba: message.rgba });
+        break;
+      }
+    }
+  }
+
+  /** Levels go from the decode worker to the render worker directly. */
+  show() {}
+
+  /** Edges too. */
+  addEdges() {}
+
+  /** @param {boolean} on */
+  setWireframe(on) {
+    this.worker.postMessage({ type: 'wireframe', on });
+  }
+
+  /** The camera may have moved: the worker draws with the page's camera state. */
+  requestFrame() {
+    this.worker.postMessage({ type: 'camera', state: this.camera ? this.camera.state : null });
+  }
+
+  /** @param {import('./renderer.js').ColourMapping | null} mapping */
+  setColourMapping(mapping) {
+    this.colourResolution = null;
+    this.worker.postMessage({ type: 'colourMapping', mapping });
+  }
+
+  /**
+   * The bitmap moves to the worker (it is not usable here afterwards).
+   * @param {ImageBitmap} source
+   * @param {AtlasResolution} resolution
+   */
+  setColourAtlas(source, resolution) {
+    this.worker.postMessage({ type: 'colourAtlas', source, resolution }, [source]);
+  }
+
+  /** @returns {Promise<Capture>} */
+  capture() {
+    const id = this.#nextCapture++;
+    return new Promise((resolve) => {
+      this.#captures.set(id, resolve);
+      this.worker.postMessage({ type: 'capture', id });
+    });
+  }
+
+  connect() {
+    const channel = new MessageChannel();
+    this.worker.postMessage({ type: 'source', port: channel.port1 }, [channel.port1]);
+    return channel.port2;
+  }
+
+  loseContext() {
+    this.worker.postMessage({ type: 'loseContext' });
+  }
+
+  restoreContext() {
+    this.worker.postMessage({ type: 'restoreContext' });
+  }
+}

@@ -1,0 +1,204 @@
+// @ts-check
+/**
+ * The render worker: draws the model on an OffscreenCanvas the page handed
+ * over (HTMLCanvasElement.transferControlToOffscreen), so WebGL calls,
+ * buffer uploads, and — with a software compositor — the read-back of every
+ * frame happen on this thread, not on the page's main thread, which only
+ * handles input and the interface.
+ *
+ * Levels come straight from the decode worker through a MessagePort
+ * (transferred buffers; the page never sees them). The page sends the
+ * camera, the canvas size, the wireframe switch and the colour textures;
+ * this worker answers with what was drawn (render-host.js mirrors it).
+ *
+ * On start it tries a WebGL2 context on a small OffscreenCanvas of its own
+ * and says whether that worked, so the page keeps its canvas (and draws on
+ * the main thread) where workers have no WebGL2 (Safari before 17, some
+ * blocked GPUs).
+ */
+
+import { OrbitCamera } from './camera.js';
+import { Renderer } from './renderer.js';
+
+/**
+ * Commands from the page.
+ * @typedef {{ type: 'canvas', canvas: OffscreenCanvas, width: number, height: number }
+ *   | { type: 'source', port: MessagePort }
+ *   | { type: 'size', width: number, height: number }
+ *   | { type: 'camera', state: import('./camera.js').OrbitState | null }
+ *   | { type: 'wireframe', on: boolean }
+ *   | { type: 'colourMapping', mapping: import('./renderer.js').ColourMapping | null }
+ *   | { type: 'colourAtlas', source: ImageBitmap, resolution: import('./renderer.js').AtlasResolution }
+ *   | { type: 'capture', id: number }
+ *   | { type: 'loseContext' } | { type: 'restoreContext' }} RenderCommand
+ */
+
+/**
+ * Reports to the page.
+ * @typedef {{ type: 'ready', webgl2: boolean }
+ *   | { type: 'started', maxTextureSize: number }
+ *   | { type: 'failed', message: string }
+ *   | { type: 'swap', level: number, vertices: number }
+ *   | { type: 'frame', level: number | null, colourResolution: import('./renderer.js').AtlasResolution | null, at: number }
+ *   | { type: 'status', lost: boolean, settled: boolean, edges: boolean, frames: number }
+ *   | { type: 'captured', id: number, width: number, height: number, rgba: Uint8Array }} RenderReport
+ */
+
+/**
+ * The worker's global scope, typed here so this file is checked with the
+ * page's libraries (the renderer it shares with the page uses DOM types).
+ * @typedef {{ postMessage: (message: RenderReport, transfer?: Transferable[]) => void,
+ *   onmessage: ((event: MessageEvent<RenderCommand>) => void) | null }} RenderScope
+ */
+
+const scope = /** @type {RenderScope} */ (/** @type {unknown} */ (self));
+
+/** Bigger upload slices than on the main thread: only this worker's frames wait for them. */
+const WORKER_UPLOAD = { uploadBudgetMs: 12, uploadChunkBytes: 1 << 20 };
+
+/** @type {Renderer | null} */
+let renderer = null;
+/** @type {MessagePort | null} */
+let source = null;
+/** @type {import('./camera.js').OrbitState | null} */
+let cameraState = null;
+let lastStatus = '';
+
+/** @param {RenderReport} message @param {Transferable[]} [transfer] */
+function report(message, transfer = []) {
+  scope.postMessage(message, transfer);
+}
+
+/** Wall-clock milliseconds, so the page can place them on its own timeline. */
+function epochNow() {
+  return performance.timeOrigin + performance.now();
+}
+
+function sendStatus() {
+  if (!renderer) return;
+  const status = {
+    lost: renderer.lost,
+    settled: renderer.settled,
+    edges: Boolean(renderer.current?.edgeBuffer && renderer.current.uploads.length === 0),
+    frames: renderer.frames,
+  };
+  const key = JSON.stringify({ ...status, frames: 0 });
+  // Frames alone are not worth a message each; state changes are.
+  if (key === lastStatus) return;
+  lastStatus = key;
+  report({ type: 'status', ...status });
+}
+
+/** @param {import('./reconstruction.js').WorkerMessage} message */
+function fromDecoder(message) {
+  if (!renderer) return;
+  if (message.type === 'level') {
+    // The same camera the page makes from the same bounds; the page's moves follow as 'camera'.
+    if (!renderer.camera) {
+      renderer.camera = new OrbitCamera(message.baseBounds);
+      if (cameraState) renderer.camera.state = structuredClone(cameraState);
+    }
+    renderer.show(message);
+  } else if (message.type === 'edges') {
+    renderer.addEdges(message.level, message.edges);
+  }
+  sendStatus();
+}
+
+/** @param {OffscreenCanvas} canvas @param {number} width @param {number} height */
+function start(canvas, width, height) {
+  canvas.width = width;
+  canvas.height = height;
+  try {
+    renderer = new Renderer(
+      canvas,
+      null,
+      {
+        onSwap: (level) => report({ type: 'swap', level: level.level, vertices: level.vertices }),
+        onFrame: () =>
+          report({
+            type: 'frame',
+            level: renderer?.current?.source.level ?? null,
+            colourResolution: renderer?.colourResolution ?? null,
+            at: epochNow(),
+          }),
+        onTick: sendStatus,
+      },
+      WORKER_UPLOAD,
+    );
+  } catch (error) {
+    report({ type: 'failed', message: error instanceof Error ? error.message : String(error) });
+    return;
+  }
+  canvas.addEventListener('webglcontextlost', () => queueMicrotask(sendStatus));
+  canvas.addEventListener('webglcontextrestored', () => queueMicrotask(sendStatus));
+  report({ type: 'started', maxTextureSize: renderer.maxTextureSize });
+  sendStatus();
+}
+
+scope.onmessage = (event) => {
+  const command = event.data;
+  switch (command.type) {
+    case 'canvas':
+      start(command.canvas, command.width, command.height);
+      break;
+    case 'source':
+      // A new decode worker (a retry): the old one's port is closed, so nothing late arrives from it.
+      source?.close();
+      source = command.port;
+      source.onmessage = (e) => fromDecoder(e.data);
+      break;
+    case 'size':
+      if (!renderer) break;
+      if (renderer.canvas.width !== command.width || renderer.canvas.height !== command.height) {
+        renderer.canvas.width = command.width;
+        renderer.canvas.height = command.height;
+      }
+      renderer.requestFrame();
+      break;
+    case 'camera':
+      cameraState = command.state;
+      if (renderer?.camera && cameraState) renderer.camera.state = structuredClone(cameraState);
+      renderer?.requestFrame();
+      break;
+    case 'wireframe':
+      renderer?.setWireframe(command.on);
+      break;
+    case 'colourMapping':
+      renderer?.setColourMapping(command.mapping);
+      break;
+    case 'colourAtlas':
+      renderer?.setColourAtlas(command.source, command.resolution);
+      break;
+    case 'capture': {
+      if (!renderer) break;
+      const { width, height, rgba } = renderer.capture();
+      report({ type: 'captured', id: command.id, width, height, rgba }, [rgba.buffer]);
+      break;
+    }
+    case 'loseContext':
+      renderer?.loseContext();
+      break;
+    case 'restoreContext':
+      renderer?.restoreContext();
+      break;
+  }
+};
+
+/** Whether this worker can draw WebGL2 at all, before the page gives up its canvas. */
+function probe() {
+  try {
+    if (typeof OffscreenCanvas !== 'function') return false;
+    const gl = /** @type {WebGL2RenderingContext | null} */ (new OffscreenCanvas(1, 1).getContext('webgl2'));
+    if (!gl) return false;
+    // Free it now rather than at garbage collection: the real context comes next.
+    gl.getExtension('WEBGL_lose_context')?.loseContext();
+    return true;
+  } catch {
+    return false;
+  }
+}
+
+// Names this thread in DevTools traces (the benchmark finds its tasks by it).
+performance.mark('vitrine:render-worker');
+report({ type: 'ready', webgl2: probe() });
