@@ -38,6 +38,9 @@ pub struct Summary {
     pub p50_ms: f64,
     pub p95_ms: f64,
     pub p99_ms: f64,
+    /// p99 of the time to the response head (the service's own delay).
+    #[serde(default)]
+    pub head_p99_ms: f64,
     pub max_ms: f64,
     /// Time to the visitor's last level (completed visitors).
     pub recon_median_s: f64,
@@ -99,6 +102,14 @@ pub fn summarize(outcome: &CrowdOutcome, baselines: &Baselines) -> Summary {
             .map(|r| r.dur_us as f64 / 1e3)
             .collect(),
     );
+    let heads = sorted(
+        outcome
+            .requests
+            .iter()
+            .filter(|r| r.status != 0)
+            .map(|r| r.head_us as f64 / 1e3)
+            .collect(),
+    );
     let done: Vec<&VisitorResult> = outcome.visitors.iter().filter(|v| v.complete()).collect();
     let recon = sorted(done.iter().filter_map(|v| v.total_ms()).collect());
     let ratios = sorted(
@@ -139,6 +150,7 @@ pub fn summarize(outcome: &CrowdOutcome, baselines: &Baselines) -> Summary {
         p50_ms: percentile(&lat, 50.0),
         p95_ms: percentile(&lat, 95.0),
         p99_ms: percentile(&lat, 99.0),
+        head_p99_ms: percentile(&heads, 99.0),
         max_ms: lat.last().copied().unwrap_or(f64::NAN),
         recon_median_s: percentile(&recon, 50.0) / 1e3,
         recon_p95_s: percentile(&recon, 95.0) / 1e3,
@@ -191,14 +203,14 @@ fn map(m: &BTreeMap<impl std::fmt::Display, usize>) -> String {
 
 pub fn markdown(rows: &[Summary]) -> String {
     let mut s = String::new();
-    s.push_str("| caps | visitors | arrivals | requests | p50 ms | p95 ms | p99 ms | reconstruction median / p95 s | × lone visitor, median / p95 | public desktop level (median) | load-capped visitors (at level: n) | failed visitors | non-2xx answers | bytes served | server CPU s (% of a core) | server peak RSS MiB | harness CPU s | max pressure | every run: p99, p95 × lone, load-capped |\n");
+    s.push_str("| caps | visitors | arrivals | requests | p50 ms | p95 ms | p99 ms | p99 to response head ms | reconstruction median / p95 s | × lone visitor, median / p95 | public desktop level (median) | load-capped visitors (at level: n) | failed visitors | non-2xx answers | bytes served | server CPU s (% of a core) | server peak RSS MiB | harness CPU s | max pressure | every run: p99, p95 × lone, load-capped |\n");
     s.push_str(
-        "|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---|---:|---|---:|---:|---:|---:|---:|\n",
+        "|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---|---:|---|---:|---:|---:|---:|---:|\n",
     );
     for r in rows {
         let _ = writeln!(
             s,
-            "| {} | {} | {} | {} | {:.1} | {:.1} | {:.1} | {:.2} / {:.2} | {:.2} / {:.2} | {} | {} ({}) | {} | {} | {:.1} MB | {:.1} ({:.0} %) | {:.0} | {:.1} | {} | {} |",
+            "| {} | {} | {} | {} | {:.1} | {:.1} | {:.1} | {:.1} | {:.2} / {:.2} | {:.2} / {:.2} | {} | {} ({}) | {} | {} | {:.1} MB | {:.1} ({:.0} %) | {:.0} | {:.1} | {} | {} |",
             r.caps,
             r.visitors,
             r.pattern,
@@ -206,6 +218,7 @@ pub fn markdown(rows: &[Summary]) -> String {
             r.p50_ms,
             r.p95_ms,
             r.p99_ms,
+            r.head_p99_ms,
             r.recon_median_s,
             r.recon_p95_s,
             r.ratio_median,

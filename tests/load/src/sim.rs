@@ -199,6 +199,10 @@ pub struct Req {
     pub start_us: u64,
     /// To the last byte of the body.
     pub dur_us: u64,
+    /// To the response head: how long the service took to answer, apart
+    /// from moving the body through the (shared) CPU and loopback.
+    #[serde(default)]
+    pub head_us: u64,
     /// 0: no answer (connection refused, reset, timed out).
     pub status: u16,
     pub retry_after: bool,
@@ -291,6 +295,7 @@ impl Visit {
             kind,
             start_us: start.duration_since(self.epoch).as_micros() as u64,
             dur_us: 0,
+            head_us: 0,
             status: 0,
             retry_after: false,
             bytes: 0,
@@ -301,6 +306,7 @@ impl Visit {
         match client.get(&url).send().await {
             Err(e) => error = Some(format!("{kind:?}: {e}")),
             Ok(mut response) => {
+                req.head_us = start.elapsed().as_micros() as u64;
                 req.status = response.status().as_u16();
                 req.retry_after = response.headers().contains_key(RETRY_AFTER);
                 let keep = keep || !response.status().is_success();
