@@ -2,9 +2,11 @@
 /**
  * The viewer's chrome inside a shadow root (so a museum site's CSS cannot
  * reach it): canvas sized to device pixels, progress line, cap notice, error
- * overlay with retry, title panel, and the reset / wireframe / fullscreen
- * buttons.
+ * overlay with retry, title panel (with the quality chart when the model's
+ * curve was measured), and the reset / wireframe / fullscreen buttons.
  */
+
+import { describeLevel, renderQualityChart } from './quality-chart.js';
 
 /** Device pixels per CSS pixel, capped: beyond 2 a tablet pays 2.25× the fill for little gain. */
 const MAX_PIXEL_RATIO = 2;
@@ -40,7 +42,13 @@ button[aria-pressed="true"] { background: #5e81ac; border-color: #81a1c1; }
 .error div { background: #3b2226; border: 1px solid #bf616a; border-radius: 8px; padding: 16px 20px;
   max-width: min(32rem, 85%); }
 .error p { margin: 0 0 12px; }
+.quality { margin: 6px 0 0; }
+.quality summary { cursor: pointer; font-size: 12px; color: #cfd5de; }
+.quality svg { display: block; width: 100%; max-width: 260px; height: auto; margin-top: 4px; }
+.quality p { font-size: 12px; }
+@media (max-width: 480px), (max-height: 360px) { .quality { display: none; } }
 :host([chrome="minimal"]) .panel p { display: none; }
+:host([chrome="minimal"]) .quality { display: none; }
 :host([chrome="minimal"]) button.optional { display: none; }
 `;
 
@@ -49,6 +57,11 @@ export class ViewerUi {
   onWireframe = () => {};
   onRetry = () => {};
   onResize = () => {};
+  /** The quality curve the chart shows. @type {ReadonlyArray<import('./quality-chart.js').QualityPoint> | null} */
+  #curve = null;
+  /** Level the chart's marker was drawn at (`null`: redraw). @type {number | null} */
+  #chartLevel = null;
+  #shownLevel = -1;
 
   /**
    * @param {HTMLElement} host
@@ -83,6 +96,11 @@ export class ViewerUi {
     this.bar = $('.bar');
     this.error = $('.error');
     this.wireButton = $('[data-action="wireframe"]');
+    this.quality = document.createElement('details');
+    this.quality.className = 'quality';
+    this.quality.open = true;
+    this.quality.hidden = true;
+    this.quality.innerHTML = '<summary>Quality per level</summary><div class="chart"></div><p></p>';
     $('[data-action="reset"]').onclick = () => this.onReset();
     this.wireButton.onclick = () => this.onWireframe();
     $('[data-action="fullscreen"]').onclick = () => this.toggleFullscreen();
@@ -133,11 +151,36 @@ export class ViewerUi {
       p.textContent = description;
       this.panel.append(p);
     }
+    this.panel.append(this.quality);
+  }
+
+  /**
+   * The model's quality curve (manifest `quality`), or `null` to hide the chart.
+   * @param {ReadonlyArray<import('./quality-chart.js').QualityPoint> | null} curve
+   */
+  setQuality(curve) {
+    this.#curve = curve && curve.length > 0 ? curve : null;
+    this.#chartLevel = null;
+    this.#drawQuality(this.#shownLevel);
+  }
+
+  /** @param {number} level on screen; the chart is redrawn only when it changes */
+  #drawQuality(level) {
+    this.#shownLevel = level;
+    if (this.#chartLevel === level) return;
+    this.#chartLevel = level;
+    const svg = this.#curve ? renderQualityChart(this.#curve, level) : '';
+    this.quality.hidden = svg === '';
+    /** @type {HTMLElement} */ (this.quality.querySelector('.chart')).innerHTML = svg;
+    /** @type {HTMLElement} */ (this.quality.querySelector('p')).textContent = this.#curve
+      ? describeLevel(this.#curve, level)
+      : '';
   }
 
   /** @param {import('./viewer.js').ViewerState} state */
   setProgress(state) {
     this.#setColour(state);
+    this.#drawQuality(state.shownLevel);
     if (state.shownLevel < 0) {
       this.progress.textContent = `Loading… ${formatBytes(state.received)} received`;
       return;

@@ -32,6 +32,7 @@ import { openRenderer } from './render-host.js';
  * @property {boolean} has_colour
  * @property {number} last_level
  * @property {Array<{ level: number, vertices: number, faces: number, bytes: number, url: string, allowed: boolean }>} levels
+ * @property {import('./quality-chart.js').QualityPoint[]} [quality] per-level quality, when measured at ingest
  * @property {ManifestColour} [colour]
  * @property {{ device: string, audience: string }} visitor
  * @property {{ level: number, reason: string | null, retry_after_s: number | null }} cap
@@ -220,6 +221,7 @@ export class Viewer {
   #begin(manifest, module, worker) {
     this.manifest = manifest;
     this.ui.setDetails(manifest.title, manifest.description);
+    this.ui.setQuality(manifest.quality ?? null);
     this.#worker = worker;
     worker.onmessage = (event) => this.#message(event.data);
     worker.onerror = (event) => this.#fail(`the decoder failed: ${event.message}`);

@@ -22,6 +22,7 @@ export const webDist = join(root, 'web', 'dist');
  * @property {boolean} [colour] paint a procedural pattern on the vertices
  * @property {'vertex' | 'ccc' | 'none'} [colourMode] how `vitrine ingest` stores the colour (default vertex)
  * @property {string} [policy] exhibition, open or researchers
+ * @property {boolean} [quality] measure every level at ingest (`vitrine ingest --quality`)
  */
 
 /**
@@ -41,6 +42,7 @@ export async function startService({ models, serveArgs = [] }) {
     const ingest = ['ingest', mesh, '--db', db, '--slug', m.slug, '--title', m.title];
     ingest.push('--description', m.description ?? '', '--policy', m.policy ?? 'open');
     if (m.colourMode) ingest.push('--colour', m.colourMode);
+    if (m.quality) ingest.push('--quality');
     execFileSync(vitrine, ingest, { stdio: 'pipe', env });
   }
   // Chromium on SwiftShader keeps both cores of a small machine busy, which

@@ -1,0 +1,237 @@
+// @ts-check
+/**
+ * The quality curve of a model as a small SVG chart: the manifest's
+ * `quality` (measured at ingest with `vitrine ingest --quality`,
+ * server/src/service/api.rs), one point per level. x is the level's vertex
+ * count on a log scale; y is the error in 0–255 units, also on a log scale
+ * (the two errors can differ by a hundredfold, and each falls by orders of
+ * magnitude as a scan refines): the Lindstrom–Turk image RMSE over 24 views
+ * and, when the model has colour, Roy's colour RMSE. A marker stands at the
+ * level on screen.
+ *
+ * Pure functions of the data (no DOM), so Node tests them and the viewer's
+ * panel inserts the string into its shadow root. Every number is formatted
+ * here; no text from the manifest reaches the markup.
+ */
+
+/**
+ * One level's quality against the original.
+ * @typedef {object} QualityPoint
+ * @property {number} level 0 is the base mesh
+ * @property {number} vertices
+ * @property {number} hausdorff symmetric Hausdorff distance over the bounding-box diagonal
+ * @property {number | null} roy_rmse Roy et al. colour RMSE (0–255), null without colour
+ * @property {number} image_rmse Lindstrom–Turk luma RMSE (0–255) over 24 views
+ */
+
+/**
+ * @typedef {object} ChartOptions
+ * @property {number} [width] of the viewBox (default 260)
+ * @property {number} [height] of the viewBox (default 130)
+ */
+
+/**
+ * @typedef {'image_rmse' | 'roy_rmse'} SeriesKey
+ * @typedef {{ level: number, x: number, y: number }} PlacedPoint
+ * @typedef {{ key: SeriesKey, label: string, colour: string, points: PlacedPoint[] }} PlacedSeries
+ */
+
+/**
+ * Where everything goes, in viewBox units (y grows downwards).
+ * @typedef {object} ChartLayout
+ * @property {number} width
+ * @property {number} height
+ * @property {{ left: number, right: number, top: number, bottom: number }} plot
+ * @property {PlacedSeries[]} series lines to draw, image RMSE first
+ * @property {{ level: number, x: number, points: Array<{ key: SeriesKey, y: number }> } | null} marker
+ *   the level on screen, when it is on the curve
+ * @property {Array<{ x: number, label: string }>} xTicks
+ * @property {Array<{ y: number, label: string }>} yTicks
+ */
+
+/** @type {ReadonlyArray<{ key: SeriesKey, label: string, colour: string }>} */
+export const SERIES = [
+  { key: 'image_rmse', label: 'image RMSE', colour: '#88c0d0' },
+  { key: 'roy_rmse', label: 'colour RMSE (Roy)', colour: '#ebcb8b' },
+];
+
+const MARGIN = { left: 26, right: 16, top: 16, bottom: 16 };
+/** Closest two vertex-count labels may be, in viewBox units. */
+const MIN_TICK_GAP = 32;
+
+/** @param {unknown} v @returns {v is number} */
+const finite = (v) => typeof v === 'number' && Number.isFinite(v);
+
+/**
+ * The usable points, by level: positive vertex counts and a finite image RMSE.
+ * @param {ReadonlyArray<QualityPoint> | null | undefined} quality
+ * @returns {QualityPoint[]}
+ */
+export function cleanPoints(quality) {
+  if (!Array.isArray(quality)) return [];
+  return quality
+    .filter((p) => p && finite(p.level) && finite(p.vertices) && p.vertices > 0 && finite(p.image_rmse))
+    .sort((a, b) => a.level - b.level);
+}
+
+/** The smallest error drawn: a level measured as exact sits on the chart's floor. */
+export const MIN_ERROR = 0.01;
+
+/** @param {number} n vertex count, for an axis label: 500, 2k, 10k, 1.5M */
+export function formatCount(n) {
+  if (n >= 1e6) return `${+(n / 1e6).toFixed(1)}M`;
+  if (n >= 1e3) return `${+(n / 1e3).toFixed(1)}k`;
+  return String(Math.round(n));
+}
+
+/**
+ * Places the curve. `null` when there is nothing to draw.
+ * @param {ReadonlyArray<QualityPoint> | null | undefined} quality
+ * @param {number} level the level on screen (-1: none yet)
+ * @param {ChartOptions} [options]
+ * @returns {ChartLayout | null}
+ */
+export function layoutQualityChart(quality, level, options = {}) {
+  const points = cleanPoints(quality);
+  if (points.length === 0) return null;
+  const width = options.width ?? 260;
+  const height = options.height ?? 130;
+  const plot = { left: MARGIN.left, right: width - MARGIN.right, top: MARGIN.top, bottom: height - MARGIN.bottom };
+  const logs = points.map((p) => Math.log10(p.vertices));
+  const [lo, hi] = [Math.min(...logs), Math.max(...logs)];
+  /** @param {number} vertices */
+  const x = (vertices) =>
+    hi > lo
+      ? plot.left + ((Math.log10(vertices) - lo) / (hi - lo)) * (plot.right - plot.left)
+      : (plot.left + plot.right) / 2;
+  // y: whole decades around the errors.
+  const errors = points
+    .flatMap((p) => [p.image_rmse, ...(finite(p.roy_rmse) ? [p.roy_rmse] : [])])
+    .map((v) => Math.log10(Math.max(MIN_ERROR, v)));
+  const yLo = Math.floor(Math.min(...errors));
+  const yHi = Math.max(yLo + 1, Math.ceil(Math.max(...errors)));
+  /** @param {number} v */
+  const y = (v) =>
+    plot.bottom - ((Math.log10(Math.max(MIN_ERROR, v)) - yLo) / (yHi - yLo)) * (plot.bottom - plot.top);
+  /** @type {PlacedSeries[]} */
+  const series = [];
+  for (const s of SERIES) {
+    const placed = points
+      .filter((p) => finite(p[s.key]))
+      .map((p) => ({ level: p.level, x: x(p.vertices), y: y(/** @type {number} */ (p[s.key])) }));
+    if (placed.length > 0) series.push({ ...s, points: placed });
+  }
+  const shown = points.find((p) => p.level === level);
+  const marker = shown
+    ? {
+        level: shown.level,
+        x: x(shown.vertices),
+        points: series.flatMap((s) => {
+          const p = s.points.find((q) => q.level === shown.level);
+          return p ? [{ key: s.key, y: p.y }] : [];
+        }),
+      }
+    : null;
+  // The ends of the curve, and the powers of ten between them that have room.
+  const first = points[0].vertices;
+  const last = points[points.length - 1].vertices;
+  /** @type {ChartLayout['xTicks']} */
+  const xTicks = (hi > lo ? [first, last] : [first]).map((v) => ({ x: x(v), label: formatCount(v) }));
+  for (let e = Math.ceil(lo); e <= hi; e++) {
+    const at = x(10 ** e);
+    if (xTicks.every((t) => Math.abs(t.x - at) >= MIN_TICK_GAP)) xTicks.push({ x: at, label: formatCount(10 ** e) });
+  }
+  xTicks.sort((a, b) => a.x - b.x);
+  /** @type {ChartLayout['yTicks']} */
+  const yTicks = [];
+  for (let e = yLo; e <= yHi; e++) yTicks.push({ y: y(10 ** e), label: `${+(10 ** e).toFixed(Math.max(0, -e))}` });
+  return { width, height, plot, series, marker, xTicks, yTicks };
+}
+
+/** @param {number} v */
+const f = (v) => `${+v.toFixed(1)}`;
+
+/**
+ * The chart as SVG markup; an empty string when there is no curve.
+ * @param {ReadonlyArray<QualityPoint> | null | undefined} quality
+ * @param {number} level the level on screen (-1: none yet)
+ * @param {ChartOptions} [options]
+ */
+export function renderQualityChart(quality, level, options = {}) {
+  const layout = layoutQualityChart(quality, level, options);
+  if (!layout) return '';
+  const { width, height, plot, series, marker, xTicks, yTicks } = layout;
+  const parts = [
+    `<svg xmlns="http://www.w3.org/2000/svg" class="quality-chart" viewBox="0 0 ${width} ${height}" ` +
+      `width="${width}" height="${height}" role="img" aria-label="${describeChart(quality)}" ` +
+      `font-family="system-ui, sans-serif" font-size="10">`,
+    `<g class="axes" stroke="#4c566a" stroke-width="1">` +
+      `<line x1="${plot.left}" y1="${plot.bottom}" x2="${plot.right}" y2="${plot.bottom}"/>` +
+      `<line x1="${plot.left}" y1="${plot.top}" x2="${plot.left}" y2="${plot.bottom}"/></g>`,
+  ];
+  for (const t of xTicks) {
+    parts.push(
+      `<text class="x-tick" x="${f(t.x)}" y="${height - 4}" text-anchor="middle" fill="#cfd5de">${t.label}</text>`,
+    );
+  }
+  for (const t of yTicks) {
+    parts.push(
+      `<text class="y-tick" x="${plot.left - 3}" y="${f(t.y + 3)}" text-anchor="end" fill="#cfd5de">${t.label}</text>`,
+    );
+  }
+  series.forEach((s, k) => {
+    const line = s.points.map((p) => `${f(p.x)},${f(p.y)}`).join(' ');
+    parts.push(
+      `<polyline class="series" data-series="${s.key}" points="${line}" fill="none" stroke="${s.colour}" ` +
+        `stroke-width="1.5" stroke-linejoin="round"/>`,
+    );
+    for (const p of s.points) {
+      parts.push(
+        `<circle data-series="${s.key}" data-level="${p.level}" cx="${f(p.x)}" cy="${f(p.y)}" r="1.8" ` +
+          `fill="${s.colour}"/>`,
+      );
+    }
+    const lx = plot.left + 4 + k * 100;
+    parts.push(
+      `<g class="legend"><line x1="${lx}" y1="7" x2="${lx + 10}" y2="7" stroke="${s.colour}" stroke-width="2"/>` +
+        `<text x="${lx + 13}" y="10" fill="#cfd5de">${s.label}</text></g>`,
+    );
+  });
+  if (marker) {
+    parts.push(
+      `<g class="marker" data-marker="" data-level="${marker.level}">` +
+        `<line x1="${f(marker.x)}" y1="${plot.top}" x2="${f(marker.x)}" y2="${plot.bottom}" stroke="#eceff4" ` +
+        `stroke-width="1" stroke-dasharray="2 2"/>` +
+        marker.points
+          .map((p) => `<circle cx="${f(marker.x)}" cy="${f(p.y)}" r="3.2" fill="none" stroke="#eceff4" stroke-width="1.5"/>`)
+          .join('') +
+        `</g>`,
+    );
+  }
+  parts.push('</svg>');
+  return parts.join('');
+}
+
+/**
+ * One line about a level: what the marker points at.
+ * @param {ReadonlyArray<QualityPoint> | null | undefined} quality
+ * @param {number} level
+ * @returns {string} empty when the level is not on the curve
+ */
+export function describeLevel(quality, level) {
+  const p = cleanPoints(quality).find((q) => q.level === level);
+  if (!p) return '';
+  const roy = finite(p.roy_rmse) ? ` · colour RMSE ${p.roy_rmse.toFixed(1)}` : '';
+  const hausdorff = finite(p.hausdorff) ? ` · Hausdorff ${(100 * p.hausdorff).toFixed(2)} % of the diagonal` : '';
+  return `Level ${p.level}: image RMSE ${p.image_rmse.toFixed(1)}${roy}${hausdorff}`;
+}
+
+/** @param {ReadonlyArray<QualityPoint> | null | undefined} quality */
+function describeChart(quality) {
+  const points = cleanPoints(quality);
+  const [first, last] = [points[0], points[points.length - 1]];
+  return (
+    `Error against the original per level (log scales): image RMSE from ${first.image_rmse.toFixed(1)} ` +
+    `at ${first.vertices} vertices to ${last.image_rmse.toFixed(1)} at ${last.vertices} vertices`
+  );
+}
