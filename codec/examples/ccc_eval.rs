@@ -76,6 +76,27 @@ fn main() {
         let guarded = encode_guarded(&geometry, &options, Some(&guard), |_| {}).unwrap();
         let enc = t.elapsed().as_secs_f64();
         let (gc, gl, gb) = connectivity_bits(&guarded.bytes, mesh.positions.len());
+        if let Some(colours) = mesh.colors.as_ref().filter(|_| textured.is_none()) {
+            let complex = ccc::CellComplex::from_images(&m.parameters, &m.cell_png, &m.colour_jpeg).unwrap();
+            let mut errors: Vec<f64> = mesh
+                .positions
+                .iter()
+                .zip(colours)
+                .map(|(&p, c)| {
+                    let at = complex.colour_at(q.dequantize(q.quantize(p)).into());
+                    (0..3).map(|k| (at[k] as f64 * 255.0 - c[k] as f64).abs()).sum::<f64>() / 3.0
+                })
+                .collect();
+            errors.sort_by(f64::total_cmp);
+            let n = errors.len();
+            println!(
+                "colour error at the vertices (mean abs per channel): mean {:.2}, median {:.2}, p90 {:.2}, p99 {:.2}",
+                errors.iter().sum::<f64>() / n as f64,
+                errors[n / 2],
+                errors[n * 9 / 10],
+                errors[n * 99 / 100]
+            );
+        }
         let r = &m.report;
         let p = &m.parameters;
         println!(

@@ -108,9 +108,9 @@ pub(crate) fn sample_bilinear(image: &image::RgbImage, uv: DVec2) -> [f64; 3] {
 /// objects, 6 for statues); here it follows the vertex count.
 fn default_cell_size(extent: DVec3, vertices: usize) -> f64 {
     let longest = extent.max_element().max(f64::MIN_POSITIVE);
-    // About the edge length of a base mesh with 1 % of the vertices: the
-    // guard then rarely fires (measured in BENCHMARKS.md).
-    let cubes = (0.16 * (vertices as f64).sqrt()).clamp(12.0, 200.0);
+    // A few base-mesh edges (1 % of the vertices) per cube: the guard then
+    // rarely fires, and tiles stay large next to their gutters (BENCHMARKS.md).
+    let cubes = (0.08 * (vertices as f64).sqrt()).clamp(12.0, 200.0);
     longest / cubes
 }
 
