@@ -13,7 +13,8 @@ vitrine=target/release/vitrine
 rm -f "$db" "$db-wal" "$db-shm"
 $vitrine ingest data/torus.ply --db "sqlite:$db" --slug painted-torus --policy open \
     --title "Painted torus" --description "A generated, painted torus with scan-like noise (300k vertices)."
-$vitrine ingest data/torus.ply --db "sqlite:$db" --slug painted-torus-ccc --policy open --colour ccc \
+# --quality: the model page plots its per-level quality curve (adds ~20 s here).
+$vitrine ingest data/torus.ply --db "sqlite:$db" --slug painted-torus-ccc --policy open --colour ccc --quality \
     --title "Painted torus (cell-complex texture)" \
     --description "The same torus with its colour in a cubic-cell-complex texture shared by every level."
 # A real textured scan, when the shared data folder is there (it is never committed).
