@@ -41,6 +41,9 @@ pub struct Summary {
     /// p99 of the time to the response head (the service's own delay).
     #[serde(default)]
     pub head_p99_ms: f64,
+    /// p99 to the last byte, by kind of request (manifest, base, batch...).
+    #[serde(default)]
+    pub p99_ms_by_kind: BTreeMap<String, f64>,
     pub max_ms: f64,
     /// Time to the visitor's last level (completed visitors).
     pub recon_median_s: f64,
@@ -151,6 +154,19 @@ pub fn summarize(outcome: &CrowdOutcome, baselines: &Baselines) -> Summary {
         p95_ms: percentile(&lat, 95.0),
         p99_ms: percentile(&lat, 99.0),
         head_p99_ms: percentile(&heads, 99.0),
+        p99_ms_by_kind: {
+            let mut by_kind: BTreeMap<String, Vec<f64>> = BTreeMap::new();
+            for r in &outcome.requests {
+                by_kind
+                    .entry(format!("{:?}", r.kind).to_lowercase())
+                    .or_default()
+                    .push(r.dur_us as f64 / 1e3);
+            }
+            by_kind
+                .into_iter()
+                .map(|(k, v)| (k, percentile(&sorted(v), 99.0)))
+                .collect()
+        },
         max_ms: lat.last().copied().unwrap_or(f64::NAN),
         recon_median_s: percentile(&recon, 50.0) / 1e3,
         recon_p95_s: percentile(&recon, 95.0) / 1e3,
