@@ -80,16 +80,24 @@ impl ColourSurface<'_> {
 /// Bilinear sample at texture coordinates with glTF's convention (v down),
 /// repeating outside `[0, 1]` as glTF's default sampler does.
 pub(crate) fn sample_bilinear(image: &image::RgbImage, uv: DVec2) -> [f64; 3] {
+    let x = uv.x.rem_euclid(1.0) * image.width() as f64;
+    let y = uv.y.rem_euclid(1.0) * image.height() as f64;
+    bilinear(image, x, y, i64::rem_euclid)
+}
+
+/// Bilinear sample (0–255) at texel-space coordinates, texel centres at
+/// `i + 0.5`; `edge` maps an index outside `0..n` back in (repeat or clamp).
+pub(crate) fn bilinear(
+    image: &image::RgbImage,
+    x: f64,
+    y: f64,
+    edge: fn(i64, i64) -> i64,
+) -> [f64; 3] {
     let (w, h) = (image.width() as i64, image.height() as i64);
-    let x = uv.x.rem_euclid(1.0) * w as f64 - 0.5;
-    let y = uv.y.rem_euclid(1.0) * h as f64 - 0.5;
+    let (x, y) = (x - 0.5, y - 0.5);
     let (x0, y0) = (x.floor(), y.floor());
     let (fx, fy) = (x - x0, y - y0);
-    let px = |xi: i64, yi: i64| {
-        image
-            .get_pixel(xi.rem_euclid(w) as u32, yi.rem_euclid(h) as u32)
-            .0
-    };
+    let px = |xi: i64, yi: i64| image.get_pixel(edge(xi, w) as u32, edge(yi, h) as u32).0;
     let (x0, y0) = (x0 as i64, y0 as i64);
     let (a, b, c, d) = (
         px(x0, y0),

@@ -4,6 +4,7 @@
 use glam::{DVec3, Vec3};
 use image::RgbImage;
 
+use super::build::bilinear;
 use super::grid::Grid;
 use super::images::CELL_TEXELS;
 use super::projection::exit_face;
@@ -139,35 +140,11 @@ impl CellComplex {
         let local = uv.map(|c| (g + c * t).clamp(g + inset, g + t - inset));
         let x = (col * side + local[0]) * self.scale;
         let y = (row * side + local[1]) * self.scale;
-        bilinear(&self.atlas, x, y)
+        let clamp = |i: i64, n: i64| i.clamp(0, n - 1);
+        bilinear(&self.atlas, x, y, clamp).map(|c| (c / 255.0) as f32)
     }
 
     pub fn parameters(&self) -> &CccParameters {
         &self.parameters
     }
-}
-
-/// Bilinear sample at texel-space coordinates (texel centres at `i + 0.5`), edges clamped.
-fn bilinear(image: &RgbImage, x: f64, y: f64) -> [f32; 3] {
-    let (w, h) = (image.width() as i64, image.height() as i64);
-    let (x, y) = (x - 0.5, y - 0.5);
-    let (x0, y0) = (x.floor(), y.floor());
-    let (fx, fy) = ((x - x0) as f32, (y - y0) as f32);
-    let px = |xi: i64, yi: i64| {
-        image
-            .get_pixel(xi.clamp(0, w - 1) as u32, yi.clamp(0, h - 1) as u32)
-            .0
-    };
-    let (x0, y0) = (x0 as i64, y0 as i64);
-    let (a, b, c, d) = (
-        px(x0, y0),
-        px(x0 + 1, y0),
-        px(x0, y0 + 1),
-        px(x0 + 1, y0 + 1),
-    );
-    std::array::from_fn(|k| {
-        let top = a[k] as f32 * (1.0 - fx) + b[k] as f32 * fx;
-        let bottom = c[k] as f32 * (1.0 - fx) + d[k] as f32 * fx;
-        (top * (1.0 - fy) + bottom * fy) / 255.0
-    })
 }
