@@ -22,6 +22,8 @@ import { Renderer } from './renderer.js';
  * @property {(level: { level: number, vertices: number }) => void} onSwap a level is complete on the GPU
  * @property {(frame: { level: number | null, colourResolution: AtlasResolution | null, at: number }) => void} onFrame
  *   a frame was drawn: the level and colour texture in it, at (performance.now() of this page)
+ * @property {(bounds: import('./geometry.js').Bounds) => import('./camera.js').OrbitCamera} camera
+ *   the viewer's camera, made from the base mesh's bounds by whoever needs it first
  */
 
 /**
@@ -33,14 +35,15 @@ import { Renderer } from './renderer.js';
  * @property {boolean} edges the level on screen has its wire edges on the GPU
  * @property {AtlasResolution | null} colourResolution
  * @property {number} maxTextureSize
- * @property {(level: LevelMessage) => void} show main thread only: the worker's levels go straight to the render worker
- * @property {(level: number, edges: Uint32Array) => void} addEdges
  * @property {(on: boolean) => void} setWireframe
  * @property {() => void} requestFrame
  * @property {(mapping: import('./renderer.js').ColourMapping | null) => void} setColourMapping
  * @property {(source: ImageBitmap, resolution: AtlasResolution) => void} setColourAtlas
  * @property {() => Promise<Capture>} capture draws and reads the pixels (rows bottom-up)
- * @property {() => MessagePort | null} connect a port for a new decode worker to post levels to (null: post them to the page)
+ * @property {() => Promise<number>} finish resolves when the GPU has drawn every frame asked
+ *   for so far, with performance.now() then (benchmarks: frames are drawn some time after they are issued)
+ * @property {(port: MessagePort) => void} attach the port a decode worker posts its levels
+ *   and edges to (a new one replaces the last: a retry's new worker)
  * @property {() => void} loseContext tests
  * @property {() => void} restoreContext tests
  */
@@ -69,6 +72,7 @@ export async function openRenderer(canvas, hooks, options) {
         worker.onmessage = (event) => resolve(event.data?.type === 'ready' && event.data.webgl2 === true);
         worker.onerror = () => resolve(false);
       });
+      performance.mark(`vitrine:render-worker-${ready ? 'ready' : 'without-webgl2'}`);
       if (ready) return WorkerRenderer.start(canvas, worker, hooks);
       worker.terminate();
     }
@@ -85,6 +89,7 @@ class MainRenderer {
    * @param {RenderHooks} hooks
    */
   constructor(canvas, hooks) {
+    this.hooks = hooks;
     this.renderer = new Renderer(canvas, null, {
       onSwap: (level) => hooks.onSwap(level),
       onFrame: () =>
@@ -125,14 +130,22 @@ class MainRenderer {
     return this.renderer.maxTextureSize;
   }
 
-  /** @param {LevelMessage} level */
-  show(level) {
-    this.renderer.show(level);
-  }
+  /** @type {MessagePort | null} */
+  #port = null;
 
-  /** @param {number} level @param {Uint32Array} edges */
-  addEdges(level, edges) {
-    this.renderer.addEdges(level, edges);
+  /** @param {MessagePort} port */
+  attach(port) {
+    this.#port?.close();
+    this.#port = port;
+    port.onmessage = (event) => {
+      const message = /** @type {import('./reconstruction.js').WorkerMessage} */ (event.data);
+      if (message.type === 'level') {
+        this.renderer.camera ??= this.hooks.camera(message.baseBounds);
+        this.renderer.show(message);
+      } else if (message.type === 'edges') {
+        this.renderer.addEdges(message.level, message.edges);
+      }
+    };
   }
 
   /** @param {boolean} on */
@@ -158,8 +171,9 @@ class MainRenderer {
     return this.renderer.capture();
   }
 
-  connect() {
-    return null;
+  async finish() {
+    this.renderer.finish();
+    return performance.now();
   }
 
   loseContext() {
@@ -188,6 +202,7 @@ class WorkerRenderer {
   /** @type {AtlasResolution | null} */
   colourResolution = null;
   maxTextureSize = 4096;
+  /** @type {Map<number, (value: any) => void>} */
   #captures = new Map();
   #nextCapture = 1;
 
@@ -219,6 +234,7 @@ class WorkerRenderer {
       worker.onmessage = (event) => {
         const message = /** @type {import('./render-worker.js').RenderReport} */ (event.data);
         if (message.type === 'started') {
+          performance.mark('vitrine:render-worker-started');
           host.maxTextureSize = message.maxTextureSize;
           resolve(host);
         } else if (message.type === 'failed') {
@@ -284,20 +300,16 @@ class WorkerRenderer {
         this.edges = message.edges;
         this.frames = message.frames;
         break;
-      case 'captured': {
+      case 'captured':
+      case 'finished': {
         const done = this.#captures.get(message.id);
         this.#captures.delete(message.id);
-        done?.({ width: message.width, height: message.height, rgba: message.rgba });
+        if (message.type === 'captured') done?.({ width: message.width, height: message.height, rgba: message.rgba });
+        else done?.(message.at - performance.timeOrigin);
         break;
       }
     }
   }
-
-  /** Levels go from the decode worker to the render worker directly. */
-  show() {}
-
-  /** Edges too. */
-  addEdges() {}
 
   /** @param {boolean} on */
   setWireframe(on) {
@@ -324,6 +336,15 @@ class WorkerRenderer {
     this.worker.postMessage({ type: 'colourAtlas', source, resolution }, [source]);
   }
 
+  /** @returns {Promise<number>} */
+  finish() {
+    const id = this.#nextCapture++;
+    return new Promise((resolve) => {
+      this.#captures.set(id, resolve);
+      this.worker.postMessage({ type: 'finish', id });
+    });
+  }
+
   /** @returns {Promise<Capture>} */
   capture() {
     const id = this.#nextCapture++;
@@ -333,10 +354,9 @@ class WorkerRenderer {
     });
   }
 
-  connect() {
-    const channel = new MessageChannel();
-    this.worker.postMessage({ type: 'source', port: channel.port1 }, [channel.port1]);
-    return channel.port2;
+  /** Levels go from the decode worker to the render worker directly. @param {MessagePort} port */
+  attach(port) {
+    this.worker.postMessage({ type: 'source', port }, [port]);
   }
 
   loseContext() {

@@ -29,7 +29,7 @@ import { Renderer } from './renderer.js';
  *   | { type: 'wireframe', on: boolean }
  *   | { type: 'colourMapping', mapping: import('./renderer.js').ColourMapping | null }
  *   | { type: 'colourAtlas', source: ImageBitmap, resolution: import('./renderer.js').AtlasResolution }
- *   | { type: 'capture', id: number }
+ *   | { type: 'capture', id: number } | { type: 'finish', id: number }
  *   | { type: 'loseContext' } | { type: 'restoreContext' }} RenderCommand
  */
 
@@ -41,7 +41,8 @@ import { Renderer } from './renderer.js';
  *   | { type: 'swap', level: number, vertices: number }
  *   | { type: 'frame', level: number | null, colourResolution: import('./renderer.js').AtlasResolution | null, at: number }
  *   | { type: 'status', lost: boolean, settled: boolean, edges: boolean, frames: number }
- *   | { type: 'captured', id: number, width: number, height: number, rgba: Uint8Array }} RenderReport
+ *   | { type: 'captured', id: number, width: number, height: number, rgba: Uint8Array }
+ *   | { type: 'finished', id: number, at: number }} RenderReport
  */
 
 /**
@@ -176,6 +177,10 @@ scope.onmessage = (event) => {
       report({ type: 'captured', id: command.id, width, height, rgba }, [rgba.buffer]);
       break;
     }
+    case 'finish':
+      renderer?.finish();
+      report({ type: 'finished', id: command.id, at: epochNow() });
+      break;
     case 'loseContext':
       renderer?.loseContext();
       break;

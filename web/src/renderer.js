@@ -205,6 +205,11 @@ export class Renderer {
     this.#loseContext?.loseContext();
   }
 
+  /** Waits until the GPU has drawn everything asked of it (benchmarks: when the last frame is really done). */
+  finish() {
+    if (!this.lost) this.gl.finish();
+  }
+
   /** Restores a context lost by loseContext(). */
   restoreContext() {
     this.#loseContext?.restoreContext();

@@ -175,18 +175,25 @@ export class Viewer {
     this.ui.showNotice(null);
     try {
       // Manifest, decoder and worker script load in parallel.
-      const loading = Promise.all([
+      // The renderer starts beside them and is not waited for: the decode
+      // worker posts levels into a MessagePort that the renderer takes
+      // when it is ready (they queue there until then).
+      const rendering = this.#openRenderer();
+      rendering.catch(() => {}); // awaited below
+      const [manifest, module, worker] = await Promise.all([
         this.#fetchManifest(),
         compileDecoder(this.options.wasmUrl),
         this.#createWorker(this.options.workerUrl),
-        this.#openRenderer(),
       ]);
-      const [manifest, module, worker] = await loading;
       if (attempt !== this.#attempt) {
         worker.terminate();
         return;
       }
-      this.#begin(manifest, module, worker);
+      const levels = this.#begin(manifest, module, worker);
+      const renderer = await rendering;
+      if (attempt !== this.#attempt) return;
+      if (this.camera) renderer.camera = this.camera;
+      renderer.attach(levels);
     } catch (error) {
       if (attempt === this.#attempt) this.#fail(error instanceof Error ? error.message : String(error));
     }
@@ -250,16 +257,23 @@ export class Viewer {
       showFrom: Math.min(this.state.shownLevel + 1, target),
       wireframe: this.#wireframe,
     };
-    // With a render worker, levels go to it directly; the page gets a notice without the buffers.
-    const port = /** @type {import('./render-host.js').RenderHost} */ (this.renderer).connect();
-    worker.postMessage({ type: 'load', module, request, port }, port ? [port] : []);
+    // Levels and edges go through a port to the renderer (a render worker
+    // directly, or this page in the fallback); the page gets each level as
+    // a notice without its buffers.
+    const channel = new MessageChannel();
+    worker.postMessage({ type: 'load', module, request, port: channel.port2 }, [channel.port2]);
+    return channel.port1;
   }
 
   /** The renderer, opened once per viewer (a retry keeps it); a failure is tried again on retry. */
   #openRenderer() {
     this.#rendering ??= openRenderer(
       this.ui.canvas,
-      { onSwap: (level) => this.#shown(level), onFrame: (frame) => this.#framed(frame) },
+      {
+        onSwap: (level) => this.#shown(level),
+        onFrame: (frame) => this.#framed(frame),
+        camera: (bounds) => (this.camera ??= new OrbitCamera(bounds)),
+      },
       { offscreen: this.options.offscreen, createWorker: () => this.#createWorker(this.options.renderWorkerUrl) },
     ).then(
       (renderer) => (this.renderer = renderer),
@@ -278,12 +292,12 @@ export class Viewer {
 
   /** @param {import('./reconstruction.js').WorkerMessage} message */
   #message(message) {
-    const renderer = /** @type {import('./render-host.js').RenderHost} */ (this.renderer);
     switch (message.type) {
       case 'level':
+        // A notice: the buffers went to the renderer.
         if (!this.camera) {
           this.camera = new OrbitCamera(message.baseBounds);
-          renderer.camera = this.camera;
+          if (this.renderer) this.renderer.camera = this.camera;
         }
         this.#set({
           decodedLevel: message.level,
@@ -291,10 +305,8 @@ export class Viewer {
           decodeMs: message.decodeMs,
           deriveMs: message.deriveMs,
         });
-        renderer.show(message);
         break;
       case 'edges':
-        renderer.addEdges(message.level, message.edges);
         break;
       case 'progress':
         this.#set({ received: message.received });
