@@ -134,6 +134,8 @@ export class Viewer {
   renderer = null;
   /** @type {Promise<import('./render-host.js').RenderHost> | null} */
   #rendering = null;
+  /** The port the newest decode worker posts its levels into. @type {MessagePort | null} */
+  #levels = null;
   /** @type {Worker | null} */
   #worker = null;
   /** @type {ReturnType<typeof setTimeout> | null} */
@@ -190,8 +192,11 @@ export class Viewer {
         return;
       }
       const levels = this.#begin(manifest, module, worker);
+      this.#levels = levels;
       const renderer = await rendering;
-      if (attempt !== this.#attempt) return;
+      // Levels decoded before a failure are still shown (the error may come
+      // before the renderer is ready); a retry's newer port replaces this one.
+      if (this.#levels !== levels) return;
       if (this.camera) renderer.camera = this.camera;
       renderer.attach(levels);
     } catch (error) {
