@@ -167,6 +167,8 @@ export class Renderer {
     positionBuffer: null,
     colourBuffer: null,
   };
+  /** @type {LevelMessage | null} the newest level, waiting for the first one to be on screen */
+  #next = null;
   /** @type {any} WEBGL_lose_context, for tests */
   #loseContext = null;
 
@@ -217,7 +219,7 @@ export class Renderer {
 
   /** Nothing waiting to be uploaded: the newest level is complete on the GPU. */
   get settled() {
-    return !this.lost && !this.pending && Boolean(this.current) && this.current?.uploads.length === 0;
+    return !this.lost && !this.pending && !this.#next && Boolean(this.current) && this.current?.uploads.length === 0;
   }
 
   #init() {
@@ -263,7 +265,8 @@ export class Renderer {
     this.#store.gpuCapacity = 0;
     this.#init();
     this.#uploadColour();
-    const newest = this.pending?.source ?? this.current?.source;
+    const newest = this.#next ?? this.pending?.source ?? this.current?.source;
+    this.#next = null;
     this.current = null;
     this.pending = null;
     if (newest) this.show(newest);
@@ -277,7 +280,14 @@ export class Renderer {
   show(level) {
     this.#receive(level);
     if (this.lost) {
+      this.#next = null;
       this.pending = { ...emptyMesh(), source: level };
+      return;
+    }
+    // The first level to arrive is drawn first (the base mesh at once), even
+    // when newer ones arrive with it; after that the newest wins.
+    if (this.pending && !this.current) {
+      this.#next = level;
       return;
     }
     if (this.pending) this.#release(this.pending);
@@ -444,6 +454,10 @@ export class Renderer {
         this.pending = null;
         this.#dirty = true;
         this.hooks.onSwap?.(pending.source);
+        if (this.#next) {
+          this.pending = this.#allocate(this.#next);
+          this.#next = null;
+        }
       }
     } else if (this.current?.uploads.length && caughtUp) {
       issued = true;
