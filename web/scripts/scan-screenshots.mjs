@@ -23,7 +23,9 @@ const out = join(root, 'docs', 'screenshots');
 mkdirSync(out, { recursive: true });
 const browser = await launch({ width: 800, height: 640 });
 try {
-  for (const [name, level] of [['base', 0], ['middle', Math.round(last / 2)], ['final', last]]) {
+  /** @type {[string, number][]} */
+  const shots = [['base', 0], ['middle', Math.round(last / 2)], ['final', last]];
+  for (const [name, level] of shots) {
     const page = await browser.context.newPage();
     await page.route('**/batches/**', (route) => {
       const batch = Number(new URL(route.request().url()).pathname.split('/').pop());
