@@ -158,7 +158,7 @@ pub async fn run_serve(args: ServeArgs) -> anyhow::Result<()> {
     let storage = super::open_storage(&args.db, &args.connect_options(), true).await?;
     let state = AppState::new(storage, args.service_config());
     let _sampler = state.spawn_load_sampler();
-    let listener = TcpListener::bind(args.listen).await?;
+    let listener = listen(args.listen)?;
     tracing::info!(
         addr = %listener.local_addr()?,
         db = %super::redact(&args.db),
@@ -199,4 +199,21 @@ mod tests {
             (d.max_connections, d.acquire_timeout)
         );
     }
+}
+
+/// Connections the kernel may hold for us before `accept`. Tokio's
+/// default (1,024) overflows when a crowd arrives in the same instant: the
+/// dropped SYNs are retried by clients one second later, which was the whole
+/// of a 1,000-visitor burst's p99. The kernel caps it at `net.core.somaxconn`.
+const LISTEN_BACKLOG: u32 = 8192;
+
+fn listen(addr: std::net::SocketAddr) -> std::io::Result<TcpListener> {
+    let socket = if addr.is_ipv4() {
+        tokio::net::TcpSocket::new_v4()?
+    } else {
+        tokio::net::TcpSocket::new_v6()?
+    };
+    socket.set_reuseaddr(true)?;
+    socket.bind(addr)?;
+    socket.listen(LISTEN_BACKLOG)
 }
