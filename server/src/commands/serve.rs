@@ -176,6 +176,23 @@ pub async fn run_serve(args: ServeArgs) -> anyhow::Result<()> {
     Ok(())
 }
 
+/// Connections the kernel may hold for us before `accept`. Tokio's
+/// default (1,024) overflows when a crowd arrives in the same instant: the
+/// dropped SYNs are retried by clients one second later, which was the whole
+/// of a 1,000-visitor burst's p99. The kernel caps it at `net.core.somaxconn`.
+const LISTEN_BACKLOG: u32 = 8192;
+
+fn listen(addr: std::net::SocketAddr) -> std::io::Result<TcpListener> {
+    let socket = if addr.is_ipv4() {
+        tokio::net::TcpSocket::new_v4()?
+    } else {
+        tokio::net::TcpSocket::new_v6()?
+    };
+    socket.set_reuseaddr(true)?;
+    socket.bind(addr)?;
+    socket.listen(LISTEN_BACKLOG)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -199,21 +216,4 @@ mod tests {
             (d.max_connections, d.acquire_timeout)
         );
     }
-}
-
-/// Connections the kernel may hold for us before `accept`. Tokio's
-/// default (1,024) overflows when a crowd arrives in the same instant: the
-/// dropped SYNs are retried by clients one second later, which was the whole
-/// of a 1,000-visitor burst's p99. The kernel caps it at `net.core.somaxconn`.
-const LISTEN_BACKLOG: u32 = 8192;
-
-fn listen(addr: std::net::SocketAddr) -> std::io::Result<TcpListener> {
-    let socket = if addr.is_ipv4() {
-        tokio::net::TcpSocket::new_v4()?
-    } else {
-        tokio::net::TcpSocket::new_v6()?
-    };
-    socket.set_reuseaddr(true)?;
-    socket.bind(addr)?;
-    socket.listen(LISTEN_BACKLOG)
 }
