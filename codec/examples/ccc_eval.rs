@@ -77,14 +77,18 @@ fn main() {
         let enc = t.elapsed().as_secs_f64();
         let (gc, gl, gb) = connectivity_bits(&guarded.bytes, mesh.positions.len());
         if let Some(colours) = mesh.colors.as_ref().filter(|_| textured.is_none()) {
-            let complex = ccc::CellComplex::from_images(&m.parameters, &m.cell_png, &m.colour_jpeg).unwrap();
+            let complex =
+                ccc::CellComplex::from_images(&m.parameters, &m.cell_png, &m.colour_jpeg).unwrap();
             let mut errors: Vec<f64> = mesh
                 .positions
                 .iter()
                 .zip(colours)
                 .map(|(&p, c)| {
                     let at = complex.colour_at(q.dequantize(q.quantize(p)).into());
-                    (0..3).map(|k| (at[k] as f64 * 255.0 - c[k] as f64).abs()).sum::<f64>() / 3.0
+                    (0..3)
+                        .map(|k| (at[k] as f64 * 255.0 - c[k] as f64).abs())
+                        .sum::<f64>()
+                        / 3.0
                 })
                 .collect();
             errors.sort_by(f64::total_cmp);
