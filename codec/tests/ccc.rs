@@ -161,6 +161,12 @@ fn corrupt_or_mismatched_textures_are_errors() {
         ..CccOptions::default()
     };
     assert!(ccc::build(&mesh, &q, ColourSource::PerVertex(&mesh), &tiny).is_err());
+    // So small that the cube counts would overflow: still a clear error.
+    let absurd = CccOptions {
+        cell_size: Some(1e-30),
+        ..CccOptions::default()
+    };
+    assert!(ccc::build(&mesh, &q, ColourSource::PerVertex(&mesh), &absurd).is_err());
     let bad = CccOptions {
         cell_size: Some(f32::NAN),
         ..CccOptions::default()

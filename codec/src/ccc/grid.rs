@@ -17,9 +17,12 @@ pub const MAX_CUBES: u64 = 1 << 24;
 impl Grid {
     /// A grid over the bounding cube `[min, max]` with about `cubes_on_longest`
     /// cubes along the longest axis; the model sits inside with half a cube to spare.
+    /// Dimensions are clamped to 2²⁰ cubes per axis; check [`Grid::cube_count`].
     pub fn around(min: DVec3, max: DVec3, cell_size: f64) -> Grid {
         let extent = (max - min).max(DVec3::splat(0.0));
-        let dims = (extent / cell_size).floor().as_ivec3() + IVec3::ONE;
+        let dims = ((extent / cell_size).floor() + DVec3::ONE)
+            .clamp(DVec3::ONE, DVec3::splat(1048576.0))
+            .as_ivec3();
         let slack = DVec3::splat(cell_size) * dims.as_dvec3() - extent;
         Grid {
             origin: min - slack * 0.5,
@@ -29,6 +32,7 @@ impl Grid {
     }
 
     pub fn cube_count(&self) -> u64 {
+        // At most 2⁶⁰ after the clamp in `around`: no overflow.
         self.dims.x as u64 * self.dims.y as u64 * self.dims.z as u64
     }
 

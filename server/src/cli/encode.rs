@@ -3,7 +3,7 @@ use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
 use std::path::PathBuf;
 use std::time::Instant;
-use vitrine_codec::ccc::{encode_coloured, CccOptions, ColourMode};
+use vitrine_codec::ccc::{encode_coloured, ColourMode};
 use vitrine_codec::{BaseTarget, EncodeOptions};
 
 #[derive(Args, Debug)]
@@ -31,6 +31,8 @@ pub struct EncodeArgs {
     /// has colour or a texture, else `none`.
     #[arg(long)]
     pub colour: Option<ColourMode>,
+    #[command(flatten)]
+    pub ccc: vitrine::CccArgs,
 }
 
 impl EncodeArgs {
@@ -78,7 +80,7 @@ pub fn run(args: EncodeArgs) -> anyhow::Result<()> {
         texture.as_ref(),
         mode,
         &args.options(),
-        &CccOptions::default(),
+        &args.ccc.options(),
         |p| {
             bar.set_message(p.layer.to_string());
             bar.set_position((p.input_vertices - p.vertices) as u64);

@@ -59,9 +59,38 @@ pub struct IngestArgs {
     /// default, 256, keeps ingest fast; `vitrine inspect --original` uses 512.
     #[arg(long, default_value_t = 256, value_parser = clap::value_parser!(u32).range(16..=4096))]
     pub quality_image_size: u32,
+    #[command(flatten)]
+    pub ccc: CccArgs,
     /// Test hook: pause inside the transaction before committing.
     #[arg(long, hide = true, env = "VITRINE_TEST_PAUSE_BEFORE_COMMIT_MS")]
     pub pause_before_commit_ms: Option<u64>,
+}
+
+/// How the cubic cell complex is built (`--colour ccc`); by default from the
+/// geometry.
+#[derive(clap::Args, Debug, Clone)]
+pub struct CccArgs {
+    /// Cube edge of the cell complex in model units (default: the longest
+    /// side over 0.08·√vertices, at least 12 and at most 200 cubes).
+    #[arg(long)]
+    pub cell_size: Option<f32>,
+    /// Texels per side of a tile (default: from a budget of about 4 texels per vertex).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=256))]
+    pub tile_size: Option<u32>,
+    /// JPEG quality of the colour atlas.
+    #[arg(long, default_value_t = 90, value_parser = clap::value_parser!(u8).range(1..=100))]
+    pub jpeg_quality: u8,
+}
+
+impl CccArgs {
+    pub fn options(&self) -> CccOptions {
+        CccOptions {
+            cell_size: self.cell_size,
+            tile_size: self.tile_size,
+            jpeg_quality: self.jpeg_quality,
+            ..CccOptions::default()
+        }
+    }
 }
 
 pub async fn run_ingest(args: IngestArgs) -> anyhow::Result<()> {
@@ -114,7 +143,7 @@ pub async fn run_ingest(args: IngestArgs) -> anyhow::Result<()> {
             ..EncodeOptions::default()
         },
         colour: args.colour,
-        ccc: CccOptions::default(),
+        ccc: args.ccc.options(),
         quality: args.quality.then(|| QualityOptions {
             image_size: args.quality_image_size,
             ..QualityOptions::default()

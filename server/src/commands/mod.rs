@@ -4,7 +4,7 @@ mod ingest;
 mod serve;
 mod token;
 
-pub use ingest::{run_ingest, IngestArgs};
+pub use ingest::{run_ingest, CccArgs, IngestArgs};
 pub use serve::{run_serve, ServeArgs};
 pub use token::{new_token, run_token, TokenArgs};
 
