@@ -7,7 +7,9 @@ use serde::{Deserialize, Serialize};
 
 use crate::ccc::{CellComplex, TextureShader};
 use crate::import::TexturedSurface;
-use crate::metrics::{self, ConstantColour, SurfaceShader, VertexColours};
+use crate::metrics::{
+    self, ConstantColour, ImageReference, RenderOptions, SurfaceShader, VertexColours,
+};
 use crate::{Decoder, IndexedMesh, Limits, Result, StreamIndex};
 
 /// Metrics of one level.
@@ -75,6 +77,11 @@ pub fn stream_quality(
             }
             (None, None) => (original.mesh, &ConstantColour::CLAY),
         };
+    let reference = ImageReference::new(
+        ref_mesh,
+        ref_shader,
+        &RenderOptions::square(options.image_size),
+    );
     let mut decoder = Decoder::new(&stream[index.base.clone()], Limits::default())?;
     let mut out = Vec::with_capacity(index.batches.len() + 1);
     for level in 0..=index.batches.len() {
@@ -106,8 +113,7 @@ pub fn stream_quality(
                 None => &ConstantColour::CLAY,
             },
         };
-        let image =
-            metrics::image_rmse((ref_mesh, ref_shader), (&mesh, shader), options.image_size);
+        let image = reference.rmse(&mesh, shader);
         out.push(LevelQuality {
             level,
             vertices: mesh.positions.len(),

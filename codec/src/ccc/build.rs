@@ -4,7 +4,7 @@
 use glam::{DVec2, DVec3, IVec3};
 
 use super::grid::{for_each_overlapped_cube, Grid, MAX_CUBES};
-use super::projection::{face_point, FACES};
+use super::projection::{face_point, other_axes, FACES};
 use super::{CccOptions, ColourSource};
 use crate::{Error, IndexedMesh, Quantization, Result};
 
@@ -246,11 +246,6 @@ fn colour_surface<'a>(
             let colours = m.colors.as_deref().ok_or_else(|| {
                 Error::Parameter("per-vertex colour source has no colours".into())
             })?;
-            if !std::ptr::eq(m, mesh) && m.positions.len() != mesh.positions.len() {
-                return Err(Error::Parameter(
-                    "colour source differs from the mesh".into(),
-                ));
-            }
             if colours.len() != positions.len() {
                 return Err(Error::Parameter(
                     "colour count differs from vertex count".into(),
@@ -507,11 +502,7 @@ impl TexelBins {
         let sign = if face.is_multiple_of(2) { 1.0 } else { -1.0 };
         let plane = if face.is_multiple_of(2) { 1.0 } else { 0.0 };
         let depth = sign * (plane - centre[axis]);
-        let (b0, b1) = match axis {
-            0 => (1, 2),
-            1 => (0, 2),
-            _ => (0, 1),
-        };
+        let (b0, b1) = other_axes(axis);
         self.ranges.clear();
         for (k, tri) in triangles.enumerate() {
             let w = tri.map(|p| sign * (p[axis] - centre[axis]));

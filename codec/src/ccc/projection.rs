@@ -41,7 +41,7 @@ pub fn face_point(face: usize, uv: [f64; 2]) -> DVec3 {
 }
 
 /// The two axes spanning a face across `axis`, in the order `(u, v)`.
-fn other_axes(axis: usize) -> (usize, usize) {
+pub(super) fn other_axes(axis: usize) -> (usize, usize) {
     match axis {
         0 => (1, 2),
         1 => (0, 2),

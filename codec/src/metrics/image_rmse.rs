@@ -1,7 +1,7 @@
 //! The image-space luminance RMSE of Lindstrom and Turk (2000).
 
 use super::parallel_map;
-use super::raster::{render, RenderOptions, SurfaceShader};
+use super::raster::{render, Camera, RenderOptions, SurfaceShader};
 use super::views::{bounding_sphere, rhombicuboctahedron};
 use crate::IndexedMesh;
 
@@ -21,8 +21,8 @@ pub fn image_rmse(
     approx: (&IndexedMesh, &dyn SurfaceShader),
     size: u32,
 ) -> f64 {
-    let per_view = image_rmse_per_view(reference, approx, &RenderOptions::square(size));
-    (per_view.iter().map(|e| e * e).sum::<f64>() / per_view.len() as f64).sqrt()
+    ImageReference::new(reference.0, reference.1, &RenderOptions::square(size))
+        .rmse(approx.0, approx.1)
 }
 
 /// The luma RMSE of each of the 24 views, with any image size, background and
@@ -32,18 +32,49 @@ pub fn image_rmse_per_view(
     approx: (&IndexedMesh, &dyn SurfaceShader),
     options: &RenderOptions,
 ) -> [f64; 24] {
-    let (center, radius) = bounding_sphere(reference.0);
-    let cameras = rhombicuboctahedron(center, radius);
-    let errors = parallel_map(cameras.len(), |i| {
-        let a = render(reference.0, reference.1, &cameras[i], options);
-        let b = render(approx.0, approx.1, &cameras[i], options);
-        let sum: f64 = a
-            .luminance
-            .iter()
-            .zip(&b.luminance)
-            .map(|(x, y)| f64::from(x - y).powi(2))
-            .sum();
-        (sum / a.luminance.len().max(1) as f64).sqrt()
-    });
-    std::array::from_fn(|i| errors[i])
+    ImageReference::new(reference.0, reference.1, options).per_view(approx.0, approx.1)
+}
+
+/// The reference's 24 snapshots, rendered once, for measuring many
+/// approximations against (every level of a stream).
+pub struct ImageReference {
+    cameras: [Camera; 24],
+    options: RenderOptions,
+    luminance: Vec<Vec<f32>>,
+}
+
+impl ImageReference {
+    pub fn new(mesh: &IndexedMesh, shader: &dyn SurfaceShader, options: &RenderOptions) -> Self {
+        let (center, radius) = bounding_sphere(mesh);
+        let cameras = rhombicuboctahedron(center, radius);
+        let luminance = parallel_map(cameras.len(), |i| {
+            render(mesh, shader, &cameras[i], options).luminance
+        });
+        ImageReference {
+            cameras,
+            options: *options,
+            luminance,
+        }
+    }
+
+    /// Luma RMSE of each view of `mesh` against the reference's.
+    pub fn per_view(&self, mesh: &IndexedMesh, shader: &dyn SurfaceShader) -> [f64; 24] {
+        let errors = parallel_map(self.cameras.len(), |i| {
+            let b = render(mesh, shader, &self.cameras[i], &self.options);
+            let a = &self.luminance[i];
+            let sum: f64 = a
+                .iter()
+                .zip(&b.luminance)
+                .map(|(x, y)| f64::from(x - y).powi(2))
+                .sum();
+            (sum / a.len().max(1) as f64).sqrt()
+        });
+        std::array::from_fn(|i| errors[i])
+    }
+
+    /// [`image_rmse`] of `mesh` against the reference.
+    pub fn rmse(&self, mesh: &IndexedMesh, shader: &dyn SurfaceShader) -> f64 {
+        let per_view = self.per_view(mesh, shader);
+        (per_view.iter().map(|e| e * e).sum::<f64>() / per_view.len() as f64).sqrt()
+    }
 }

@@ -13,9 +13,7 @@ use clap::Args;
 use vitrine_codec::ccc::{
     encode_coloured, vertex_colours_from_texture, CccOptions, CellComplex, ColourMode,
 };
-use vitrine_codec::import::{import_path_textured, ImportOptions};
 use vitrine_codec::quality::{stream_quality, LevelQuality, Original, QualityOptions};
-use vitrine_codec::repair::{prepare, RepairOptions};
 use vitrine_codec::{breakdown, EncodeOptions};
 
 #[derive(Args, Debug)]
@@ -58,13 +56,7 @@ pub fn run(args: ColourBenchArgs) -> anyhow::Result<()> {
     for path in &args.meshes {
         let name = mesh_name(path);
         eprintln!("{name}: importing");
-        let imported = import_path_textured(path, &ImportOptions::default())
-            .with_context(|| format!("importing {}", path.display()))?;
-        for w in &imported.warnings {
-            eprintln!("  warning: {w}");
-        }
-        let texture = imported.texture;
-        let (mut mesh, _) = prepare(imported.mesh, &RepairOptions::default())?;
+        let (mut mesh, texture, _) = super::load_coloured_mesh(path)?;
         if let Some(t) = &texture {
             mesh.colors = Some(vertex_colours_from_texture(&mesh, t));
         }

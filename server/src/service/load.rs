@@ -163,6 +163,12 @@ impl LoadMonitor {
         let steps = c.steps.max(1);
         let per_step = (c.high_inflight / u64::from(steps)).max(1);
         let target = (1 + (inflight - c.high_inflight) / per_step).min(u64::from(steps)) as u8;
+        // Past the threshold every request lands here: take the lock only to raise.
+        if self.forced.load(Ordering::Relaxed) < 0
+            && i32::from(target) <= self.pressure.load(Ordering::Relaxed)
+        {
+            return;
+        }
         let Ok(mut s) = self.smoothed.lock() else {
             return;
         };
