@@ -181,7 +181,7 @@ case_slow_db() {
     local out=""
     for caps in on off; do
         local flags=(--cache-bytes 0)
-        [ $caps = off ] && flags+=(--load-high-inflight 1000000000 --load-high-latency-ms 1000000000 --load-high-queue-ms 1000000000)
+        [ $caps = off ] && flags+=(--admit-rate 0 --load-high-inflight 1000000000 --load-high-latency-ms 1000000000 --load-high-queue-ms 1000000000)
         serve "postgres://postgres@127.0.0.1:$proxy_port/postgres" "${flags[@]}"
         if "$load" crowd --url "$url" --slug sample --profile "$profile" --visitors "$crowd_n" \
             --pattern burst >"$work/slow_db_$caps.out" 2>&1; then

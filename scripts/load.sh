@@ -6,7 +6,10 @@
 #                              upsampled igea, 1/50/100/1000/5000 visitors at once,
 #                              caps off and on, RUNS runs each (median), then 1,000
 #                              visitors ramping and steady; writes target/load/ and
-#                              docs/load.svg
+#                              docs/load.svg. "caps on" is the default service:
+#                              load caps and admission control of new visitors
+#                              (503 busy + Retry-After past --admit-burst, which
+#                              visitors retry with jitter); "caps off" turns both off
 #   scripts/load.sh --short    CI (≤ 5 minutes with scripts/faults.sh --short): igea.ply
 #                              (134 k vertices), 1 and 200 visitors with caps on;
 #                              fails on any answer but 200/304/429/503, a 429/503

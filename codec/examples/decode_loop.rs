@@ -1,4 +1,4 @@
-//! Profiling aid: `cargo run --release --example decode_loop mesh.ply [runs]`.
+//! Profiling aid: `cargo run --release --example decode_loop mesh.ply [decode-runs] [encode-runs]`.
 use std::time::Instant;
 use vitrine_codec::import::{import_path, ImportOptions};
 use vitrine_codec::repair::{prepare, RepairOptions};
@@ -13,15 +13,31 @@ fn main() {
     )
     .unwrap()
     .0;
-    let t = Instant::now();
-    let e = encode(&mesh, &EncodeOptions::default()).unwrap();
-    println!("encode {:.1} ms", t.elapsed().as_secs_f64() * 1e3);
+    let encode_runs: usize = std::env::args().nth(3).map_or(1, |s| s.parse().unwrap());
+    let mut encode_times = Vec::new();
+    let mut e = None;
+    for _ in 0..encode_runs.max(1) {
+        let t = Instant::now();
+        e = Some(encode(&mesh, &EncodeOptions::default()).unwrap());
+        encode_times.push(t.elapsed().as_secs_f64());
+    }
+    let e = e.unwrap();
+    encode_times.sort_by(f64::total_cmp);
+    let median = encode_times[encode_times.len() / 2];
+    println!(
+        "encode median {:.1} ms = {:.2} Mv/s",
+        median * 1e3,
+        mesh.positions.len() as f64 / median / 1e6
+    );
     let mut times = Vec::new();
     for _ in 0..runs {
         let t = Instant::now();
         let d = decode(&e.bytes, None, Limits::default()).unwrap();
         times.push(t.elapsed().as_secs_f64());
         std::hint::black_box(d.indices().len());
+    }
+    if runs == 0 {
+        return;
     }
     times.sort_by(f64::total_cmp);
     let n = mesh.positions.len() as f64;

@@ -39,6 +39,9 @@ fn main() {
             b[1..].iter().map(f).sum::<u32>() as f64 * 8.0 / n
         };
         let conn = sum(|l| l.connectivity + l.overhead);
+        if std::env::var_os("OVERHEAD").is_some() {
+            println!("  overhead {:.3} b/v", sum(|l| l.overhead));
+        }
         conn_sum += conn;
         total_sum += e.bytes.len() as f64 * 8.0 / n;
         println!(

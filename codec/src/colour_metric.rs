@@ -32,6 +32,10 @@ impl Default for ColourMetricGuard {
 }
 
 impl PatchGuard for ColourMetricGuard {
+    fn uses_mean_face_area(&self) -> bool {
+        true
+    }
+
     fn allows(&self, p: &CandidatePatch<'_>) -> bool {
         let Some(centre_colour) = p.centre_colour else {
             return true;

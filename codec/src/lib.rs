@@ -22,6 +22,7 @@ mod entropy;
 mod error;
 mod format;
 mod frenet;
+mod gates;
 mod halfedge;
 mod inspect;
 mod mesh;

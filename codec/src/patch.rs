@@ -51,6 +51,10 @@ pub(crate) struct Pattern {
     pub gate_corner: u8,
     /// Corner holding polygon edge `i → i+1`.
     pub polygon_corner: [u8; MAX_VALENCE],
+    /// How to reach every triangle from the gate triangle across diagonals,
+    /// `valence − 3` steps `[from, k, to, r]`: the half-edge at corner `k`
+    /// of triangle `from` is the twin of the one at corner `r` of `to`.
+    pub walk: [[u8; 4]; MAX_VALENCE - 3],
 }
 
 pub(crate) const NO_TWIN: u8 = 100;
@@ -109,6 +113,21 @@ impl Pattern {
                 twin[c] = other as u8;
             }
         }
+        let mut walk = [[0u8; 4]; MAX_VALENCE - 3];
+        let mut reached = vec![gate.0];
+        let mut at = 0;
+        while at < reached.len() {
+            let t = reached[at];
+            at += 1;
+            for k in 0..3 {
+                let other = twin[3 * t + k];
+                if other < NO_TWIN && !reached.contains(&(other as usize / 3)) {
+                    let to = other as usize / 3;
+                    walk[reached.len() - 1] = [t as u8, k as u8, to as u8, other % 3];
+                    reached.push(to);
+                }
+            }
+        }
         Pattern {
             valence,
             triangles,
@@ -117,6 +136,7 @@ impl Pattern {
             gate_triangle: gate.0 as u8,
             gate_corner: gate.1 as u8,
             polygon_corner,
+            walk,
         }
     }
 }
@@ -139,6 +159,62 @@ pub(crate) fn pattern(valence: usize, t0: Tag, t1: Tag) -> &'static Pattern {
     &table[(valence - MIN_VALENCE) * 4 + tag_index(t0) * 2 + tag_index(t1)]
 }
 
+impl Pattern {
+    /// The faces this pattern covers, as walks from the gate triangle: at
+    /// each triangle, which edge after the one it was entered by leads on
+    /// (1 = next, 2 = previous). The gate triangle is the empty walk.
+    pub(crate) fn walks(&self) -> Vec<Vec<u8>> {
+        let mut path: Vec<Vec<u8>> = vec![Vec::new(); self.triangle_count()];
+        let mut entry = [0u8; MAX_VALENCE - 2];
+        entry[self.gate_triangle as usize] = self.gate_corner;
+        let mut out = vec![Vec::new()];
+        for &[from, k, to, r] in &self.walk[..self.valence - 3] {
+            let mut w = path[from as usize].clone();
+            w.push((k + 3 - entry[from as usize]) % 3);
+            entry[to as usize] = r;
+            path[to as usize] = w.clone();
+            out.push(w);
+        }
+        out
+    }
+}
+
+/// The face a valence-(d+1) patch adds to the valence-d one with the same
+/// gate tags, for d = 3, 4, 5: a walk of `len` steps from the gate (see
+/// [`Pattern::walks`]). Patches grow by one face as their valence grows
+/// (tested below), so walking these in turn tells how wide a patch fits.
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct Growth {
+    pub len: u8,
+    pub steps: [u8; MAX_VALENCE - 3],
+}
+
+pub(crate) fn growth(t0: Tag, t1: Tag) -> &'static [Growth; MAX_VALENCE - MIN_VALENCE] {
+    static TABLE: OnceLock<Vec<[Growth; MAX_VALENCE - MIN_VALENCE]>> = OnceLock::new();
+    let table = TABLE.get_or_init(|| {
+        let mut table = Vec::new();
+        for t0 in [Tag::Plus, Tag::Minus] {
+            for t1 in [Tag::Plus, Tag::Minus] {
+                let mut row = [Growth::default(); MAX_VALENCE - MIN_VALENCE];
+                for (i, g) in row.iter_mut().enumerate() {
+                    let small = pattern(MIN_VALENCE + i, t0, t1).walks();
+                    let big = pattern(MIN_VALENCE + i + 1, t0, t1).walks();
+                    let added = big
+                        .iter()
+                        .find(|w| !small.contains(w))
+                        .expect("a larger patch adds a face");
+                    g.len = added.len() as u8;
+                    g.steps[..added.len()].copy_from_slice(added);
+                }
+                table.push(row);
+            }
+        }
+        table
+    });
+    let tag_index = |t: Tag| usize::from(t == Tag::Minus);
+    &table[tag_index(t0) * 2 + tag_index(t1)]
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -150,6 +226,48 @@ mod tests {
             &p.triangles[..4],
             &[[0, 1, 2], [2, 3, 4], [4, 5, 0], [0, 2, 4]]
         );
+    }
+
+    #[test]
+    fn walks_reach_every_triangle_once() {
+        for valence in MIN_VALENCE..=MAX_VALENCE {
+            for t0 in [Tag::Plus, Tag::Minus] {
+                for t1 in [Tag::Plus, Tag::Minus] {
+                    let p = pattern(valence, t0, t1);
+                    let mut seen = vec![p.gate_triangle];
+                    for &[from, k, to, r] in &p.walk[..valence - 3] {
+                        assert!(seen.contains(&from) && !seen.contains(&to));
+                        assert_eq!(p.twin[3 * from as usize + k as usize], 3 * to + r);
+                        seen.push(to);
+                    }
+                    assert_eq!(seen.len(), valence - 2);
+                }
+            }
+        }
+    }
+
+    /// The faces of a valence-d patch are among those of the valence-(d+1)
+    /// patch with the same gate tags (AD01's ear clipping grows the same
+    /// way), so if d + 1 fits around a gate, d does too.
+    #[test]
+    fn patterns_grow_by_one_face() {
+        for t0 in [Tag::Plus, Tag::Minus] {
+            for t1 in [Tag::Plus, Tag::Minus] {
+                for valence in MIN_VALENCE..MAX_VALENCE {
+                    let small = pattern(valence, t0, t1).walks();
+                    let big = pattern(valence + 1, t0, t1).walks();
+                    for w in &small {
+                        assert!(
+                            big.contains(w),
+                            "{valence} {t0:?} {t1:?}: {w:?} not in {big:?}"
+                        );
+                    }
+                    let added = growth(t0, t1)[valence - MIN_VALENCE];
+                    let added = &added.steps[..added.len as usize];
+                    assert!(big.iter().any(|w| w == added) && !small.iter().any(|w| w == added));
+                }
+            }
+        }
     }
 
     #[test]

@@ -1,10 +1,10 @@
 //! Prediction of a removed vertex from its patch, and the adaptive models the
 //! residuals are coded with. Encoder and decoder call the same functions.
 
-use crate::entropy::{BitModel, IntModel, RangeDecoder, RangeEncoder, SymbolModel};
+use crate::entropy::{IntModel, RangeDecoder, RangeEncoder};
 use crate::frenet::{round, Frame};
 use crate::halfedge::Connectivity;
-use crate::patch::{Tag, MAX_VALENCE};
+use crate::patch::Tag;
 
 /// Context for a gate's code: the tags of its two vertices and of the
 /// third vertex of its front face *as the decoder sees it* (the coarse
@@ -22,14 +22,10 @@ pub(crate) const GATE_CONTEXTS: usize = 27;
 /// Residual magnitude grows with the patch's size: code each size class
 /// (≈ log2 of the mean border edge length) with its own models.
 pub(crate) const SCALE_CLASSES: usize = 16;
-/// Decimation symbols: 0 = null patch, `valence − 2` otherwise (1..=4).
-pub(crate) const DECIMATION_SYMBOLS: usize = MAX_VALENCE - 1;
-
-/// Adaptive models of one conquest pass; reset per pass so every batch
-/// decodes on its own given the previous level (AD01 resets per layer too).
+/// Adaptive geometry and colour models of one conquest pass; reset per
+/// pass so every batch decodes on its own given the previous level (AD01
+/// resets per layer too). Connectivity models are in [`crate::gates`].
 pub(crate) struct PassModels {
-    pub valence: Vec<SymbolModel>,
-    pub cleaning: [BitModel; GATE_CONTEXTS],
     pub tangent: Vec<IntModel>,
     pub normal: Vec<IntModel>,
     pub colour: [IntModel; 3],
@@ -38,10 +34,6 @@ pub(crate) struct PassModels {
 impl PassModels {
     pub(crate) fn new() -> Self {
         PassModels {
-            valence: (0..GATE_CONTEXTS)
-                .map(|_| SymbolModel::new(DECIMATION_SYMBOLS))
-                .collect(),
-            cleaning: [BitModel::default(); GATE_CONTEXTS],
             tangent: (0..SCALE_CLASSES).map(|_| IntModel::new()).collect(),
             normal: (0..SCALE_CLASSES).map(|_| IntModel::new()).collect(),
             colour: [IntModel::new(), IntModel::new(), IntModel::new()],

@@ -82,6 +82,7 @@ pub fn stream_quality(
         ref_shader,
         &RenderOptions::square(options.image_size),
     );
+    let distances = metrics::HausdorffReference::new(original.mesh, options.hausdorff_samples);
     let mut decoder = Decoder::new(&stream[index.base.clone()], Limits::default())?;
     let mut out = Vec::with_capacity(index.batches.len() + 1);
     for level in 0..=index.batches.len() {
@@ -100,7 +101,7 @@ pub fn stream_quality(
                     .collect(),
             );
         }
-        let h = metrics::hausdorff(original.mesh, &mesh, options.hausdorff_samples);
+        let h = distances.distance_to(&mesh);
         let roy = metrics::roy_colour_rmse(original.mesh, &mesh).ok();
         let vertex;
         let shader: &dyn SurfaceShader = match complex {

@@ -109,3 +109,18 @@ fn encoder_output_matches_golden_values() {
         diffs.join("\n  ")
     );
 }
+
+/// Coding passes on a second thread must not change a byte.
+#[test]
+fn pipelined_and_in_place_coding_write_the_same_stream() {
+    for (name, mesh) in meshes() {
+        let write = |pipelined| {
+            let options = EncodeOptions {
+                pipelined,
+                ..EncodeOptions::default()
+            };
+            encode(&mesh, &options).unwrap().bytes
+        };
+        assert_eq!(write(true), write(false), "{name}");
+    }
+}

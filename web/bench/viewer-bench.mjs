@@ -6,7 +6,9 @@
 //   and with DevTools network emulation at 10 Mbit/s;
 // - time to the last level (its frame issued, and drawn: the GPU finished,
 //   gl.finish() after the viewer settles), and time spent in the WASM
-//   decoder (all levels) and in normals / edges, both inside the worker;
+//   decoder (all levels, inside the decode worker) and in normals / edges
+//   (in the decode worker, or — normals — in the render worker, which derives
+//   them for the levels it draws);
 // - longest main-thread task of the page's renderer, from a DevTools trace
 //   (RunTask events), during reconstruction (from the base mesh on screen to
 //   the last level on screen) and over the whole load (start-up included),
@@ -25,13 +27,13 @@ import { loadavg } from 'node:os';
 import { parseArgs } from 'node:util';
 import { launch } from '../test/support/browser.mjs';
 import { startService } from '../test/support/service.mjs';
+import { tracedLoad } from './traced-load.mjs';
 
 const { values } = parseArgs({
   options: { 'kilo-vertices': { type: 'string', default: '1000' }, runs: { type: 'string', default: '3' } },
 });
 const kilo = Number(values['kilo-vertices']);
 const runs = Number(values.runs);
-const MBIT = 1_000_000 / 8;
 
 const t0 = performance.now();
 const service = await startService({
@@ -49,51 +51,19 @@ let browser;
  */
 async function load(path, mbits) {
   const { context } = /** @type {NonNullable<typeof browser>} */ (browser);
-  const page = await context.newPage();
-  const cdp = await context.newCDPSession(page);
-  await cdp.send('Network.enable');
-  await cdp.send('Network.setCacheDisabled', { cacheDisabled: true });
-  if (mbits) {
-    await cdp.send('Network.emulateNetworkConditions', {
-      offline: false,
-      latency: 20,
-      downloadThroughput: mbits * MBIT,
-      uploadThroughput: mbits * MBIT,
-    });
-  }
-  // The page says when it is done through the console, so no DevTools
-  // evaluation (which runs on the main thread) falls inside the trace.
-  await page.addInitScript(() => {
-    const w = /** @type {any} */ (window);
-    w.__longtasks = [];
-    new PerformanceObserver((list) => w.__longtasks.push(...list.getEntries().map((e) => e.duration))).observe({
-      type: 'longtask',
-      buffered: true,
-    });
-    document.addEventListener('vitrine-level', () => {
-      const status = /** @type {any} */ (document.querySelector('vitrine-viewer'))?.viewer?.state.status;
-      if (status === 'complete' || status === 'capped') console.debug('vitrine:settled');
-    });
+  const { events, state, drawnMs, collected: longtasks } = await tracedLoad(context, `${service.url}${path}`, {
+    mbits,
+    categories: ['devtools.timeline', 'disabled-by-default-devtools.timeline', 'toplevel', 'blink.user_timing'],
+    initScript: () => {
+      const w = /** @type {any} */ (window);
+      w.__longtasks = [];
+      new PerformanceObserver((list) => w.__longtasks.push(...list.getEntries().map((e) => e.duration))).observe({
+        type: 'longtask',
+        buffered: true,
+      });
+    },
+    collect: (page) => page.evaluate(() => /** @type {any} */ (window).__longtasks),
   });
-  /** @type {any[]} */
-  const events = [];
-  cdp.on('Tracing.dataCollected', (e) => events.push(...e.value));
-  const traced = new Promise((resolve) => cdp.once('Tracing.tracingComplete', resolve));
-  await cdp.send('Tracing.start', {
-    categories: 'devtools.timeline,disabled-by-default-devtools.timeline,toplevel,blink.user_timing',
-    transferMode: 'ReportEvents',
-  });
-  const settled = page.waitForEvent('console', { predicate: (m) => m.text() === 'vitrine:settled', timeout: 600_000 });
-  await page.goto(`${service.url}${path}`, { waitUntil: 'commit' });
-  await settled;
-  // Frames are drawn after they are issued (SwiftShader takes seconds for the
-  // last level); wait for the GPU, so the next load does not start behind it.
-  const drawnMs = await page.evaluate(() => /** @type {any} */ (document.querySelector('vitrine-viewer')).viewer.renderer.finish());
-  const state = await page.evaluate(() => /** @type {any} */ (document.querySelector('vitrine-viewer')).viewer.state);
-  const longtasks = await page.evaluate(() => /** @type {any} */ (window).__longtasks);
-  await cdp.send('Tracing.end');
-  await traced;
-  await page.close();
   if (state.status !== 'complete') throw new Error(`viewer ended as ${state.status}: ${state.message}`);
   return { state, drawnMs, longtasks, ...longestTasks(events, manifest.last_level) };
 }
@@ -119,6 +89,12 @@ function longestTasks(events, last) {
   let during = 0;
   let script = 0;
   let worker = 0;
+  // Thread (CPU) time of the longest task and script: on a loaded machine a
+  // task's wall time also counts the time its thread waited for a core.
+  let duringCpu = 0;
+  let scriptCpu = 0;
+  /** @type {any} */
+  let longest = null;
   for (const e of events) {
     if (e.ph !== 'X' || e.pid !== pid) continue;
     const inWindow = e.ts + e.dur >= from && e.ts <= to;
@@ -128,12 +104,35 @@ function longestTasks(events, last) {
     if (e.tid !== tid) continue;
     // The viewer's own code: script run from a task (frame callback, worker
     // message, resize observer), GL calls and their waits included.
-    if (e.name === 'FunctionCall' && inWindow) script = Math.max(script, e.dur / 1000);
+    if (e.name === 'FunctionCall' && inWindow && e.dur / 1000 > script) {
+      script = e.dur / 1000;
+      scriptCpu = (e.tdur ?? 0) / 1000;
+    }
     if (e.name !== 'RunTask' && e.name !== 'ThreadControllerImpl::RunTask') continue;
     all = Math.max(all, e.dur / 1000);
-    if (inWindow) during = Math.max(during, e.dur / 1000);
+    if (inWindow && e.dur / 1000 > during) {
+      during = e.dur / 1000;
+      duringCpu = (e.tdur ?? 0) / 1000;
+      longest = e;
+    }
   }
-  return { longestMs: all, longestDuringMs: during, longestScriptMs: script, longestWorkerMs: workerTid === undefined ? null : worker };
+  // What the longest task did: its longest inner events (stderr, for reading the table).
+  const inside = longest
+    ? events
+        .filter((e) => e.ph === 'X' && e.pid === pid && e.tid === tid && e !== longest && e.ts >= longest.ts && e.ts < longest.ts + longest.dur && e.dur >= 1000)
+        .sort((a, b) => b.dur - a.dur)
+        .slice(0, 4)
+        .map((e) => `${e.name}${e.args?.data?.functionName ? ` ${e.args.data.functionName}` : ''} ${(e.dur / 1000).toFixed(0)}/${((e.tdur ?? 0) / 1000).toFixed(1)} ms`)
+    : [];
+  return {
+    longestMs: all,
+    longestDuringMs: during,
+    longestDuringCpuMs: duringCpu,
+    longestDuringInside: inside,
+    longestScriptMs: script,
+    longestScriptCpuMs: scriptCpu,
+    longestWorkerMs: workerTid === undefined ? null : worker,
+  };
 }
 
 /** @param {number[]} xs */
@@ -156,7 +155,7 @@ const only = process.env.VITRINE_BENCH_ONLY;
 console.log(`Model: torus, ${manifest.levels.at(-1).vertices.toLocaleString('en')} vertices, ${manifest.levels.length} levels, ` +
   `base ${manifest.levels[0].vertices.toLocaleString('en')} vertices / ${manifest.levels[0].bytes.toLocaleString('en')} bytes, ` +
   `all payloads ${totalBytes.toLocaleString('en')} bytes. Median of ${runs} cold loads each (longest tasks: worst run).\n`);
-console.log('| scenario | first frame | last level shown | last level drawn (GPU done) | WASM decode, all levels | normals + edges | longest main-thread task during reconstruction | of which the viewer\'s script | longest over the whole load | long tasks > 50 ms | longest render-worker task during reconstruction |');
+console.log('| scenario | first frame | last level shown | last level drawn (GPU done) | WASM decode, all levels | normals + edges | longest main-thread task during reconstruction (its thread time) | of which the viewer\'s script (thread time) | longest over the whole load | long tasks > 50 ms | longest render-worker task during reconstruction |');
 console.log('|---|---|---|---|---|---|---|---|---|---|---|');
 let version = '';
 /** Every scenario, one browser per compositing mode. */
@@ -165,7 +164,9 @@ async function measure() {
     browser = await launch({ width: 1024, height: 768, gpuCompositing: gpu });
     version = (await browser.context.browser()?.version()) ?? version;
     for (const [name, path, mbits, compositing] of scenarios) {
-      if (compositing === gpu && (!only || name.includes(only))) await scenario(name, path, mbits);
+      // VITRINE_BENCH_ONLY: rows whose name contains it, or is it exactly with a leading '='.
+      const wanted = !only || (only.startsWith('=') ? name === only.slice(1) : name.includes(only));
+      if (compositing === gpu && wanted) await scenario(name, path, mbits);
     }
     await browser.close();
   }
@@ -183,16 +184,22 @@ async function scenario(name, path, mbits) {
   const pick = (/** @type {(r: any) => number} */ f) => median(results.map(f));
   const worst = (/** @type {(r: any) => number} */ f) => Math.max(...results.map(f));
   const last = manifest.last_level;
+  /** The worst run's wall time, with that task's thread time. @param {string} wall @param {string} cpu */
+  const cpuOfWorst = (wall, cpu) => {
+    const r = results.reduce((a, b) => (b[wall] > a[wall] ? b : a));
+    return `${r[wall].toFixed(0)} ms (${r[cpu].toFixed(1)} ms CPU)`;
+  };
   console.log(
     `| ${name} | ${s(pick((r) => r.state.firstFrameMs))} | ${s(pick((r) => r.state.shownAtMs[last]))} | ${s(pick((r) => r.drawnMs))} | ` +
-      `${s(pick((r) => r.state.decodeMs))} | ${s(pick((r) => r.state.deriveMs))} | ` +
-      `${worst((r) => r.longestDuringMs).toFixed(0)} ms | ${worst((r) => r.longestScriptMs).toFixed(0)} ms | ` +
+      `${s(pick((r) => r.state.decodeMs))} | ${s(pick((r) => r.state.deriveMs + (r.state.normalsMs ?? 0)))} | ` +
+      `${cpuOfWorst('longestDuringMs', 'longestDuringCpuMs')} | ${cpuOfWorst('longestScriptMs', 'longestScriptCpuMs')} | ` +
       `${worst((r) => r.longestMs).toFixed(0)} ms | ${worst((r) => r.longtasks.length)} | ` +
       `${results[0].longestWorkerMs === null ? '–' : `${worst((r) => r.longestWorkerMs).toFixed(0)} ms`} |`,
   );
   for (const r of results) {
-    const { longestMs, longestDuringMs, longestScriptMs, longestWorkerMs, longtasks } = r;
-    console.error(name, JSON.stringify({ ...r.state, drawnMs: r.drawnMs, longestMs, longestDuringMs, longestScriptMs, longestWorkerMs, longtasks }));
+    const { state, drawnMs, longestMs, longestDuringMs, longestDuringCpuMs, longestDuringInside, longestScriptMs, longestScriptCpuMs, longestWorkerMs, longtasks } = r;
+    const { shownAtMs, firstFrameMs, decodeMs, deriveMs, normalsMs } = state;
+    console.error(name, JSON.stringify({ firstFrameMs, shownAtMs, decodeMs, deriveMs, normalsMs, drawnMs, longestMs, longestDuringMs, longestDuringCpuMs, longestDuringInside, longestScriptMs, longestScriptCpuMs, longestWorkerMs, longtasks }));
   }
 }
 

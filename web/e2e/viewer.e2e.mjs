@@ -281,6 +281,44 @@ test('a load cap is retried and refinement resumes when it rises', async () => {
   await direct.page.close();
 });
 
+test('a visitor refused in a surge (503 busy, Retry-After) is told so, waits and loads', async () => {
+  const page = await browser.context.newPage();
+  let manifests = 0;
+  /** @type {number[]} */
+  const asked = [];
+  await page.route('**/api/models/torus*', async (route) => {
+    manifests++;
+    asked.push(Date.now());
+    if (manifests <= 2) {
+      // What admission control answers (server/src/service/admission.rs).
+      await route.fulfill({
+        status: 503,
+        headers: { 'retry-after': '1', 'cache-control': 'no-store' },
+        json: { error: 'busy', message: 'many visitors are arriving; come back shortly', retry_after_s: 1 },
+      });
+    } else {
+      await route.continue();
+    }
+  });
+  await page.goto(`${service.url}/m/torus`);
+  await page.waitForFunction(
+    () => /** @type {any} */ (document.querySelector('vitrine-viewer'))?.shadowRoot?.querySelector('.notice')?.textContent === 'Many visitors are arriving: starting in 1 s',
+    null,
+    { timeout: 10_000, polling: 20 },
+  );
+  const done = await until(page, `s.status === 'complete'`, 20_000);
+  assert.equal(done.shownLevel, manifest.last_level);
+  assert.equal(manifests, 3);
+  // Each retry waited Retry-After (1 s) plus up to 1 s of jitter.
+  for (let i = 1; i < asked.length; i++) {
+    const gap = asked[i] - asked[i - 1];
+    assert.ok(gap >= 950 && gap < 2600, `retry ${i} after ${gap} ms`);
+  }
+  assert.equal(await shadowHidden(page, '.notice'), true);
+  assert.equal(await shadowHidden(page, '.error'), true);
+  await page.close();
+});
+
 /** @param {Page} page */
 function thread(page) {
   return page.evaluate(() => /** @type {any} */ (document.querySelector('vitrine-viewer')).viewer.renderer.thread);

@@ -70,9 +70,11 @@ try {
     await settled(page, 'complete');
     await page.locator('vitrine-viewer canvas').focus();
     await page.keyboard.press('w');
+    // The renderer (a render worker or the main thread's) reports its wire
+    // edges uploaded and the level settled on the GPU.
     await page.waitForFunction(() => {
       const r = /** @type {any} */ (document.querySelector('vitrine-viewer')).viewer.renderer;
-      return r.current?.edgeBuffer && r.current.uploads.length === 0;
+      return r.edges && r.settled;
     });
   });
   await shot('/m/torus?device=phone', 'viewer-capped-phone.png', (page) => settled(page, 'capped'));

@@ -1,8 +1,10 @@
 // @ts-check
 /**
- * Per-level derived geometry, computed in the decode worker so the main
- * thread only uploads: smooth vertex normals, the wireframe's edge list and
- * the bounding box.
+ * Per-level derived geometry: smooth vertex normals (in the render worker,
+ * for the levels it draws; in the decode worker when the renderer is on the
+ * main thread — only levels sent before the page knew that, when a render
+ * worker turned out to have no WebGL2, are derived there, a slice at a
+ * time), the wireframe's edge list and the bounding box (decode worker).
  */
 
 /**
@@ -16,6 +18,8 @@
  * weights each face by its area), packed as normalised int16 triples: half
  * the bytes of float32, and 1/32767 is far below what shading can show.
  * Vertices on no face get (0, 0, 0); the shader treats them as facing the eye.
+ * The renderer computes them the same way a slice at a time
+ * ({@link accumulateNormals}, {@link packNormals}).
  * @param {Float32Array} positions
  * @param {Uint32Array} indices
  * @returns {Int16Array}
@@ -23,16 +27,35 @@
 export function vertexNormals(positions, indices) {
   const n = positions.length / 3;
   const sum = new Float32Array(3 * n);
-  for (let t = 0; t < indices.length; t += 3) {
+  accumulateNormals(positions, indices, sum, 0, indices.length);
+  const packed = new Int16Array(3 * n);
+  packNormals(sum, packed, 0, 3 * n);
+  return packed;
+}
+
+/**
+ * Adds the (area-weighted) normals of the triangles whose indices are
+ * indices[from…to) to their corners' sums.
+ * @param {Float32Array} positions
+ * @param {Uint32Array} indices
+ * @param {Float32Array} sum three per vertex
+ * @param {number} from a multiple of 3
+ * @param {number} to a multiple of 3
+ */
+export function accumulateNormals(positions, indices, sum, from, to) {
+  for (let t = from; t < to; t += 3) {
     const a = 3 * indices[t];
     const b = 3 * indices[t + 1];
     const c = 3 * indices[t + 2];
-    const ux = positions[b] - positions[a];
-    const uy = positions[b + 1] - positions[a + 1];
-    const uz = positions[b + 2] - positions[a + 2];
-    const vx = positions[c] - positions[a];
-    const vy = positions[c + 1] - positions[a + 1];
-    const vz = positions[c + 2] - positions[a + 2];
+    const ax = positions[a];
+    const ay = positions[a + 1];
+    const az = positions[a + 2];
+    const ux = positions[b] - ax;
+    const uy = positions[b + 1] - ay;
+    const uz = positions[b + 2] - az;
+    const vx = positions[c] - ax;
+    const vy = positions[c + 1] - ay;
+    const vz = positions[c + 2] - az;
     const nx = uy * vz - uz * vy;
     const ny = uz * vx - ux * vz;
     const nz = ux * vy - uy * vx;
@@ -46,20 +69,28 @@ export function vertexNormals(positions, indices) {
     sum[c + 1] += ny;
     sum[c + 2] += nz;
   }
-  const packed = new Int16Array(3 * n);
-  for (let i = 0; i < 3 * n; i += 3) {
+}
+
+/**
+ * Normalises sum[from…to) (whole vertices) into int16 triples.
+ * @param {Float32Array} sum
+ * @param {Int16Array} packed
+ * @param {number} from a multiple of 3
+ * @param {number} to a multiple of 3
+ */
+export function packNormals(sum, packed, from, to) {
+  for (let i = from; i < to; i += 3) {
     const x = sum[i];
     const y = sum[i + 1];
     const z = sum[i + 2];
-    const length = Math.sqrt(x * x + y * y + z * z);
-    if (length > 0) {
-      const s = 32767 / length;
+    const q = x * x + y * y + z * z;
+    if (q > 0) {
+      const s = 32767 / Math.sqrt(q);
       packed[i] = Math.round(x * s);
       packed[i + 1] = Math.round(y * s);
       packed[i + 2] = Math.round(z * s);
     }
   }
-  return packed;
 }
 
 /**

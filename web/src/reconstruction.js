@@ -9,6 +9,7 @@
 
 import { DecodeError } from './codec.js';
 import { bounds, edgeIndices, vertexNormals } from './geometry.js';
+import { retryAfterSeconds, waitToRetry } from './retry.js';
 
 /**
  * @typedef {object} LoadRequest
@@ -19,6 +20,12 @@ import { bounds, edgeIndices, vertexNormals } from './geometry.js';
  * @property {number} [showFrom] with `each`, post levels from this one on (a retry
  *   does not step back through levels already on screen)
  * @property {boolean} wireframe also build the edge list of each posted level
+ * @property {'always' | 'last'} [normals] which posted levels carry their normals:
+ *   every one (the default: the renderer is on the page's main thread), or only
+ *   the level this worker stops at (`upTo`), when it has nothing else to do;
+ *   the levels before it go without, straight on to the next batch, and a
+ *   render worker derives normals for those it draws (levels superseded while
+ *   they wait for it never are)
  * @property {Record<string, string>} [headers] sent with every request
  * @property {number} [capacity] vertices of the last level (from the manifest): the
  *   renderer sizes its position and colour buffers once for it
@@ -36,7 +43,8 @@ import { bounds, edgeIndices, vertexNormals } from './geometry.js';
  * @property {number} [capacity] vertices the renderer should make room for
  *   (the last level's), so later levels append without reallocating
  * @property {Float32Array} positions x, y, z of vertices firstVertex…vertices − 1
- * @property {Int16Array} normals normalised int16 x, y, z of every vertex
+ * @property {Int16Array | null} normals normalised int16 x, y, z of every vertex
+ *   (null: not computed, the renderer derives them; see LoadRequest.normals)
  * @property {Uint8Array | null} colours r, g, b of vertices firstVertex…vertices − 1
  * @property {Uint32Array} indices
  * @property {Uint32Array | null} edges
@@ -60,9 +68,20 @@ import { bounds, edgeIndices, vertexNormals } from './geometry.js';
 
 /** @typedef {LevelMessage | StatusMessage} WorkerMessage */
 
+/**
+ * What the page's main thread gets for a level when the buffers went to a
+ * render worker: a few numbers, nothing to copy.
+ * @typedef {Pick<LevelMessage, 'type' | 'level' | 'vertices' | 'faces' | 'baseBounds' | 'received' | 'decodeMs' | 'deriveMs'>} LevelNotice
+ */
+
+/** @typedef {LevelNotice | StatusMessage} PageMessage */
+
 /** @typedef {(message: WorkerMessage, transfer: Transferable[]) => void} Post */
 
 /** @typedef {{ bytes: Uint8Array } | { capped: { status: number, reason: string | null, retryAfterS: number | null } }} Fetched */
+
+/** How many times one payload waits out a 503 with Retry-After. */
+const UNAVAILABLE_RETRIES = 5;
 
 /** Thrown for transport failures and unexpected HTTP answers. */
 export class NetworkError extends Error {}
@@ -109,6 +128,15 @@ export class Reconstruction {
   extend(upTo) {
     this.request.upTo = Math.min(upTo, this.request.batchUrls.length);
     this.#wake?.();
+  }
+
+  /**
+   * Which levels posted from now on carry their normals (the page says
+   * 'always' once it knows its renderer is on the main thread).
+   * @param {'always' | 'last'} which
+   */
+  setNormals(which) {
+    this.request.normals = which;
   }
 
   /** @param {boolean} on */
@@ -210,16 +238,17 @@ export class Reconstruction {
    * Posts the current level. Vertices are only ever appended (codec/FORMAT.md:
    * each pass appends the vertices it inserts), so positions and colours
    * carry only the vertices not posted before (from `firstVertex`); normals
-   * and indices change everywhere and go whole. Normals and edges are
-   * computed on views into the decoder's memory, so nothing is copied out
-   * except what is sent.
+   * and indices change everywhere and go whole. Normals (unless the
+   * renderer derives them) and edges are computed on views into the
+   * decoder's memory, so nothing is copied out except what is sent.
    */
   #postLevel() {
     const decoder = /** @type {import('./codec.js').StreamDecoder} */ (this.#decoder);
     const t0 = performance.now();
     const view = decoder.view();
     const t1 = performance.now();
-    const normals = vertexNormals(view.positions, view.indices);
+    const derive = this.request.normals !== 'last' || view.level >= this.request.upTo;
+    const normals = derive ? vertexNormals(view.positions, view.indices) : null;
     const edges = this.request.wireframe ? edgeIndices(view.indices, view.vertices) : null;
     const t2 = performance.now();
     const first = Math.min(this.#sentVertices, view.vertices);
@@ -228,9 +257,10 @@ export class Reconstruction {
     const indices = view.indices.slice();
     this.#sentVertices = view.vertices;
     this.#decodeMs += t1 - t0 + (performance.now() - t2);
-    this.#deriveMs += t2 - t1;
+    if (normals || edges) this.#deriveMs += t2 - t1;
     /** @type {Transferable[]} */
-    const transfer = [positions.buffer, normals.buffer, indices.buffer];
+    const transfer = [positions.buffer, indices.buffer];
+    if (normals) transfer.push(normals.buffer);
     if (colours) transfer.push(colours.buffer);
     if (edges) transfer.push(edges.buffer);
     this.post(
@@ -267,16 +297,23 @@ export class Reconstruction {
     const what = level === 0 ? 'base mesh' : `batch ${level}`;
     /** @type {Response} */
     let response;
-    try {
-      response = await this.fetchImpl(url, { headers: this.request.headers, signal: this.#abort.signal });
-    } catch (error) {
-      throw new NetworkError(`could not fetch the ${what}: ${describe(error)}`);
+    for (let tries = 0; ; tries++) {
+      try {
+        response = await this.fetchImpl(url, { headers: this.request.headers, signal: this.#abort.signal });
+      } catch (error) {
+        throw new NetworkError(`could not fetch the ${what}: ${describe(error)}`);
+      }
+      // A 503 that says when to come back (shedding under load, a database
+      // restarting) is waited out, with 0–1 s of jitter, a few times.
+      if (response.status !== 503 || tries >= UNAVAILABLE_RETRIES) break;
+      const wait = retryAfterSeconds(response, await response.json().catch(() => null));
+      if (wait === null) break;
+      await waitToRetry(Math.min(wait, 60), this.#abort.signal);
     }
     if (response.status === 403 || response.status === 429) {
       const body = await response.json().catch(() => ({}));
       if (body && body.error === 'level_capped') {
-        const header = Number(response.headers.get('retry-after'));
-        const retryAfterS = body.retry_after_s ?? (Number.isFinite(header) && header > 0 ? header : null);
+        const retryAfterS = retryAfterSeconds(response, body);
         return { capped: { status: response.status, reason: body.reason ?? null, retryAfterS } };
       }
     }

@@ -19,7 +19,8 @@ import { Renderer } from './renderer.js';
 
 /**
  * @typedef {object} RenderHooks
- * @property {(level: { level: number, vertices: number }) => void} onSwap a level is complete on the GPU
+ * @property {(level: { level: number, vertices: number, normalsMs: number }) => void} onSwap a level is
+ *   complete on the GPU (normalsMs: the renderer's time deriving normals so far)
  * @property {(frame: { level: number | null, colourResolution: AtlasResolution | null, at: number }) => void} onFrame
  *   a frame was drawn: the level and colour texture in it, at (performance.now() of this page)
  * @property {(bounds: import('./geometry.js').Bounds) => import('./camera.js').OrbitCamera} camera
@@ -91,7 +92,7 @@ class MainRenderer {
   constructor(canvas, hooks) {
     this.hooks = hooks;
     this.renderer = new Renderer(canvas, null, {
-      onSwap: (level) => hooks.onSwap(level),
+      onSwap: (level) => hooks.onSwap({ level: level.level, vertices: level.vertices, normalsMs: this.renderer.normalsMs }),
       onFrame: () =>
         hooks.onFrame({
           level: this.renderer.current?.source.level ?? null,

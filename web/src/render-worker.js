@@ -38,7 +38,7 @@ import { Renderer } from './renderer.js';
  * @typedef {{ type: 'ready', webgl2: boolean }
  *   | { type: 'started', maxTextureSize: number }
  *   | { type: 'failed', message: string }
- *   | { type: 'swap', level: number, vertices: number }
+ *   | { type: 'swap', level: number, vertices: number, normalsMs: number }
  *   | { type: 'frame', level: number | null, colourResolution: import('./renderer.js').AtlasResolution | null, at: number }
  *   | { type: 'status', lost: boolean, settled: boolean, edges: boolean, frames: number }
  *   | { type: 'captured', id: number, width: number, height: number, rgba: Uint8Array }
@@ -64,6 +64,8 @@ let source = null;
 /** @type {import('./camera.js').OrbitState | null} */
 let cameraState = null;
 let lastStatus = '';
+/** Level and colour texture of the last frame reported. */
+let lastFrame = '';
 
 /** @param {RenderReport} message @param {Transferable[]} [transfer] */
 function report(message, transfer = []) {
@@ -115,14 +117,17 @@ function start(canvas, width, height) {
       canvas,
       null,
       {
-        onSwap: (level) => report({ type: 'swap', level: level.level, vertices: level.vertices }),
-        onFrame: () =>
-          report({
-            type: 'frame',
-            level: renderer?.current?.source.level ?? null,
-            colourResolution: renderer?.colourResolution ?? null,
-            at: epochNow(),
-          }),
+        onSwap: (level) => report({ type: 'swap', level: level.level, vertices: level.vertices, normalsMs: renderer?.normalsMs ?? 0 }),
+        onFrame: () => {
+          // The page wants each level's and colour texture's first frame,
+          // not every frame of an orbit: one small message per change.
+          const level = renderer?.current?.source.level ?? null;
+          const colourResolution = renderer?.colourResolution ?? null;
+          const key = `${level} ${colourResolution}`;
+          if (key === lastFrame) return;
+          lastFrame = key;
+          report({ type: 'frame', level, colourResolution, at: epochNow() });
+        },
         onTick: sendStatus,
       },
       WORKER_UPLOAD,

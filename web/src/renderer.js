@@ -25,10 +25,14 @@
 
 import { multiply } from './camera.js';
 import { GLSL_CCC, cccUniforms } from './ccc.js';
+import { accumulateNormals, packNormals } from './geometry.js';
 import { BACKGROUND, CLAY, GLSL_SHADE, WIRE_ALPHA, WIRE_COLOUR } from './shading.js';
 
 const UPLOAD_BUDGET_MS = 6;
 const UPLOAD_CHUNK_BYTES = 256 << 10;
+/** Triangles, then vertices, per step of a level's normals between budget checks (well under a millisecond). */
+const NORMAL_TRIANGLES_PER_STEP = 8192;
+const NORMAL_VERTICES_PER_STEP = 16384;
 
 /**
  * requestAnimationFrame where the thread has one (pages; Chromium's and
@@ -85,6 +89,13 @@ void main() {
 /** @typedef {{ target: number, buffer: WebGLBuffer, data: ArrayBufferView, offset: number }} Upload */
 
 /**
+ * A level's normals being derived here, a slice per frame (the level came
+ * without them: LoadRequest.normals): face normals summed per corner up to
+ * index `index`, then packed up to component `packed`.
+ * @typedef {{ sum: Float32Array, normals: Int16Array, index: number, packed: number }} NormalJob
+ */
+
+/**
  * One level on the GPU: its own normals, indices and edges; positions and
  * colours from the shared vertex store.
  * @typedef {object} GpuMesh
@@ -93,6 +104,8 @@ void main() {
  * @property {WebGLBuffer[]} buffers
  * @property {WebGLBuffer} indexBuffer
  * @property {WebGLBuffer | null} edgeBuffer
+ * @property {WebGLBuffer | null} normalBuffer
+ * @property {NormalJob | null} normalJob normals still to derive before they are uploaded
  * @property {Upload[]} uploads
  */
 
@@ -139,6 +152,8 @@ export class Renderer {
   wireframe = false;
   lost = false;
   frames = 0;
+  /** Milliseconds spent deriving normals of levels that came without them. */
+  normalsMs = 0;
   /** @type {number | null} */
   #raf = null;
   #dirty = false;
@@ -446,9 +461,11 @@ export class Renderer {
     const caughtUp = !this.#fence || gl.getSyncParameter(this.#fence, gl.SYNC_STATUS) === gl.SIGNALED;
     let issued = false;
     const pending = this.pending;
+    const start = performance.now();
+    const inBudget = () => performance.now() - start < this.uploadBudgetMs;
     if (pending && caughtUp) {
       issued = true;
-      if (this.#upload(pending, pending.source.vertices)) {
+      if (this.#upload(pending, pending.source.vertices, inBudget)) {
         if (this.current) this.#release(this.current);
         this.current = pending;
         this.pending = null;
@@ -461,7 +478,7 @@ export class Renderer {
       }
     } else if (this.current?.uploads.length && caughtUp) {
       issued = true;
-      if (this.#upload(this.current, this.current.source.vertices)) this.#dirty = true;
+      if (this.#upload(this.current, this.current.source.vertices, inBudget)) this.#dirty = true;
     }
     if (this.#dirty) {
       this.#dirty = false;
@@ -507,7 +524,19 @@ export class Renderer {
     gl.bindBuffer(gl.ARRAY_BUFFER, store.positionBuffer);
     gl.enableVertexAttribArray(0);
     gl.vertexAttribPointer(0, 3, gl.FLOAT, false, 0, 0);
-    buffer(gl.ARRAY_BUFFER, level.normals);
+    /** @type {NormalJob | null} */
+    let normalJob = null;
+    let normalBuffer;
+    if (level.normals) {
+      normalBuffer = buffer(gl.ARRAY_BUFFER, level.normals);
+    } else {
+      // Derived here (#deriveNormals), then uploaded like the rest.
+      normalBuffer = gl.createBuffer();
+      gl.bindBuffer(gl.ARRAY_BUFFER, normalBuffer);
+      gl.bufferData(gl.ARRAY_BUFFER, 6 * level.vertices, gl.STATIC_DRAW);
+      buffers.push(normalBuffer);
+      normalJob = { sum: new Float32Array(3 * level.vertices), normals: new Int16Array(3 * level.vertices), index: 0, packed: 0 };
+    }
     gl.enableVertexAttribArray(1);
     gl.vertexAttribPointer(1, 3, gl.SHORT, true, 0, 0);
     if (level.colours && store.colourBuffer) {
@@ -524,7 +553,73 @@ export class Renderer {
       edgeBuffer = buffer(gl.ELEMENT_ARRAY_BUFFER, level.edges);
       buffers.pop();
     }
-    return { source: level, vao, buffers, indexBuffer, edgeBuffer, uploads };
+    if (normalJob) this.#queueNormals();
+    return { source: level, vao, buffers, indexBuffer, edgeBuffer, normalBuffer, normalJob, uploads };
+  }
+
+  /** @type {MessagePort | null} */
+  #normalsPort = null;
+  #normalsQueued = false;
+
+  /**
+   * Derives the pending level's normals in tasks of their own, a budget's
+   * worth each, not in animation frames: they are CPU work, and need not
+   * wait for the GPU (a frame can be late by seconds on SwiftShader) nor
+   * for the frame rate; between two slices the thread takes its messages
+   * (camera moves). A MessageChannel rather than setTimeout, which is
+   * clamped to 4 ms after a few nested calls.
+   */
+  #queueNormals() {
+    if (this.#normalsQueued) return;
+    this.#normalsQueued = true;
+    if (!this.#normalsPort) {
+      const channel = new MessageChannel();
+      channel.port1.onmessage = () => this.#normalsTask();
+      this.#normalsPort = channel.port2;
+    }
+    this.#normalsPort.postMessage(null);
+  }
+
+  #normalsTask() {
+    this.#normalsQueued = false;
+    const mesh = this.pending;
+    if (!mesh?.normalJob || this.lost) return;
+    const start = performance.now();
+    this.#deriveNormals(mesh, () => performance.now() - start < this.uploadBudgetMs);
+    if (mesh.normalJob) this.#queueNormals();
+    else this.#schedule();
+  }
+
+  /**
+   * Derives a level's normals (geometry.js, the decode worker's own
+   * algorithm) while the budget lasts; when they are complete, the level
+   * keeps them (a lost context does not derive them again) and their upload
+   * is queued.
+   * @param {GpuMesh} mesh
+   * @param {() => boolean} inBudget
+   */
+  #deriveNormals(mesh, inBudget) {
+    const job = /** @type {NormalJob} */ (mesh.normalJob);
+    const t0 = performance.now();
+    const indices = mesh.source.indices;
+    // Every vertex of the level was received with it or before (vertices are only appended).
+    const positions = this.#store.positions;
+    while (job.index < indices.length && inBudget()) {
+      const end = Math.min(indices.length, job.index + 3 * NORMAL_TRIANGLES_PER_STEP);
+      accumulateNormals(positions, indices, job.sum, job.index, end);
+      job.index = end;
+    }
+    while (job.index === indices.length && job.packed < job.sum.length && inBudget()) {
+      const end = Math.min(job.sum.length, job.packed + 3 * NORMAL_VERTICES_PER_STEP);
+      packNormals(job.sum, job.normals, job.packed, end);
+      job.packed = end;
+    }
+    this.normalsMs += performance.now() - t0;
+    if (job.index < indices.length || job.packed < job.sum.length) return;
+    mesh.normalJob = null;
+    mesh.source.normals = job.normals;
+    if (this.lost || !mesh.normalBuffer) return;
+    mesh.uploads.unshift({ target: this.gl.ARRAY_BUFFER, buffer: mesh.normalBuffer, data: job.normals, offset: 0 });
   }
 
   /**
@@ -602,14 +697,13 @@ export class Renderer {
    * store up to the mesh's vertex count, then the mesh's own buffers.
    * @param {GpuMesh} mesh
    * @param {number} vertices
-   * @returns {boolean} whether the mesh is complete
+   * @param {() => boolean} inBudget
+   * @returns {boolean} whether the mesh is complete (normals derived and everything uploaded)
    */
-  #upload(mesh, vertices) {
+  #upload(mesh, vertices, inBudget) {
     const gl = this.gl;
-    const start = performance.now();
     const store = this.#ensureStore();
     const chunk = this.uploadChunkBytes;
-    const inBudget = () => performance.now() - start < this.uploadBudgetMs;
     gl.bindVertexArray(null);
     while (store.uploaded < vertices && inBudget()) {
       // The same vertex range of positions (12 bytes each) and colours (3).
@@ -631,7 +725,7 @@ export class Renderer {
       job.offset = end;
       if (end === bytes.length) mesh.uploads.shift();
     }
-    return mesh.uploads.length === 0 && store.uploaded >= vertices;
+    return !mesh.normalJob && mesh.uploads.length === 0 && store.uploaded >= vertices;
   }
 
   /** @param {GpuMesh} mesh */
@@ -724,5 +818,5 @@ const PLACEHOLDER = /** @type {import('./ccc.js').CccParameters} */ ({
 /** @returns {Omit<GpuMesh, 'source'>} */
 function emptyMesh() {
   const none = /** @type {any} */ (null);
-  return { vao: none, buffers: [], indexBuffer: none, edgeBuffer: null, uploads: [] };
+  return { vao: none, buffers: [], indexBuffer: none, edgeBuffer: null, normalBuffer: null, normalJob: null, uploads: [] };
 }

@@ -177,18 +177,38 @@ export class ViewerUi {
       : '';
   }
 
-  /** @param {import('./viewer.js').ViewerState} state */
+  /**
+   * Runs on the main thread for every notice while a model loads, so it
+   * stays small: the DOM is touched only where a text or width changed (no
+   * style, layout or paint for an unchanged line), and nothing here reads
+   * layout.
+   * @param {import('./viewer.js').ViewerState} state
+   */
   setProgress(state) {
     this.#setColour(state);
     this.#drawQuality(state.shownLevel);
     if (state.shownLevel < 0) {
-      this.progress.textContent = `Loading… ${formatBytes(state.received)} received`;
+      this.#write(this.progress, `Loading… ${formatBytes(state.received)} received`);
       return;
     }
-    const vertices = state.vertices.toLocaleString('en');
-    this.progress.textContent =
-      `Level ${state.shownLevel} of ${state.lastLevel} · ${vertices} vertices · ${formatBytes(state.received)} received`;
-    this.bar.style.width = `${(100 * state.shownLevel) / Math.max(1, state.lastLevel)}%`;
+    const vertices = formatCount(state.vertices);
+    this.#write(
+      this.progress,
+      `Level ${state.shownLevel} of ${state.lastLevel} · ${vertices} vertices · ${formatBytes(state.received)} received`,
+    );
+    const width = `${(100 * state.shownLevel) / Math.max(1, state.lastLevel)}%`;
+    if (this.#barWidth !== width) this.bar.style.width = this.#barWidth = width;
+  }
+
+  #barWidth = '0';
+  /** Text last written per element. @type {WeakMap<HTMLElement, string>} */
+  #texts = new WeakMap();
+
+  /** @param {HTMLElement} element @param {string} text */
+  #write(element, text) {
+    if (this.#texts.get(element) === text) return;
+    this.#texts.set(element, text);
+    element.textContent = text;
   }
 
   /**
@@ -205,12 +225,17 @@ export class ViewerUi {
     const text = state.colourError
       ? `Colour: ${state.colourError}`
       : texts[/** @type {keyof typeof texts} */ (state.colour)] ?? null;
+    const key = `${state.colour}\n${state.colourError !== null}\n${text}`;
+    if (key === this.#colourKey) return;
+    this.#colourKey = key;
     this.colour.hidden = text === null;
-    this.colour.textContent = text ?? '';
+    this.#write(this.colour, text ?? '');
     this.colour.dataset.colour = state.colour;
     if (state.colourError) this.colour.dataset.error = '';
     else delete this.colour.dataset.error;
   }
+
+  #colourKey = '';
 
   /** @param {string | null} text */
   showNotice(text) {
@@ -233,6 +258,17 @@ export class ViewerUi {
     if (document.fullscreenElement) void document.exitFullscreen();
     else void this.root.requestFullscreen?.().catch(() => {});
   }
+}
+
+/** Made once: a formatter per call would set one up for every notice. */
+const COUNT_FORMAT = new Intl.NumberFormat('en', { maximumFractionDigits: 0 });
+
+/**
+ * A count with thousands separators (998,560).
+ * @param {number} n a whole number
+ */
+export function formatCount(n) {
+  return COUNT_FORMAT.format(n);
 }
 
 /** @param {number} bytes */

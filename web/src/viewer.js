@@ -9,7 +9,8 @@ import { OrbitCamera } from './camera.js';
 import { checkParameters } from './ccc.js';
 import { OrbitControls } from './controls.js';
 import { decodePng } from './png.js';
-import { openRenderer } from './render-host.js';
+import { canTransfer, openRenderer } from './render-host.js';
+import { retryAfterSeconds, waitToRetry } from './retry.js';
 
 /**
  * @typedef {object} ViewerOptions
@@ -55,7 +56,8 @@ import { openRenderer } from './render-host.js';
  * @property {number} vertices of the level on screen
  * @property {number} received payload bytes
  * @property {number} decodeMs time inside the WASM decoder
- * @property {number} deriveMs time computing normals and edges in the worker
+ * @property {number} deriveMs time computing normals and edges in the decode worker
+ * @property {number} normalsMs time the renderer spent deriving normals (levels sent without them)
  * @property {number | null} firstFrameMs performance.now() of the first frame with a mesh
  * @property {Record<number, number>} shownAtMs performance.now() when each level was first drawn
  * @property {string | null} message cap or error text on screen
@@ -93,6 +95,9 @@ export function compileDecoder(url) {
   return module;
 }
 
+/** How many times a load waits out a 503 with Retry-After before it gives up. */
+const BUSY_RETRIES = 20;
+
 const REASONS = {
   audience: () => 'the full-resolution scan is reserved for researchers',
   device: (/** @type {string} */ device) => `that is the most detail sent to a ${device}`,
@@ -112,6 +117,7 @@ export class Viewer {
     received: 0,
     decodeMs: 0,
     deriveMs: 0,
+    normalsMs: 0,
     firstFrameMs: null,
     shownAtMs: {},
     message: null,
@@ -183,7 +189,7 @@ export class Viewer {
       const rendering = this.#openRenderer();
       rendering.catch(() => {}); // awaited below
       const [manifest, module, worker] = await Promise.all([
-        this.#fetchManifest(),
+        this.#fetchManifest(attempt),
         compileDecoder(this.options.wasmUrl),
         this.#createWorker(this.options.workerUrl),
       ]);
@@ -198,6 +204,9 @@ export class Viewer {
       // before the renderer is ready); a retry's newer port replaces this one.
       if (this.#levels !== levels) return;
       if (this.camera) renderer.camera = this.camera;
+      // Normals are derived by the renderer when it has a thread of its own;
+      // the main thread's fallback gets them from the decode worker.
+      if (renderer.thread === 'main') worker.postMessage({ type: 'normals', which: 'always' });
       renderer.attach(levels);
     } catch (error) {
       if (attempt === this.#attempt) this.#fail(error instanceof Error ? error.message : String(error));
@@ -261,6 +270,12 @@ export class Viewer {
       show: this.options.level === null ? 'each' : 'last',
       showFrom: Math.min(this.state.shownLevel + 1, target),
       wireframe: this.#wireframe,
+      // A render worker derives the normals of the levels before the last
+      // that it draws (see start(): if the renderer turns out to be on the
+      // main thread, the decode worker is told to send them all).
+      normals: (this.renderer ? this.renderer.thread === 'main' : !(this.options.offscreen && canTransfer(this.ui.canvas)))
+        ? 'always'
+        : 'last',
     };
     // Levels and edges go through a port to the renderer (a render worker
     // directly, or this page in the fallback); the page gets each level as
@@ -295,7 +310,7 @@ export class Viewer {
     return this.options.level === null ? cap : Math.min(cap, this.options.level);
   }
 
-  /** @param {import('./reconstruction.js').WorkerMessage} message */
+  /** @param {import('./reconstruction.js').PageMessage} message */
   #message(message) {
     switch (message.type) {
       case 'level':
@@ -310,8 +325,6 @@ export class Viewer {
           decodeMs: message.decodeMs,
           deriveMs: message.deriveMs,
         });
-        break;
-      case 'edges':
         break;
       case 'progress':
         this.#set({ received: message.received });
@@ -333,9 +346,9 @@ export class Viewer {
     }
   }
 
-  /** @param {{ level: number, vertices: number }} level */
+  /** @param {{ level: number, vertices: number, normalsMs: number }} level */
   #shown(level) {
-    this.#set({ shownLevel: level.level, vertices: level.vertices });
+    this.#set({ shownLevel: level.level, vertices: level.vertices, normalsMs: level.normalsMs });
     if (level.level < this.state.targetLevel || this.state.status !== 'refining') return;
     const last = /** @type {Manifest} */ (this.manifest).last_level;
     if (this.#cap.level < Math.min(last, this.options.level ?? last)) this.#announceCap();
@@ -359,7 +372,9 @@ export class Viewer {
     this.state.firstFrameMs ??= now;
     // The colour textures wait for the first frame of the base mesh.
     if (first) this.#loadColour();
-    this.ui.root.dispatchEvent(new CustomEvent('vitrine-level', { detail: { level }, bubbles: true, composed: true }));
+    // The page's listeners run in a task of their own, after this one: the
+    // render worker's report stays a small task however much they do.
+    setTimeout(() => this.ui.root.dispatchEvent(new CustomEvent('vitrine-level', { detail: { level }, bubbles: true, composed: true })));
   }
 
   /**
@@ -498,19 +513,38 @@ export class Viewer {
   }
 
   /** @returns {Promise<Manifest>} */
-  async #fetchManifest() {
-    let response;
-    try {
-      response = await fetch(this.#apiUrl(this.options.manifestUrl), { cache: 'no-store' });
-    } catch (error) {
-      throw new Error(`could not reach the server (${error instanceof Error ? error.message : error})`);
-    }
-    if (!response.ok) {
+  /**
+   * The model's manifest. When `attempt` is given (a load, not a re-check of
+   * the cap), a 503 that says when to come back — the service admitting new
+   * visitors gradually in a surge (`busy`), or shedding load — is waited out
+   * and asked again, with 0–1 s of jitter so that refused visitors do not
+   * all return at once; a stop or a new load ends the wait.
+   * @param {number} [attempt]
+   */
+  async #fetchManifest(attempt) {
+    for (let tries = 0; ; tries++) {
+      let response;
+      try {
+        response = await fetch(this.#apiUrl(this.options.manifestUrl), { cache: 'no-store' });
+      } catch (error) {
+        throw new Error(`could not reach the server (${error instanceof Error ? error.message : error})`);
+      }
+      if (response.ok) {
+        if (tries > 0) this.ui.showNotice(null);
+        return response.json();
+      }
       const body = await response.json().catch(() => null);
+      const wait = response.status === 503 ? retryAfterSeconds(response, body) : null;
+      if (attempt !== undefined && wait !== null && tries < BUSY_RETRIES) {
+        const seconds = Math.min(Math.ceil(wait), 300);
+        this.ui.showNotice(`Many visitors are arriving: starting in ${seconds} s`);
+        await waitToRetry(seconds);
+        if (attempt !== this.#attempt) throw new Error('stopped');
+        continue;
+      }
       const detail = body?.message ?? body?.error ?? response.statusText;
       throw new Error(`the server answered ${response.status} for this model (${detail})`);
     }
-    return response.json();
   }
 
   /** @param {string} path relative to the manifest's URL */

@@ -14,7 +14,8 @@ import { Reconstruction } from './reconstruction.js';
 /**
  * @typedef {{ type: 'load', module: WebAssembly.Module, request: import('./reconstruction.js').LoadRequest, port?: MessagePort | null }
  *   | { type: 'extend', upTo: number }
- *   | { type: 'wireframe', on: boolean }} WorkerCommand
+ *   | { type: 'wireframe', on: boolean }
+ *   | { type: 'normals', which: 'always' | 'last' }} WorkerCommand
  */
 
 const scope = /** @type {DedicatedWorkerGlobalScope} */ (/** @type {unknown} */ (self));
@@ -26,10 +27,8 @@ let job = null;
 
 /** @type {MessagePort | null} */
 let renderPort = null;
-const NO_FLOATS = new Float32Array(0);
-const NO_SHORTS = new Int16Array(0);
-const NO_INDICES = new Uint32Array(0);
-
+/** A 'normals' command that came while the decoder was starting. @type {'always' | 'last' | null} */
+let normals = null;
 /** @type {import('./reconstruction.js').Post} */
 function post(message, transfer) {
   if (!renderPort || (message.type !== 'level' && message.type !== 'edges')) {
@@ -38,7 +37,10 @@ function post(message, transfer) {
   }
   renderPort.postMessage(message, transfer);
   if (message.type === 'level') {
-    scope.postMessage({ ...message, positions: NO_FLOATS, normals: NO_SHORTS, colours: null, indices: NO_INDICES, edges: null });
+    const { type, level, vertices, faces, baseBounds, received, decodeMs, deriveMs } = message;
+    /** @type {import('./reconstruction.js').LevelNotice} */
+    const notice = { type, level, vertices, faces, baseBounds, received, decodeMs, deriveMs };
+    scope.postMessage(notice);
   }
 }
 
@@ -56,10 +58,14 @@ scope.onmessage = async (/** @type {MessageEvent<WorkerCommand>} */ event) => {
       return;
     }
     job = new Reconstruction(instance, command.request, post);
+    if (normals !== null) job.setNormals(normals);
     void job.run();
   } else if (command.type === 'extend') {
     job?.extend(command.upTo);
   } else if (command.type === 'wireframe') {
     job?.setWireframe(command.on);
+  } else if (command.type === 'normals') {
+    normals = command.which;
+    job?.setNormals(command.which);
   }
 };

@@ -101,15 +101,43 @@ test('every level arrives in order, equal to a direct decode, with unit normals'
     assert.deepEqual(positions, expected.positions);
     assert.deepEqual(level.indices, expected.indices);
     assert.deepEqual(colours, expected.colours);
-    assert.equal(level.normals.length, 3 * level.vertices);
-    for (let i = 0; i < level.normals.length; i += 3) {
-      const length = Math.hypot(level.normals[i], level.normals[i + 1], level.normals[i + 2]) / 32767;
+    assert.ok(level.normals, `level ${level.level} carries its normals`);
+    const normals = level.normals;
+    assert.equal(normals.length, 3 * level.vertices);
+    for (let i = 0; i < normals.length; i += 3) {
+      const length = Math.hypot(normals[i], normals[i + 1], normals[i + 2]) / 32767;
       assert.ok(Math.abs(length - 1) < 1e-3, `normal ${i / 3} of level ${level.level} has length ${length}`);
     }
   }
   const total = [parts.base, ...parts.batches].reduce((s, p) => s + p.length, 0);
   assert.equal(got[last].received, total);
   assert.ok(got[last].decodeMs > 0);
+});
+
+test("normals: 'last' sends only the level it stops at with normals; 'always' every level from then on", async () => {
+  const svc = service();
+  const cap = 2;
+  const { job, messages } = await reconstruct({ upTo: cap, normals: 'last' }, svc, has('done'));
+  const sent = levels(messages);
+  assert.deepEqual(sent.map((l) => l.level), [...Array(cap + 1).keys()]);
+  for (const level of sent.slice(0, -1)) assert.equal(level.normals, null, `level ${level.level}`);
+  assert.ok(sent.slice(0, -1).every((l) => l.deriveMs === 0), 'nothing derived in the decode worker before the last level');
+  assert.equal(sent[cap].normals?.length, 3 * sent[cap].vertices, 'the level it stops at');
+  job.setNormals('always');
+  messages.length = 0;
+  const done = new Promise((resolve) => {
+    const post = job.post;
+    job.post = (message, transfer) => {
+      post(message, transfer);
+      if (message.type === 'done') resolve(undefined);
+    };
+  });
+  job.extend(cap + 2);
+  await done;
+  const next = levels(messages);
+  assert.deepEqual(next.map((l) => l.level), [cap + 1, cap + 2]);
+  for (const level of next) assert.equal(level.normals?.length, 3 * level.vertices, `level ${level.level}`);
+  job.cancel();
 });
 
 test('batch k + 1 is requested before level k is decoded', async () => {
@@ -202,6 +230,20 @@ test('HTTP and transport failures become network error messages', async () => {
   };
   const transport = await reconstruct({}, down, has('error'));
   assert.match(JSON.stringify(transport.messages.find((m) => m.type === 'error')), /"network".*Failed to fetch/);
+});
+
+test('a 503 with Retry-After on a payload is waited out and the load goes on', async () => {
+  const svc = service({
+    answer: (k, attempt) =>
+      k === 2 && attempt <= 2 ? { status: 503, body: { error: 'database_unavailable', retry_after_s: 0 }, headers: { 'retry-after': '0' } } : null,
+  });
+  const { messages } = await reconstruct({}, svc, has('done'));
+  assert.equal(messages.find((m) => m.type === 'error'), undefined);
+  assert.equal(Math.max(...levels(messages).map((l) => l.level)), last);
+  assert.equal(svc.log.filter((line) => line === 'fetch 2').length, 3);
+  // Without Retry-After a 503 is an error at once.
+  const bare = await reconstruct({}, service({ answer: (k) => (k === 2 ? { status: 503 } : null) }), has('error'));
+  assert.match(JSON.stringify(bare.messages.find((m) => m.type === 'error')), /"network".*503 for the batch 2/);
 });
 
 test('wireframe: each edge of the closed torus once', async () => {

@@ -1,35 +1,19 @@
-//! The decoder's mirror of the conquests: the same gate traversal over the
-//! coarser mesh, reading one code per gate and re-inserting removed vertices.
-
-use std::collections::VecDeque;
+//! The decoder's side of a conquest: the shared gate traversal over the
+//! coarser mesh ([`crate::gates`]) with codes read from the stream, then the
+//! removed vertices' positions and colours, then their re-insertion.
 
 use super::Level;
-use crate::entropy::RangeDecoder;
-use crate::halfedge::{face, next, prev, NONE};
-use crate::patch::{pattern, Pattern, Tag, MAX_VALENCE, NO_TWIN};
-use crate::predict::{
-    decode_colour, gate_context, predict_colour, umbrellas, PassModels, PatchPrediction,
-};
+use crate::entropy::{BitModel, RangeDecoder, SymbolModel};
+use crate::gates::{GateCodes, PassKind, Region, Traversal};
+use crate::halfedge::{face, NONE};
+use crate::patch::MAX_VALENCE;
+use crate::predict::{decode_colour, predict_colour, umbrellas, PassModels, PatchPrediction};
 use crate::{Error, Result};
-
-const FREE: u8 = 0;
-const CONQUERED: u8 = 1;
-
-#[derive(Clone, Copy, PartialEq, Eq)]
-pub(crate) enum PassKind {
-    Decimating,
-    Cleaning,
-}
 
 /// Scratch state reused across passes so a pass allocates nothing per vertex.
 #[derive(Default)]
 pub(crate) struct Scratch {
-    state: Vec<u8>,
-    tag: Vec<Tag>,
-    face_done: Vec<bool>,
-    gates: VecDeque<u32>,
-    /// Patches found by the traversal, inserted once geometry is decoded.
-    pending: Vec<Region>,
+    traversal: Traversal,
     decoded: Vec<([i32; 3], Option<[u8; 3]>)>,
     umbrellas: Vec<[i32; 4]>,
 }
@@ -43,8 +27,20 @@ pub(crate) struct PassInput<'a> {
     pub colour: &'a [u8],
 }
 
+/// Gate codes read from the pass's connectivity section.
+struct StreamCodes<'a>(RangeDecoder<'a>);
+
+impl GateCodes for StreamCodes<'_> {
+    fn decimation(&mut self, model: &mut SymbolModel, limit: usize) -> Result<usize> {
+        Ok(self.0.decode_symbol_below(model, limit))
+    }
+
+    fn cleaning(&mut self, model: &mut BitModel) -> Result<bool> {
+        Ok(self.0.decode_bit(model))
+    }
+}
+
 struct Streams<'a> {
-    conn: RangeDecoder<'a>,
     geom: RangeDecoder<'a>,
     colour: RangeDecoder<'a>,
     models: PassModels,
@@ -60,202 +56,43 @@ impl Level {
                 _ => Err(Error::stream("pass without seeds claims inserted vertices")),
             };
         }
-        let target = n + pass.inserted as usize;
-        scratch.state.clear();
-        scratch.state.resize(n, FREE);
-        scratch.tag.clear();
-        scratch.tag.resize(n, Tag::None);
-        scratch.pending.clear();
-        scratch.face_done.clear();
-        scratch
-            .face_done
-            .resize(self.conn.face_count_slots(), false);
+        // Phase 1: the traversal finds every patch (nothing inserted yet).
+        let mut codes = StreamCodes(RangeDecoder::new(pass.connectivity)?);
+        umbrellas(&self.conn, &self.positions_q, &mut scratch.umbrellas);
+        let traversal = &mut scratch.traversal;
+        traversal.run(
+            &self.conn,
+            &scratch.umbrellas,
+            pass.kind,
+            &pass.seeds,
+            pass.inserted as usize,
+            &mut codes,
+        )?;
+        codes.0.check_overrun()?;
+        if traversal.regions.len() != pass.inserted as usize {
+            return Err(Error::stream(format!(
+                "pass inserted {} vertices, its header says {}",
+                traversal.regions.len(),
+                pass.inserted
+            )));
+        }
         let mut s = Streams {
-            conn: RangeDecoder::new(pass.connectivity)?,
             geom: RangeDecoder::new(pass.geometry)?,
             colour: RangeDecoder::new(pass.colour)?,
             models: PassModels::new(),
         };
-        for &[a, b] in &pass.seeds {
-            if a as usize >= n || b as usize >= n {
-                return Err(Error::stream(
-                    "seed gate names a vertex that does not exist yet",
-                ));
-            }
-            let h = self
-                .conn
-                .find_half_edge(a, b)
-                .ok_or_else(|| Error::stream("seed gate is not an edge of the mesh"))?;
-            if scratch.face_done[face(h) as usize] {
-                return Err(Error::stream("seed gate lies in an already conquered face"));
-            }
-            conquer(scratch, a, Tag::Plus);
-            conquer(scratch, b, Tag::Minus);
-            scratch.gates.push_back(h);
-            while let Some(g) = scratch.gates.pop_front() {
-                self.process_gate(g, pass.kind, target, scratch, &mut s)?;
-            }
-        }
-        if n + scratch.pending.len() != target {
-            return Err(Error::stream(format!(
-                "pass inserted {} vertices, its header says {}",
-                scratch.pending.len(),
-                pass.inserted
-            )));
-        }
         let mut decoded = std::mem::take(&mut scratch.decoded);
         decoded.clear();
-        umbrellas(&self.conn, &self.positions_q, &mut scratch.umbrellas);
-        for r in &scratch.pending {
+        for r in &traversal.regions {
             decoded.push(self.decode_vertex(r, &scratch.umbrellas, &mut s)?);
         }
-        for (r, &(position, colour)) in scratch.pending.iter().zip(&decoded) {
+        debug_assert_eq!(n + decoded.len(), n + pass.inserted as usize);
+        for (r, &(position, colour)) in traversal.regions.iter().zip(&decoded) {
             self.insert_vertex(r, position, colour);
         }
         scratch.decoded = decoded;
-        s.conn.check_overrun()?;
         s.geom.check_overrun()?;
         s.colour.check_overrun()
-    }
-
-    fn process_gate(
-        &mut self,
-        g: u32,
-        kind: PassKind,
-        target: usize,
-        scratch: &mut Scratch,
-        s: &mut Streams,
-    ) -> Result<()> {
-        let f = face(g);
-        if scratch.face_done[f as usize] {
-            return Ok(());
-        }
-        let tag_of =
-            |scratch: &Scratch, v: u32| scratch.tag.get(v as usize).copied().unwrap_or(Tag::None);
-        let t0 = tag_of(scratch, self.conn.origin[g as usize]);
-        let t1 = tag_of(scratch, self.conn.target(g));
-        let front = self.conn.origin[prev(g) as usize];
-        let ctx = gate_context(t0, t1, tag_of(scratch, front));
-        let valence = match kind {
-            PassKind::Decimating => match s.conn.decode_symbol(&mut s.models.valence[ctx]) {
-                0 => 0,
-                sym => sym + 2,
-            },
-            PassKind::Cleaning => {
-                if s.conn.decode_bit(&mut s.models.cleaning[ctx]) {
-                    3
-                } else {
-                    0
-                }
-            }
-        };
-        if valence == 0 {
-            scratch.face_done[f as usize] = true;
-            conquer(scratch, front, Tag::Plus);
-            for h in [next(g), prev(g)] {
-                let t = self.conn.twin[h as usize];
-                if t != NONE {
-                    scratch.gates.push_back(t);
-                }
-            }
-            return Ok(());
-        }
-        if self.vertex_count() + scratch.pending.len() >= target {
-            return Err(Error::stream(
-                "pass inserts more vertices than its header says",
-            ));
-        }
-        let pat = pattern(valence, as_gate_tag(t0), as_gate_tag(t1));
-        let region = self.find_patch(g, pat, scratch)?;
-        self.claim_patch(&region, pat, scratch);
-        scratch.pending.push(region);
-        Ok(())
-    }
-
-    /// Walks the `valence − 2` faces of the retriangulated patch from the gate.
-    fn find_patch(&self, g: u32, pat: &Pattern, scratch: &Scratch) -> Result<Region> {
-        let c = &self.conn;
-        let count = pat.triangle_count();
-        let mut r = Region {
-            valence: pat.valence,
-            polygon: [NONE; MAX_VALENCE],
-            outer: [NONE; MAX_VALENCE],
-            boundary: [NONE; MAX_VALENCE],
-            corner0: [NONE; MAX_VALENCE - 2],
-        };
-        let mut first = g;
-        for _ in 0..pat.gate_corner {
-            first = prev(first);
-        }
-        r.corner0[pat.gate_triangle as usize] = first;
-        let mut stack = [0u8; MAX_VALENCE - 2];
-        stack[0] = pat.gate_triangle;
-        let mut stack_len = 1;
-        while stack_len > 0 {
-            stack_len -= 1;
-            let t = stack[stack_len] as usize;
-            let mut h = r.corner0[t];
-            for k in 0..3 {
-                let corner = 3 * t + k;
-                let local = pat.corner_vertex(corner);
-                let v = c.origin[h as usize];
-                if r.polygon[local] == NONE {
-                    if r.polygon[..pat.valence].contains(&v) {
-                        return Err(Error::stream("patch polygon repeats a vertex"));
-                    }
-                    r.polygon[local] = v;
-                } else if r.polygon[local] != v {
-                    return Err(Error::stream("patch faces do not match their pattern"));
-                }
-                let twin = pat.twin[corner];
-                if twin >= NO_TWIN {
-                    r.outer[(twin - NO_TWIN) as usize] = c.twin[h as usize];
-                    r.boundary[(twin - NO_TWIN) as usize] = h;
-                } else {
-                    let t2 = twin as usize / 3;
-                    if r.corner0[t2] == NONE {
-                        let h2 = c.twin[h as usize];
-                        if h2 == NONE {
-                            return Err(Error::stream("patch crosses a border"));
-                        }
-                        let f2 = face(h2);
-                        if scratch.face_done[f2 as usize]
-                            || r.corner0[..count]
-                                .iter()
-                                .any(|&x| x != NONE && face(x) == f2)
-                        {
-                            return Err(Error::stream("patch overlaps conquered faces"));
-                        }
-                        let mut first = h2;
-                        for _ in 0..twin % 3 {
-                            first = prev(first);
-                        }
-                        r.corner0[t2] = first;
-                        stack[stack_len] = t2 as u8;
-                        stack_len += 1;
-                    }
-                }
-                h = next(h);
-            }
-        }
-        Ok(r)
-    }
-
-    /// Phase 1 of a patch: conquer its faces and border as the encoder did,
-    /// without touching the mesh yet.
-    fn claim_patch(&self, r: &Region, pat: &Pattern, scratch: &mut Scratch) {
-        let d = r.valence;
-        for &h in &r.corner0[..d - 2] {
-            scratch.face_done[face(h) as usize] = true;
-        }
-        for i in 0..d {
-            conquer(scratch, r.polygon[i], pat.tags[i]);
-        }
-        for &o in &r.outer[1..d] {
-            if o != NONE {
-                scratch.gates.push_back(o);
-            }
-        }
     }
 
     /// Phase 2: the removed vertex's position and colour, predicted from the
@@ -330,35 +167,5 @@ impl Level {
             self.conn.out[a as usize] = base + 1;
         }
         self.conn.out[v as usize] = 3 * slots[0];
-    }
-}
-
-struct Region {
-    valence: usize,
-    polygon: [u32; MAX_VALENCE],
-    outer: [u32; MAX_VALENCE],
-    /// The region's own half-edge on each border edge `p_i → p_i+1`.
-    boundary: [u32; MAX_VALENCE],
-    /// Half-edge at corner 0 of each pattern triangle.
-    corner0: [u32; MAX_VALENCE - 2],
-}
-
-fn conquer(scratch: &mut Scratch, v: u32, tag: Tag) {
-    let i = v as usize;
-    if scratch.state[i] == FREE {
-        scratch.state[i] = CONQUERED;
-    }
-    if scratch.tag[i] == Tag::None {
-        scratch.tag[i] = tag;
-    }
-}
-
-/// Gate vertices are always tagged in a well-formed pass; a hostile one
-/// must still not panic, so an untagged vertex reads as `+`.
-fn as_gate_tag(t: Tag) -> Tag {
-    if t == Tag::None {
-        Tag::Plus
-    } else {
-        t
     }
 }

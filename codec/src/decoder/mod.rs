@@ -4,10 +4,11 @@ mod conquest;
 
 use crate::base_mesh;
 use crate::format::{ChunkHeader, Header, Reader, BASE_TAG, BATCH_TAG};
+use crate::gates::PassKind;
 use crate::halfedge::Connectivity;
 use crate::quantize::Quantization;
 use crate::{Error, IndexedMesh, Result};
-use conquest::{PassInput, PassKind, Scratch};
+use conquest::{PassInput, Scratch};
 
 /// Budget a decoder enforces before it allocates or grows anything.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -183,6 +184,10 @@ impl Decoder {
         let grow = (added as usize).min(payload.len().saturating_mul(8));
         self.level.positions_q.reserve(grow);
         self.level.positions.reserve(grow);
+        self.level.conn.out.reserve(grow);
+        if let Some(colours) = &mut self.level.colours {
+            colours.reserve(grow);
+        }
         self.level.conn.origin.reserve(6 * grow);
         self.level.conn.twin.reserve(6 * grow);
         self.level.undo_pass(&cleaning, &mut self.scratch)?;

@@ -3,49 +3,15 @@
 
 use std::collections::VecDeque;
 
+use super::coding::{CoarseMesh, PassRecord};
 use super::{CandidatePatch, PatchGuard};
-use crate::entropy::RangeEncoder;
+pub(crate) use crate::gates::PassKind;
 use crate::halfedge::{face, next, prev, Connectivity, NONE};
 use crate::patch::{pattern, Pattern, Tag, MAX_VALENCE, NO_TWIN};
-use crate::predict::{
-    encode_colour, gate_context, predict_colour, umbrellas, PassModels, PatchPrediction,
-};
-
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(crate) enum PassKind {
-    /// Removes free vertices of valence 3–6.
-    Decimating,
-    /// Removes the valence-3 vertices decimation leaves behind.
-    Cleaning,
-}
 
 const FREE: u8 = 0;
 const CONQUERED: u8 = 1;
 const REMOVED: u8 = 2;
-
-/// What one pass produced, before vertex ids are final.
-pub(crate) struct PassOutput {
-    /// Seed gates as input-vertex pairs, one per connected component.
-    pub seeds: Vec<[u32; 2]>,
-    /// Removed input vertices, in the order the decoder will insert them.
-    pub removed: Vec<u32>,
-    pub connectivity: Vec<u8>,
-    pub geometry: Vec<u8>,
-    pub colour: Vec<u8>,
-}
-
-impl PassOutput {
-    /// A pass that removes nothing: the decoder skips it.
-    pub(crate) fn empty() -> Self {
-        PassOutput {
-            seeds: Vec::new(),
-            removed: Vec::new(),
-            connectivity: Vec::new(),
-            geometry: Vec::new(),
-            colour: Vec::new(),
-        }
-    }
-}
 
 /// The mesh being simplified, with input-vertex ids throughout.
 pub(crate) struct Simplifier<'g> {
@@ -63,7 +29,6 @@ pub(crate) struct Simplifier<'g> {
     state: Vec<u8>,
     tag: Vec<Tag>,
     face_done: Vec<bool>,
-    umbrellas: Vec<[i32; 4]>,
 }
 
 /// A removable vertex and the patch around it.
@@ -74,15 +39,6 @@ struct Patch {
     ring: [u32; MAX_VALENCE],
     polygon: [u32; MAX_VALENCE],
     pattern: &'static Pattern,
-}
-
-struct Streams {
-    /// Removed vertices with their border polygons, coded once the pass is done.
-    patches: Vec<(u32, usize, [u32; MAX_VALENCE])>,
-    conn: RangeEncoder,
-    geom: RangeEncoder,
-    colour: RangeEncoder,
-    models: PassModels,
 }
 
 impl<'g> Simplifier<'g> {
@@ -106,11 +62,12 @@ impl<'g> Simplifier<'g> {
             state: vec![FREE; n],
             tag: vec![Tag::None; n],
             face_done: Vec::new(),
-            umbrellas: Vec::new(),
         }
     }
 
-    pub(crate) fn run_pass(&mut self, kind: PassKind) -> PassOutput {
+    /// Runs one conquest over the mesh, removing what it can; the record
+    /// is coded later against [`Simplifier::coarse_mesh`] taken right after.
+    pub(crate) fn run_pass(&mut self, kind: PassKind) -> PassRecord {
         for (v, s) in self.state.iter_mut().enumerate() {
             *s = if self.conn.out[v] == NONE {
                 REMOVED
@@ -119,24 +76,18 @@ impl<'g> Simplifier<'g> {
             };
         }
         self.tag.fill(Tag::None);
-        if self.patch_guard.is_some() {
+        if self.patch_guard.is_some_and(|g| g.uses_mean_face_area()) {
             self.mean_face_area = self.mean_face_area();
         }
         self.face_done.clear();
         self.face_done.resize(self.conn.face_count_slots(), false);
-        let mut streams = Streams {
-            patches: Vec::new(),
-            conn: RangeEncoder::new(),
-            geom: RangeEncoder::new(),
-            colour: RangeEncoder::new(),
-            models: PassModels::new(),
-        };
-        let mut out = PassOutput {
+        let mut record = PassRecord {
+            kind,
             seeds: Vec::new(),
-            removed: Vec::new(),
-            connectivity: Vec::new(),
-            geometry: Vec::new(),
-            colour: Vec::new(),
+            decisions: Vec::new(),
+            patches: Vec::new(),
+            input_seeds: Vec::new(),
+            input_removed: Vec::new(),
         };
         let mut gates = VecDeque::with_capacity(self.conn.face_count_slots());
         for f in 0..self.conn.face_count_slots() as u32 {
@@ -148,30 +99,25 @@ impl<'g> Simplifier<'g> {
             let (a, b) = (self.conn.origin[h as usize], self.conn.target(h));
             self.conquer(a, Tag::Plus);
             self.conquer(b, Tag::Minus);
-            out.seeds.push([a, b]);
+            record.seeds.push([a, b]);
             gates.push_back(h);
             while let Some(g) = gates.pop_front() {
-                self.process_gate(g, kind, &mut gates, &mut streams, &mut out.removed);
+                self.process_gate(g, kind, &mut gates, &mut record);
             }
         }
-        // Geometry after connectivity: predictions may use the whole coarse
-        // mesh, which is what the decoder has before it inserts anything.
-        let patches = std::mem::take(&mut streams.patches);
-        let mut umbrella_of = std::mem::take(&mut self.umbrellas);
-        if !patches.is_empty() {
-            umbrellas(&self.conn, &self.positions, &mut umbrella_of);
+        let id = |v: u32| self.ids[v as usize];
+        record.input_seeds = record.seeds.iter().map(|s| s.map(id)).collect();
+        record.input_removed = record.patches.iter().map(|p| id(p.0)).collect();
+        record
+    }
+
+    /// The mesh as the last pass left it, for coding that pass.
+    pub(crate) fn coarse_mesh(&self) -> CoarseMesh<'_> {
+        CoarseMesh {
+            conn: &self.conn,
+            positions: &self.positions,
+            colours: self.colours.as_deref(),
         }
-        for (centre, valence, polygon) in patches {
-            self.encode_vertex(centre, &polygon[..valence], &umbrella_of, &mut streams);
-        }
-        self.umbrellas = umbrella_of;
-        for v in out.removed.iter_mut().chain(out.seeds.iter_mut().flatten()) {
-            *v = self.ids[*v as usize];
-        }
-        out.connectivity = streams.conn.finish();
-        out.geometry = streams.geom.finish();
-        out.colour = streams.colour.finish();
-        out
     }
 
     /// Drops dead vertices and face slots so later passes walk dense,
@@ -267,8 +213,7 @@ impl<'g> Simplifier<'g> {
         g: u32,
         kind: PassKind,
         gates: &mut VecDeque<u32>,
-        s: &mut Streams,
-        removed: &mut Vec<u32>,
+        record: &mut PassRecord,
     ) {
         let f = face(g);
         if !self.conn.face_alive(f) || self.face_done[f as usize] {
@@ -277,26 +222,14 @@ impl<'g> Simplifier<'g> {
         let t0 = self.tag[self.conn.origin[g as usize] as usize];
         let t1 = self.tag[self.conn.target(g) as usize];
         if let Some(patch) = self.removable(g, kind, t0, t1) {
-            let pat = patch.pattern;
-            let third = pat
-                .corner_vertex(3 * pat.gate_triangle as usize + (pat.gate_corner as usize + 2) % 3);
-            let ctx = gate_context(t0, t1, self.tag[patch.polygon[third] as usize]);
-            match kind {
-                PassKind::Decimating => s
-                    .conn
-                    .encode_symbol(&mut s.models.valence[ctx], patch.valence - 2),
-                PassKind::Cleaning => s.conn.encode_bit(&mut s.models.cleaning[ctx], true),
-            }
-            s.patches.push((patch.centre, patch.valence, patch.polygon));
-            removed.push(patch.centre);
+            record.decisions.push((patch.valence - 2) as u8);
+            record
+                .patches
+                .push((patch.centre, patch.valence, patch.polygon));
             self.remove(&patch, gates);
         } else {
             let front = self.conn.origin[prev(g) as usize];
-            let ctx = gate_context(t0, t1, self.tag[front as usize]);
-            match kind {
-                PassKind::Decimating => s.conn.encode_symbol(&mut s.models.valence[ctx], 0),
-                PassKind::Cleaning => s.conn.encode_bit(&mut s.models.cleaning[ctx], false),
-            }
+            record.decisions.push(0);
             // Null patch: conquer the front face and go on through its other two edges.
             self.face_done[f as usize] = true;
             self.conquer(front, Tag::Plus);
@@ -449,39 +382,6 @@ impl<'g> Simplifier<'g> {
                 );
                 n[0] * normal[0] + n[1] * normal[1] + n[2] * normal[2] <= 0.0
             })
-    }
-
-    fn encode_vertex(
-        &self,
-        centre: u32,
-        border: &[u32],
-        umbrella_of: &[[i32; 4]],
-        s: &mut Streams,
-    ) {
-        let d = border.len();
-        let mut polygon = [[0i32; 3]; MAX_VALENCE];
-        let mut umbrellas = [[0i32; 4]; MAX_VALENCE];
-        for i in 0..d {
-            polygon[i] = self.positions[border[i] as usize];
-            umbrellas[i] = umbrella_of[border[i] as usize];
-        }
-        PatchPrediction::with_curvature(&polygon[..d], &umbrellas[..d]).encode(
-            self.positions[centre as usize],
-            &mut s.models,
-            &mut s.geom,
-        );
-        if let Some(colours) = &self.colours {
-            let mut colour = [[0u8; 3]; MAX_VALENCE];
-            for (c, &v) in colour.iter_mut().zip(border) {
-                *c = colours[v as usize];
-            }
-            encode_colour(
-                colours[centre as usize],
-                predict_colour(&colour[..d]),
-                &mut s.models,
-                &mut s.colour,
-            );
-        }
     }
 
     /// Removes the patch's centre and retriangulates its polygon by the pattern.

@@ -1,5 +1,6 @@
 //! Mesh → progressive stream.
 
+mod coding;
 mod conquest;
 
 use crate::base_mesh::{self, BaseMesh};
@@ -10,7 +11,8 @@ use crate::halfedge::connectivity;
 use crate::patch::MAX_VALENCE;
 use crate::quantize::Quantization;
 use crate::{Error, IndexedMesh, Result};
-use conquest::{PassKind, PassOutput, Simplifier};
+use coding::{PassOutput, PassSink};
+use conquest::{PassKind, Simplifier};
 
 /// Below this fraction of valence-3 vertices a layer skips its cleaning conquest.
 const CLEANING_MIN_FRACTION: f64 = 0.1;
@@ -38,6 +40,10 @@ pub struct EncodeOptions {
     /// Refuse retriangulations whose new faces fold against the patch
     /// (costs a little connectivity, keeps low levels clean).
     pub geometric_guard: bool,
+    /// Code each pass on a second thread while simplification goes on (the
+    /// same bytes either way; about 40 % of the work moves off the main
+    /// thread, for up to a second mesh's worth of memory).
+    pub pipelined: bool,
 }
 
 impl Default for EncodeOptions {
@@ -49,6 +55,7 @@ impl Default for EncodeOptions {
             max_layers: 64,
             min_layer_fraction: 0.02,
             geometric_guard: true,
+            pipelined: true,
         }
     }
 }
@@ -93,6 +100,12 @@ pub fn encode_with_progress(
 /// know the guard. Deterministic guards keep encoding deterministic.
 pub trait PatchGuard: Sync {
     fn allows(&self, patch: &CandidatePatch<'_>) -> bool;
+
+    /// Whether [`CandidatePatch::mean_face_area`] matters to this guard: it
+    /// costs a sweep over the mesh per pass, so it is 0 unless asked for.
+    fn uses_mean_face_area(&self) -> bool {
+        false
+    }
 }
 
 /// A patch the encoder is about to decimate, in quantized coordinates.
@@ -107,7 +120,8 @@ pub struct CandidatePatch<'a> {
     pub polygon_colours: [[u8; 3]; MAX_VALENCE],
     /// The retriangulation, `valence − 2` counter-clockwise triangles of polygon indices.
     pub triangles: &'a [[u8; 3]],
-    /// Mean face area of the current level (quantization units squared).
+    /// Mean face area of the current level (quantization units squared);
+    /// 0 unless the guard [asks for it](PatchGuard::uses_mean_face_area).
     pub mean_face_area: f64,
 }
 
@@ -159,37 +173,63 @@ pub fn encode_guarded(
         guard,
     );
     let mut layers = Vec::new();
-    while s.live_vertices > target && layers.len() < options.max_layers as usize {
-        let before = s.live_vertices;
-        let decimating = s.run_pass(PassKind::Decimating);
-        // A cleaning traversal costs a code per face; skip it when few
-        // valence-3 vertices exist to be removed (common on irregular scans).
-        let cleaning = if (s.valence_three_vertices() as f64)
-            < CLEANING_MIN_FRACTION * s.live_vertices as f64
-        {
-            PassOutput::empty()
-        } else {
-            s.run_pass(PassKind::Cleaning)
-        };
-        let removed = before - s.live_vertices;
-        if removed == 0 {
-            break;
+    let outputs = std::thread::scope(|scope| -> Result<Vec<PassOutput>> {
+        let mut sink = PassSink::start(scope, options.pipelined);
+        while s.live_vertices > target && layers.len() < options.max_layers as usize {
+            let before = s.live_vertices;
+            let decimating = s.run_pass(PassKind::Decimating);
+            if !sink.send(s.coarse_mesh(), decimating)? {
+                break;
+            }
+            // A cleaning traversal costs a code per face; skip it when few
+            // valence-3 vertices exist to be removed (common on irregular scans).
+            let cleaning = (s.valence_three_vertices() as f64)
+                >= CLEANING_MIN_FRACTION * s.live_vertices as f64;
+            if cleaning {
+                let record = s.run_pass(PassKind::Cleaning);
+                if !sink.send(s.coarse_mesh(), record)? {
+                    break;
+                }
+            }
+            let removed = before - s.live_vertices;
+            if removed == 0 {
+                // Coded, but not kept: pairing below stops at the last layer.
+                break;
+            }
+            layers.push(cleaning);
+            s.compact();
+            progress(EncodeProgress {
+                layer: layers.len() as u32,
+                vertices: s.live_vertices,
+                input_vertices,
+            });
+            if (removed as f64) < before as f64 * options.min_layer_fraction as f64 {
+                break;
+            }
         }
-        layers.push(Layer {
-            decimating,
-            cleaning,
-        });
-        s.compact();
-        progress(EncodeProgress {
-            layer: layers.len() as u32,
-            vertices: s.live_vertices,
-            input_vertices,
-        });
-        if (removed as f64) < before as f64 * options.min_layer_fraction as f64 {
-            break;
-        }
-    }
-    Ok(write_stream(&s, &layers, quantization, &positions, mesh))
+        sink.finish()
+    })?;
+    // Pair the coded passes back into layers (a layer without a cleaning pass gets an empty one).
+    let mut outputs = outputs.into_iter();
+    let mut next = || {
+        outputs
+            .next()
+            .ok_or_else(|| Error::Unsupported("internal error: a pass was not coded".into()))
+    };
+    let coded = layers
+        .iter()
+        .map(|&cleaning| {
+            Ok(Layer {
+                decimating: next()?,
+                cleaning: if cleaning {
+                    next()?
+                } else {
+                    PassOutput::empty()
+                },
+            })
+        })
+        .collect::<Result<Vec<_>>>()?;
+    Ok(write_stream(&s, &coded, quantization, &positions, mesh))
 }
 
 fn write_stream(

@@ -45,6 +45,23 @@ impl SymbolModel {
         }
     }
 
+    /// A model whose symbols all start at frequency `initial` (≥ 1) instead
+    /// of 1: a larger start adapts more slowly, which suits the many sparse
+    /// contexts of a model that is reset often.
+    ///
+    /// # Panics
+    /// If `n_symbols` is not in `2..=64` or `initial` is 0 or too large for the total.
+    pub fn with_initial_frequency(n_symbols: usize, initial: u32) -> Self {
+        let mut model = Self::new(n_symbols);
+        assert!(
+            initial >= 1 && initial * n_symbols as u32 <= MAX_TOTAL,
+            "SymbolModel: initial frequency {initial} out of range"
+        );
+        model.freq[..n_symbols].fill(initial);
+        model.total = initial * n_symbols as u32;
+        model
+    }
+
     /// The alphabet size.
     pub fn n_symbols(&self) -> usize {
         self.n
@@ -91,7 +108,58 @@ impl RangeEncoder {
     }
 }
 
+impl RangeEncoder {
+    /// Code `sym` knowing that the decoder can rule out every symbol from
+    /// `limit` on: the range is split among symbols `0..limit` only, so the
+    /// excluded ones cost nothing. The model still learns `sym`.
+    ///
+    /// # Panics
+    /// If `sym >= limit` or `limit` exceeds the alphabet.
+    #[inline]
+    pub fn encode_symbol_below(&mut self, model: &mut SymbolModel, sym: usize, limit: usize) {
+        assert!(
+            sym < limit && limit <= model.n,
+            "encode_symbol_below: symbol {sym} not below {limit}"
+        );
+        let total: u32 = model.freq[..limit].iter().sum();
+        let cum: u32 = model.freq[..sym].iter().sum();
+        let r = self.range / total;
+        self.low += u64::from(r * cum);
+        let rem = self.range - r * total;
+        let is_last = u32::from(sym + 1 == limit).wrapping_neg();
+        self.range = r * model.freq[sym] + (rem & is_last);
+        self.normalize();
+        model.update(sym);
+    }
+}
+
 impl RangeDecoder<'_> {
+    /// Decode a symbol coded with [`RangeEncoder::encode_symbol_below`] and
+    /// the same `limit`, and update the model. Always returns a symbol below
+    /// `limit` (clamped to the alphabet, and at least 1), whatever the input.
+    #[inline]
+    pub fn decode_symbol_below(&mut self, model: &mut SymbolModel, limit: usize) -> usize {
+        let limit = limit.clamp(1, model.n);
+        let total: u32 = model.freq[..limit].iter().sum();
+        let r = self.range / total;
+        let last = limit - 1;
+        let (mut sym, mut cum, mut next) = (0, 0, 0);
+        for &f in &model.freq[..last] {
+            next += f;
+            let past = u32::from(self.code >= r * next);
+            sym += past as usize;
+            cum += f * past;
+        }
+        // code >= r * cum here, even for corrupt input.
+        self.code -= r * cum;
+        let rem = self.range - r * total;
+        let is_last = u32::from(sym == last).wrapping_neg();
+        self.range = r * model.freq[sym] + (rem & is_last);
+        self.normalize();
+        model.update(sym);
+        sym
+    }
+
     /// Decode a symbol coded with [`RangeEncoder::encode_symbol`] and update
     /// the model. Always returns a symbol `< model.n_symbols()`, whatever the
     /// input.
@@ -230,6 +298,64 @@ mod symbol_tests {
         assert!(m.freq[..64].iter().all(|&f| f >= 1));
         assert!(m.total <= MAX_TOTAL);
         assert_eq!(m.total, m.freq.iter().sum::<u32>());
+    }
+
+    #[test]
+    fn entropy_symbol_below_round_trips_and_excluded_symbols_cost_nothing() {
+        let mut s = 7u64;
+        let n = 5;
+        // Each step admits symbols 0..limit for a random limit and codes one of them.
+        let steps: Vec<(usize, usize)> = (0..20_000)
+            .map(|_| {
+                let limit = 1 + (xorshift(&mut s) % n as u64) as usize;
+                (limit, (xorshift(&mut s) % limit as u64) as usize)
+            })
+            .collect();
+        let mut enc = RangeEncoder::new();
+        let mut m = SymbolModel::with_initial_frequency(n, 16);
+        for &(limit, sym) in &steps {
+            enc.encode_symbol_below(&mut m, sym, limit);
+        }
+        let bytes = enc.finish();
+        let mut dec = RangeDecoder::new(&bytes).unwrap();
+        let mut m = SymbolModel::with_initial_frequency(n, 16);
+        for &(limit, sym) in &steps {
+            assert_eq!(dec.decode_symbol_below(&mut m, limit), sym);
+        }
+        dec.check_overrun().unwrap();
+        // Excluding what the decoder rules out must pay: the same symbols
+        // coded over the whole alphabet cost clearly more, and the cost stays
+        // near log2(limit) per step (the model is adaptive, not told the limit's
+        // uniform law, so a little above).
+        let mut full = RangeEncoder::new();
+        let mut m = SymbolModel::with_initial_frequency(n, 16);
+        for &(_, sym) in &steps {
+            full.encode_symbol(&mut m, sym);
+        }
+        let coded = bytes.len() as f64 * 8.0;
+        let coded_full = full.finish().len() as f64 * 8.0;
+        let ideal: f64 = steps.iter().map(|&(limit, _)| (limit as f64).log2()).sum();
+        assert!(
+            coded < 0.9 * coded_full,
+            "{coded} bits vs {coded_full} without exclusion"
+        );
+        assert!(coded < 1.2 * ideal, "coded {coded} bits, ideal {ideal}");
+    }
+
+    #[test]
+    fn entropy_symbol_below_garbage_decodes_below_the_limit() {
+        let mut st = 3u64;
+        let garbage: Vec<u8> = std::iter::once(0)
+            .chain((0..4000).map(|_| xorshift(&mut st) as u8))
+            .collect();
+        let mut dec = RangeDecoder::new(&garbage).unwrap();
+        let mut m = SymbolModel::new(5);
+        for k in 0..10_000usize {
+            let limit = 1 + k % 5;
+            assert!(dec.decode_symbol_below(&mut m, limit) < limit);
+        }
+        assert_eq!(dec.decode_symbol_below(&mut m, 0), 0);
+        assert!(dec.decode_symbol_below(&mut m, 99) < 5);
     }
 
     #[test]

@@ -54,37 +54,62 @@ impl Hausdorff {
 /// it is infinite, unless the other mesh has no points either (then 0).
 /// Triangles with an out-of-range index are ignored. Runs on every core.
 pub fn hausdorff(a: &IndexedMesh, b: &IndexedMesh, samples_per_mesh: usize) -> Hausdorff {
-    let ta = triangle_corners(a);
-    let tb = triangle_corners(b);
-    let points_a = (
-        sample_surface(&ta, samples_per_mesh, SEED_A),
-        used_vertices(a),
-    );
-    let points_b = (
-        sample_surface(&tb, samples_per_mesh, SEED_B),
-        used_vertices(b),
-    );
-    let bvh_a = TriangleBvh::new(ta);
-    let bvh_b = TriangleBvh::new(tb);
-    let (a_to_b, mean_a_to_b) = one_sided(&points_a, &bvh_b);
-    let (b_to_a, mean_b_to_a) = one_sided(&points_b, &bvh_a);
-    let (mut min, mut max) = (DVec3::INFINITY, DVec3::NEG_INFINITY);
-    for p in &a.positions {
-        let p = DVec3::from(p.map(f64::from));
-        min = min.min(p);
-        max = max.max(p);
+    HausdorffReference::new(a, samples_per_mesh).distance_to(b)
+}
+
+/// The `a` side of [`hausdorff`] prepared once (its samples, its triangle
+/// hierarchy, its diagonal), to measure many meshes — every level of a
+/// stream — against the same original.
+pub struct HausdorffReference {
+    points: (Vec<DVec3>, Vec<DVec3>),
+    bvh: TriangleBvh,
+    samples_per_mesh: usize,
+    diagonal: f64,
+}
+
+impl HausdorffReference {
+    pub fn new(a: &IndexedMesh, samples_per_mesh: usize) -> Self {
+        let ta = triangle_corners(a);
+        let points = (
+            sample_surface(&ta, samples_per_mesh, SEED_A),
+            used_vertices(a),
+        );
+        let (mut min, mut max) = (DVec3::INFINITY, DVec3::NEG_INFINITY);
+        for p in &a.positions {
+            let p = DVec3::from(p.map(f64::from));
+            min = min.min(p);
+            max = max.max(p);
+        }
+        HausdorffReference {
+            points,
+            bvh: TriangleBvh::new(ta),
+            samples_per_mesh,
+            diagonal: if a.positions.is_empty() {
+                0.0
+            } else {
+                (max - min).length()
+            },
+        }
     }
-    Hausdorff {
-        a_to_b,
-        b_to_a,
-        symmetric: a_to_b.max(b_to_a),
-        mean_a_to_b,
-        mean_b_to_a,
-        diagonal: if a.positions.is_empty() {
-            0.0
-        } else {
-            (max - min).length()
-        },
+
+    /// [`hausdorff`]`(a, b, samples_per_mesh)` for the `a` this was made from.
+    pub fn distance_to(&self, b: &IndexedMesh) -> Hausdorff {
+        let tb = triangle_corners(b);
+        let points_b = (
+            sample_surface(&tb, self.samples_per_mesh, SEED_B),
+            used_vertices(b),
+        );
+        let bvh_b = TriangleBvh::new(tb);
+        let (a_to_b, mean_a_to_b) = one_sided(&self.points, &bvh_b);
+        let (b_to_a, mean_b_to_a) = one_sided(&points_b, &self.bvh);
+        Hausdorff {
+            a_to_b,
+            b_to_a,
+            symmetric: a_to_b.max(b_to_a),
+            mean_a_to_b,
+            mean_b_to_a,
+            diagonal: self.diagonal,
+        }
     }
 }
 

@@ -3,6 +3,7 @@
 //! [`ServeLimits::default`] (a test keeps them equal).
 
 use crate::serve::{serve, shutdown_signal, ServeLimits};
+use crate::service::admission::AdmissionConfig;
 use crate::service::cap::CapRules;
 use crate::service::load::LoadConfig;
 use crate::service::{app, AppState, CacheConfig, RequestLimits, ServiceConfig};
@@ -79,6 +80,14 @@ pub struct ServeArgs {
     /// Calm samples before pressure falls one step.
     #[arg(long, env = "VITRINE_LOAD_COOLDOWN_SAMPLES", default_value_t = 8)]
     pub load_cooldown_samples: u32,
+    /// New visitors (manifest requests) admitted per second once
+    /// `--admit-burst` is used up; the rest get 503 `busy` with `Retry-After`
+    /// (0: no admission control).
+    #[arg(long, env = "VITRINE_ADMIT_RATE", default_value_t = 200.0)]
+    pub admit_rate: f64,
+    /// New visitors admitted at once.
+    #[arg(long, env = "VITRINE_ADMIT_BURST", default_value_t = 100.0)]
+    pub admit_burst: f64,
     /// `Retry-After` of load-capped answers.
     #[arg(long, env = "VITRINE_LOAD_RETRY_AFTER_S", default_value_t = 10)]
     pub load_retry_after_s: u64,
@@ -125,6 +134,10 @@ impl ServeArgs {
                 steps: self.load_steps,
                 cooldown_samples: self.load_cooldown_samples,
                 retry_after: Duration::from_secs(self.load_retry_after_s),
+            },
+            admission: AdmissionConfig {
+                rate: self.admit_rate,
+                burst: self.admit_burst,
             },
             cache: CacheConfig {
                 payload_bytes: self.cache_bytes,

@@ -34,6 +34,9 @@ pub enum AppError {
     PayloadTooLarge,
     #[error("service overloaded")]
     Overloaded { retry_after: Duration },
+    /// Too many new visitors at once ([`super::admission`]): come back later.
+    #[error("too many new visitors at once; try again after Retry-After")]
+    Busy { retry_after: Duration },
     #[error("request timed out")]
     Timeout,
     #[error("internal error: {0}")]
@@ -69,7 +72,7 @@ impl AppError {
             AppError::Storage(e) if e.is_unavailable() => StatusCode::SERVICE_UNAVAILABLE,
             AppError::Storage(_) | AppError::Internal(_) => StatusCode::INTERNAL_SERVER_ERROR,
             AppError::PayloadTooLarge => StatusCode::PAYLOAD_TOO_LARGE,
-            AppError::Overloaded { .. } => StatusCode::SERVICE_UNAVAILABLE,
+            AppError::Overloaded { .. } | AppError::Busy { .. } => StatusCode::SERVICE_UNAVAILABLE,
             AppError::Timeout => StatusCode::GATEWAY_TIMEOUT,
         }
     }
@@ -84,6 +87,7 @@ impl AppError {
             AppError::Storage(_) | AppError::Internal(_) => "internal",
             AppError::PayloadTooLarge => "payload_too_large",
             AppError::Overloaded { .. } => "overloaded",
+            AppError::Busy { .. } => "busy",
             AppError::Timeout => "timeout",
         }
     }
@@ -94,7 +98,9 @@ impl AppError {
                 cap, retry_after, ..
             } if cap.reason == Some(CapReason::Load) => Some(*retry_after),
             AppError::Storage(e) if e.is_unavailable() => Some(DATABASE_RETRY_AFTER),
-            AppError::Overloaded { retry_after } => Some(*retry_after),
+            AppError::Overloaded { retry_after } | AppError::Busy { retry_after } => {
+                Some(*retry_after)
+            }
             _ => None,
         }
     }

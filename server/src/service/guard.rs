@@ -6,12 +6,13 @@
 //! stack for every request and every layer nests the response future, which
 //! is then moved around (memmove was 9 % of a cached batch's CPU under perf).
 
+use super::admission::Admit;
 use super::error::{AppError, LoggedError};
 use super::load::InflightGuard;
 use super::AppState;
 use axum::body::{Body, Bytes, HttpBody};
 use axum::extract::{Request, State};
-use axum::http::{header, HeaderValue};
+use axum::http::{header, HeaderValue, Method};
 use axum::middleware::Next;
 use axum::response::{IntoResponse, Response};
 use std::pin::Pin;
@@ -30,35 +31,47 @@ pub async fn admit(State(state): State<AppState>, request: Request, next: Next) 
     let started = Instant::now();
     let route = super::metrics::route_label(&request);
     let limits = &state.config().limits;
-    let mut response = match state.permits().clone().try_acquire_owned() {
-        // All permits taken: shed rather than queue, so latency stays bounded.
-        Err(_) => AppError::Overloaded {
-            retry_after: limits.shed_retry_after,
-        }
-        .into_response(),
-        Ok(_permit) if body_too_large(&request, limits.max_body_bytes) => {
-            AppError::PayloadTooLarge.into_response()
-        }
-        Ok(_permit) => {
-            let inflight = is_data_route(route).then(|| state.load().begin());
-            match tokio::time::timeout(limits.timeout, next.run(request)).await {
-                // The request stays in flight for the load monitor until its
-                // body has gone out: with a crowd, sending is the load, and a
-                // count that ended when the handler returned never saw it.
-                // (The concurrency permit is released now, so a client that
-                // reads slowly cannot hold the service's capacity.)
-                Ok(response) => response.map(|body| {
-                    Body::new(Tracked {
-                        body,
-                        _inflight: inflight,
-                    })
-                }),
-                Err(_) => AppError::Timeout.into_response(),
+    // A new visit during a surge: refused before anything else is spent on it.
+    let admit = if route == "/api/models/{slug}" && request.method() == Method::GET {
+        state.admission().admit()
+    } else {
+        Admit::Yes
+    };
+    let mut response = match admit {
+        Admit::Later(retry_after) => AppError::Busy { retry_after }.into_response(),
+        Admit::Yes => match state.permits().clone().try_acquire_owned() {
+            // All permits taken: shed rather than queue, so latency stays bounded.
+            Err(_) => AppError::Overloaded {
+                retry_after: limits.shed_retry_after,
             }
-        }
+            .into_response(),
+            Ok(_permit) if body_too_large(&request, limits.max_body_bytes) => {
+                AppError::PayloadTooLarge.into_response()
+            }
+            Ok(_permit) => {
+                let inflight = is_data_route(route).then(|| state.load().begin());
+                match tokio::time::timeout(limits.timeout, next.run(request)).await {
+                    // The request stays in flight for the load monitor until its
+                    // body has gone out: with a crowd, sending is the load, and a
+                    // count that ended when the handler returned never saw it.
+                    // (The concurrency permit is released now, so a client that
+                    // reads slowly cannot hold the service's capacity.)
+                    Ok(response) => response.map(|body| {
+                        Body::new(Tracked {
+                            body,
+                            _inflight: inflight,
+                        })
+                    }),
+                    Err(_) => AppError::Timeout.into_response(),
+                }
+            }
+        },
     };
     if let Some(LoggedError(err)) = response.extensions().get::<LoggedError>() {
-        if response.status().is_server_error() {
+        // Refusals under load are expected, and a log line each would add
+        // to the load: they are counted in the metrics instead.
+        let refused = matches!(**err, AppError::Busy { .. } | AppError::Overloaded { .. });
+        if response.status().is_server_error() && !refused {
             tracing::warn!(error = %err, status = %response.status(), route, "request failed");
         } else {
             tracing::debug!(error = %err, status = %response.status(), route, "request refused");

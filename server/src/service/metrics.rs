@@ -55,6 +55,7 @@ pub struct Metrics {
     latency_ewma: Gauge<f64, AtomicU64>,
     queue_ewma: Gauge<f64, AtomicU64>,
     cached_bytes: Gauge,
+    admission_backlog: Gauge<f64, AtomicU64>,
     load_cap: Family<ModelLabels, Gauge>,
     good_enough: Family<ModelLabels, Gauge>,
 }
@@ -72,6 +73,7 @@ impl Default for Metrics {
             latency_ewma: Gauge::default(),
             queue_ewma: Gauge::default(),
             cached_bytes: Gauge::default(),
+            admission_backlog: Gauge::default(),
             load_cap: Family::default(),
             good_enough: Family::default(),
         };
@@ -120,6 +122,11 @@ impl Default for Metrics {
             "payload_cache_bytes",
             "Bytes held by the payload cache",
             m.cached_bytes.clone(),
+        );
+        r.register(
+            "admission_backlog",
+            "New visitors refused with 503 busy and not yet due back",
+            m.admission_backlog.clone(),
         );
         r.register(
             "load_level_cap",
@@ -179,6 +186,7 @@ pub fn render(state: &AppState) -> String {
     m.latency_ewma.set(load.latency_ms);
     m.queue_ewma.set(load.queue_ms);
     m.cached_bytes.set(state.caches().payload_bytes() as i64);
+    m.admission_backlog.set(state.admission().backlog());
     m.load_cap.clear();
     m.good_enough.clear();
     for (slug, load_cap, good_enough) in state.current_load_caps() {

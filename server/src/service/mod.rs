@@ -5,6 +5,7 @@
 //! [`app`] builds the router so tests can drive it in-process; [`crate::serve`]
 //! runs it on a listener.
 
+pub mod admission;
 mod api;
 mod cache;
 pub mod cap;
@@ -24,6 +25,7 @@ pub use layers::RequestLimits;
 pub use visitor::VisitorHints;
 
 use crate::storage::{sha256_hex, ModelRecord, Storage, TokenGrant};
+use admission::{Admission, AdmissionConfig};
 use axum::Router;
 use cache::{through, Caches};
 use cap::{Audience, CapRules, DeviceClass, LevelCap};
@@ -55,6 +57,8 @@ pub const ROUTES: &[&str] = &[
 pub struct ServiceConfig {
     pub caps: CapRules,
     pub load: LoadConfig,
+    /// New visitors per second during a surge ([`admission`]).
+    pub admission: AdmissionConfig,
     pub cache: CacheConfig,
     pub limits: RequestLimits,
     /// The viewer's build (`index.html` and assets); a minimal built-in page
@@ -69,6 +73,7 @@ impl Default for ServiceConfig {
         ServiceConfig {
             caps: CapRules::default(),
             load: LoadConfig::default(),
+            admission: AdmissionConfig::default(),
             cache: CacheConfig::default(),
             limits: RequestLimits::default(),
             web_dir: PathBuf::from("web/dist"),
@@ -95,6 +100,7 @@ struct Inner {
     config: ServiceConfig,
     caches: Caches,
     load: Arc<LoadMonitor>,
+    admission: Admission,
     metrics: Metrics,
     /// The global concurrency limit.
     permits: Arc<Semaphore>,
@@ -107,6 +113,7 @@ impl AppState {
             storage,
             caches: Caches::new(&config.cache),
             load: LoadMonitor::new(config.load.clone()),
+            admission: Admission::new(config.admission.clone()),
             metrics: Metrics::default(),
             permits: Arc::new(Semaphore::new(config.limits.max_concurrency)),
             config,
@@ -128,6 +135,10 @@ impl AppState {
 
     pub fn load(&self) -> &Arc<LoadMonitor> {
         &self.0.load
+    }
+
+    pub fn admission(&self) -> &Admission {
+        &self.0.admission
     }
 
     pub(crate) fn caches(&self) -> &Caches {

@@ -316,6 +316,52 @@ pub async fn database_outage_and_recovery(db: TestDb) {
     );
 }
 
+/// A surge of new visitors: past the burst, manifests get 503 `busy` with
+/// `Retry-After`, visits already under way still get their payloads, and
+/// new visitors are admitted again as the bucket refills.
+pub async fn admission_in_a_surge(db: TestDb) {
+    let id = ingest_sample(&*db.storage, "torus", "open")
+        .await
+        .stored
+        .compression_id;
+    let mut config = test_config();
+    config.admission.burst = 3.0;
+    config.admission.rate = 1.0;
+    let server = TestServer::start(db.storage.clone(), config).await;
+    let http = client();
+    let manifest = server.url("/api/models/torus");
+    let mut statuses = Vec::new();
+    let mut retry_after = Vec::new();
+    for _ in 0..7 {
+        let reply = http.get(&manifest).send().await.unwrap();
+        statuses.push(reply.status().as_u16());
+        if reply.status() == StatusCode::SERVICE_UNAVAILABLE {
+            let after: u64 = reply.headers()["retry-after"]
+                .to_str()
+                .unwrap()
+                .parse()
+                .unwrap();
+            retry_after.push(after);
+            let body: serde_json::Value = reply.json().await.unwrap();
+            assert_eq!(body["error"], "busy");
+        }
+    }
+    assert_eq!(&statuses[..3], &[200, 200, 200]);
+    assert!(statuses[3..].iter().all(|s| *s == 503), "{statuses:?}");
+    // Each refused visitor is told its turn: ⌈place in the backlog / rate⌉ s.
+    assert_eq!(retry_after, vec![1, 2, 3, 4]);
+    let batch = server.url(&format!("/api/compressions/{id}/batches/1"));
+    assert_eq!(
+        http.get(&batch).send().await.unwrap().status(),
+        StatusCode::OK
+    );
+    tokio::time::sleep(Duration::from_millis(1100)).await;
+    assert_eq!(
+        http.get(&manifest).send().await.unwrap().status(),
+        StatusCode::OK
+    );
+}
+
 pub async fn shedding_and_body_limit(db: TestDb) {
     let id = ingest_sample(&*db.storage, "torus", "open")
         .await

@@ -56,6 +56,7 @@ on_both_backends!(
     http::load_cap_under_real_load,
     http::database_outage_and_recovery,
     http::shedding_and_body_limit,
+    http::admission_in_a_surge,
     http::graceful_shutdown,
     kill::killed_ingest_leaves_nothing,
     colour::ccc_mapping_stored_and_served,

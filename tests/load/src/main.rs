@@ -12,6 +12,7 @@
 
 mod faults;
 mod hostile;
+mod http;
 mod report;
 mod server;
 mod sim;
@@ -209,9 +210,16 @@ struct Results {
 
 fn main() -> Result<()> {
     let cli = Cli::parse();
-    let runtime = tokio::runtime::Builder::new_multi_thread()
-        .enable_all()
-        .build()?;
+    let mut builder = tokio::runtime::Builder::new_multi_thread();
+    // Worker threads (default: one per core). The harness shares the cores
+    // with the server it measures.
+    if let Some(n) = std::env::var("VITRINE_LOAD_THREADS")
+        .ok()
+        .and_then(|v| v.parse::<usize>().ok())
+    {
+        builder.worker_threads(n.max(1));
+    }
+    let runtime = builder.enable_all().build()?;
     runtime.block_on(async {
         match cli.command {
             Command::Run(args) => run(args).await,
@@ -417,9 +425,10 @@ async fn run(args: RunArgs) -> Result<()> {
                 sum.pattern = args.pattern.to_string();
                 sum.run = run;
                 eprintln!(
-                    "caps {caps}, {n} visitors, run {run}: p99 {:.1} ms, reconstruction median {:.2} s (× {:.2} lone, p95 × {:.2}), {} load-capped, errors {:?}, server CPU {:.1} s, peak RSS {:.0} MiB, wall {:.1} s",
-                    sum.p99_ms, sum.recon_median_s, sum.ratio_median, sum.ratio_p95,
-                    sum.load_capped, sum.errors, sum.server_cpu_s, sum.server_peak_rss_mib, sum.wall_s
+                    "caps {caps}, {n} visitors, run {run}: p99 {:.1} ms (200/304 only {:.1}, to head {:.1}), reconstruction median {:.2} s (× {:.2} lone, p95 × {:.2}; with the admission wait × {:.2} / {:.2}), {} refused at admission (wait ≤ {:.1} s), {} load-capped, errors {:?}, server CPU {:.1} s, harness CPU {:.1} s, peak RSS {:.0} MiB, wall {:.1} s",
+                    sum.p99_ms, sum.p99_ok_ms, sum.head_p99_ms, sum.recon_median_s, sum.ratio_median, sum.ratio_p95,
+                    sum.ratio_wait_median, sum.ratio_wait_p95, sum.admission_refused, sum.admission_wait_max_s,
+                    sum.load_capped, sum.errors, sum.server_cpu_s, sum.harness_cpu_s, sum.server_peak_rss_mib, sum.wall_s
                 );
                 for (status, count) in &sum.errors {
                     if status != "429" && status != "503" {
@@ -541,8 +550,8 @@ async fn crowd(args: CrowdArgs) -> Result<()> {
         println!("| {:.1} | {} |", (*b * width) as f64 / 1e6, c.join(", "));
     }
     println!(
-        "\n{} visitors ({} completed, {} failed), {} requests, p50 {:.1} ms, p99 {:.1} ms, max {:.1} ms, {:.1} MB, non-2xx {:?}, max load pressure {}",
-        sum.visitors, sum.completed, sum.failed, sum.requests, sum.p50_ms, sum.p99_ms, sum.max_ms,
+        "\n{} visitors ({} completed, {} failed, {} refused at admission), {} requests, p50 {:.1} ms, p99 {:.1} ms, max {:.1} ms, {:.1} MB, non-2xx {:?}, max load pressure {}",
+        sum.visitors, sum.completed, sum.failed, sum.admission_refused, sum.requests, sum.p50_ms, sum.p99_ms, sum.max_ms,
         sum.bytes as f64 / 1e6, sum.errors, sum.pressure_max
     );
 
@@ -629,7 +638,7 @@ async fn crowd(args: CrowdArgs) -> Result<()> {
         }
     }
     if let Some(path) = &args.json {
-        let v = serde_json::json!({ "summary": sum, "timeline": timeline });
+        let v = serde_json::json!({ "summary": sum, "timeline": timeline, "requests": outcome.requests });
         std::fs::write(path, serde_json::to_vec_pretty(&v)?)?;
     }
     if !violations.is_empty() {

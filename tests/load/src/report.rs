@@ -52,6 +52,23 @@ pub struct Summary {
     pub ratio_median: f64,
     pub ratio_p95: f64,
     pub ratio_max: f64,
+    /// The same, counting the wait for admission (503 `busy` and its
+    /// `Retry-After`) as part of the visitor's time.
+    #[serde(default)]
+    pub ratio_wait_median: f64,
+    #[serde(default)]
+    pub ratio_wait_p95: f64,
+    /// Visitors refused at least once at admission, and their wait.
+    #[serde(default)]
+    pub admission_refused: usize,
+    #[serde(default)]
+    pub admission_wait_median_s: f64,
+    #[serde(default)]
+    pub admission_wait_max_s: f64,
+    /// p99 over the requests answered 200/304 only (the p99 above covers
+    /// every request, refusals included).
+    #[serde(default)]
+    pub p99_ok_ms: f64,
     pub completed: usize,
     pub failed: usize,
     /// Public desktop visitors: median level reached.
@@ -115,13 +132,24 @@ pub fn summarize(outcome: &CrowdOutcome, baselines: &Baselines) -> Summary {
     );
     let done: Vec<&VisitorResult> = outcome.visitors.iter().filter(|v| v.complete()).collect();
     let recon = sorted(done.iter().filter_map(|v| v.total_ms()).collect());
-    let ratios = sorted(
-        done.iter()
-            .filter_map(|v| {
-                let level = v.reached()?;
-                let alone = baselines.time(v.device?, v.audience?, level)?;
-                Some(v.total_ms()? / alone)
-            })
+    // × lone visitor, from admission and counting the wait for it.
+    let (ratios, ratios_wait): (Vec<f64>, Vec<f64>) = done
+        .iter()
+        .filter_map(|v| {
+            let alone = baselines.time(v.device?, v.audience?, v.reached()?)?;
+            let time = v.total_ms()?;
+            Some((time / alone, (time + v.admission_wait_ms) / alone))
+        })
+        .unzip();
+    let (ratios, ratios_wait) = (sorted(ratios), sorted(ratios_wait));
+    let refused: Vec<&VisitorResult> = outcome.visitors.iter().filter(|v| v.refusals > 0).collect();
+    let waits = sorted(refused.iter().map(|v| v.admission_wait_ms / 1e3).collect());
+    let ok = sorted(
+        outcome
+            .requests
+            .iter()
+            .filter(|r| matches!(r.status, 200 | 304))
+            .map(|r| r.dur_us as f64 / 1e3)
             .collect(),
     );
     let levels = sorted(
@@ -173,6 +201,16 @@ pub fn summarize(outcome: &CrowdOutcome, baselines: &Baselines) -> Summary {
         ratio_median: percentile(&ratios, 50.0),
         ratio_p95: percentile(&ratios, 95.0),
         ratio_max: ratios.last().copied().unwrap_or(f64::NAN),
+        ratio_wait_median: percentile(&ratios_wait, 50.0),
+        ratio_wait_p95: percentile(&ratios_wait, 95.0),
+        admission_refused: refused.len(),
+        admission_wait_median_s: if waits.is_empty() {
+            0.0
+        } else {
+            percentile(&waits, 50.0)
+        },
+        admission_wait_max_s: waits.last().copied().unwrap_or(0.0),
+        p99_ok_ms: percentile(&ok, 99.0),
         completed: done.len(),
         failed: outcome.visitors.len() - done.len(),
         public_desktop_level: percentile(&levels, 50.0),
@@ -198,8 +236,8 @@ pub fn median_of(runs: &[Summary]) -> Summary {
         .iter()
         .map(|r| {
             format!(
-                "{:.0} ms, ×{:.2}, {} capped",
-                r.p99_ms, r.ratio_p95, r.load_capped
+                "{:.0} ms, ×{:.2}, {} capped, {} refused",
+                r.p99_ms, r.ratio_p95, r.load_capped, r.admission_refused
             )
         })
         .collect::<Vec<_>>()
@@ -219,14 +257,14 @@ fn map(m: &BTreeMap<impl std::fmt::Display, usize>) -> String {
 
 pub fn markdown(rows: &[Summary]) -> String {
     let mut s = String::new();
-    s.push_str("| caps | visitors | arrivals | requests | p50 ms | p95 ms | p99 ms | p99 to response head ms | reconstruction median / p95 s | × lone visitor, median / p95 | public desktop level (median) | load-capped visitors (at level: n) | failed visitors | non-2xx answers | bytes served | server CPU s (% of a core) | server peak RSS MiB | harness CPU s | max pressure | every run: p99, p95 × lone, load-capped |\n");
+    s.push_str("| caps | visitors | arrivals | requests | p50 ms | p95 ms | p99 ms | p99 to response head ms | p99 of 200/304 ms | reconstruction median / p95 s | × lone visitor, median / p95 | × lone counting the admission wait, median / p95 | refused at admission (max wait s) | public desktop level (median) | load-capped visitors (at level: n) | failed visitors | non-2xx answers | bytes served | server CPU s (% of a core) | server peak RSS MiB | harness CPU s | max pressure | every run: p99, p95 × lone, load-capped |\n");
     s.push_str(
-        "|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---|---:|---|---:|---:|---:|---:|---:|\n",
+        "|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|---:|---|---:|---:|---:|---:|---:|---|\n",
     );
     for r in rows {
         let _ = writeln!(
             s,
-            "| {} | {} | {} | {} | {:.1} | {:.1} | {:.1} | {:.1} | {:.2} / {:.2} | {:.2} / {:.2} | {} | {} ({}) | {} | {} | {:.1} MB | {:.1} ({:.0} %) | {:.0} | {:.1} | {} | {} |",
+            "| {} | {} | {} | {} | {:.1} | {:.1} | {:.1} | {:.1} | {:.1} | {:.2} / {:.2} | {:.2} / {:.2} | {:.2} / {:.2} | {} ({:.1}) | {} | {} ({}) | {} | {} | {:.1} MB | {:.1} ({:.0} %) | {:.0} | {:.1} | {} | {} |",
             r.caps,
             r.visitors,
             r.pattern,
@@ -235,10 +273,15 @@ pub fn markdown(rows: &[Summary]) -> String {
             r.p95_ms,
             r.p99_ms,
             r.head_p99_ms,
+            r.p99_ok_ms,
             r.recon_median_s,
             r.recon_p95_s,
             r.ratio_median,
             r.ratio_p95,
+            r.ratio_wait_median,
+            r.ratio_wait_p95,
+            r.admission_refused,
+            r.admission_wait_max_s,
             r.public_desktop_level,
             r.load_capped,
             map(&r.load_capped_levels),

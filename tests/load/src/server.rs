@@ -6,8 +6,11 @@ use std::path::{Path, PathBuf};
 use std::process::Stdio;
 use std::time::{Duration, Instant};
 
-/// Flags that put the load thresholds out of reach (as scripts/bench-service.sh).
+/// Flags that put the load thresholds out of reach (as scripts/bench-service.sh)
+/// and turn admission control off: the service without load protection.
 pub const CAPS_OFF: &[&str] = &[
+    "--admit-rate",
+    "0",
     "--load-high-inflight",
     "1000000000",
     "--load-high-latency-ms",

@@ -7,8 +7,8 @@
 //! A 403/429 `level_capped` answer stops the visitor at the level it has, as
 //! in the viewer; any other failure ends the visit.
 
+use crate::http::Conn;
 use anyhow::{Context, Result};
-use reqwest::header::{HeaderMap, HeaderValue, AUTHORIZATION, RETRY_AFTER};
 use reqwest::Client;
 use serde::{Deserialize, Serialize};
 use std::sync::atomic::{AtomicBool, AtomicU8, Ordering};
@@ -223,6 +223,13 @@ pub struct VisitorResult {
     /// A batch refused with 403/429: (level, status, reason).
     pub refused: Option<(u32, u16, Option<String>)>,
     pub failure: Option<String>,
+    /// From arrival to the manifest request that was admitted (after 503
+    /// `busy` answers and their `Retry-After`); `level_ms` counts from there.
+    #[serde(default)]
+    pub admission_wait_ms: f64,
+    /// 503 answers before the manifest was admitted.
+    #[serde(default)]
+    pub refusals: u32,
 }
 
 impl VisitorResult {
@@ -284,12 +291,25 @@ struct Fetched {
     req: Req,
     body: Option<Vec<u8>>,
     error: Option<String>,
+    retry_after_s: Option<f64>,
+}
+
+/// Most 503 answers one request is retried after.
+const MAX_RETRIES: u32 = 60;
+
+/// A deterministic uniform number in [0, 1) for (visitor, attempt).
+fn jitter(visitor: usize, attempt: u32) -> f64 {
+    let mut z = (visitor as u64) << 32 ^ u64::from(attempt) ^ 0x9e37_79b9_7f4a_7c15;
+    z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+    z ^= z >> 31;
+    (z >> 11) as f64 / (1u64 << 53) as f64
 }
 
 impl Visit {
     /// One request; the body is kept only when asked or when it is an error
     /// answer, else counted and dropped as it streams in.
-    async fn fetch(&self, client: &Client, kind: Kind, path: &str, keep: bool) -> Fetched {
+    async fn fetch(&self, conn: &mut Conn, kind: Kind, path: &str, keep: bool) -> Fetched {
         let start = Instant::now();
         let mut req = Req {
             kind,
@@ -300,40 +320,61 @@ impl Visit {
             retry_after: false,
             bytes: 0,
         };
-        let url = format!("{}{}", self.config.base_url, path);
-        let mut body = None;
-        let mut error = None;
-        match client.get(&url).send().await {
-            Err(e) => error = Some(format!("{kind:?}: {e}")),
-            Ok(mut response) => {
-                req.head_us = start.elapsed().as_micros() as u64;
-                req.status = response.status().as_u16();
-                req.retry_after = response.headers().contains_key(RETRY_AFTER);
-                let keep = keep || !response.status().is_success();
-                let mut kept = Vec::new();
-                loop {
-                    match response.chunk().await {
-                        Ok(Some(chunk)) => {
-                            req.bytes += chunk.len() as u64;
-                            if keep {
-                                kept.extend_from_slice(&chunk);
-                            }
-                        }
-                        Ok(None) => break,
-                        Err(e) => {
-                            error = Some(format!("{kind:?} body cut off: {e}"));
-                            req.status = 0;
-                            break;
-                        }
-                    }
-                }
-                if keep {
-                    body = Some(kept);
+        let answer = tokio::time::timeout(self.config.request_timeout, conn.get(path, keep)).await;
+        req.dur_us = start.elapsed().as_micros() as u64;
+        match answer {
+            Ok(Ok(a)) => {
+                req.head_us = a.head.as_micros() as u64;
+                req.status = a.status;
+                req.retry_after = a.retry_after_s.is_some();
+                req.bytes = a.bytes;
+                Fetched {
+                    req,
+                    body: a.body,
+                    error: None,
+                    retry_after_s: a.retry_after_s,
                 }
             }
+            Ok(Err(e)) => Fetched {
+                req,
+                body: None,
+                error: Some(format!("{kind:?}: {e}")),
+                retry_after_s: None,
+            },
+            Err(_) => Fetched {
+                req,
+                body: None,
+                error: Some(format!("{kind:?}: timed out")),
+                retry_after_s: None,
+            },
         }
-        req.dur_us = start.elapsed().as_micros() as u64;
-        Fetched { req, body, error }
+    }
+
+    /// [`Self::fetch`], again after `Retry-After` (plus 0–1 s of jitter)
+    /// while the answer is 503 with `Retry-After`, as the viewer does: the
+    /// refused attempts go to `reqs`.
+    async fn fetch_retrying(
+        &self,
+        conn: &mut Conn,
+        kind: Kind,
+        path: &str,
+        keep: bool,
+        who: usize,
+        reqs: &mut Vec<Req>,
+    ) -> Fetched {
+        let mut attempt = 0;
+        loop {
+            let f = self.fetch(conn, kind, path, keep).await;
+            match f.retry_after_s {
+                Some(after) if f.req.status == 503 && attempt < MAX_RETRIES => {
+                    reqs.push(f.req);
+                    attempt += 1;
+                    let wait = Duration::from_secs_f64(after.max(0.0) + jitter(who, attempt));
+                    tokio::time::sleep(wait).await;
+                }
+                _ => return f,
+            }
+        }
     }
 
     async fn decode_wait(&self, level: usize, device: Device) {
@@ -347,42 +388,30 @@ impl Visit {
 
     async fn run(
         self: Arc<Self>,
+        who: usize,
         device: Device,
         audience: Audience,
         arrive: Duration,
     ) -> (VisitorResult, Vec<Req>) {
         tokio::time::sleep_until((self.epoch + arrive).into()).await;
+        let arrived = Instant::now();
         let mut result = VisitorResult {
             device: Some(device),
             audience: Some(audience),
-            arrive_ms: self.epoch.elapsed().as_secs_f64() * 1e3,
+            arrive_ms: arrived.duration_since(self.epoch).as_secs_f64() * 1e3,
             ..VisitorResult::default()
         };
         let mut reqs = Vec::with_capacity(16);
-        let mut headers = HeaderMap::new();
-        if audience == Audience::Researcher {
-            if let Some(token) = &self.config.token {
-                if let Ok(v) = HeaderValue::from_str(&format!("Bearer {token}")) {
-                    headers.insert(AUTHORIZATION, v);
-                }
-            }
-        }
-        let client = match Client::builder()
-            .user_agent(device.user_agent())
-            .default_headers(headers)
-            .tcp_nodelay(true)
-            .pool_max_idle_per_host(2)
-            .connect_timeout(Duration::from_secs(10))
-            .timeout(self.config.request_timeout)
-            .build()
-        {
-            Ok(c) => c,
-            Err(e) => {
-                result.failure = Some(format!("client: {e}"));
-                return (result, reqs);
-            }
+        let authorization = match (audience, &self.config.token) {
+            (Audience::Researcher, Some(token)) => Some(format!("Bearer {token}")),
+            _ => None,
         };
-        let t0 = Instant::now();
+        let mut conn = Conn::new(
+            &self.config.base_url,
+            device.user_agent(),
+            authorization.as_deref(),
+            Duration::from_secs(10),
+        );
         let fail = |result: &mut VisitorResult, f: &Fetched, what: &str| {
             result.failure = Some(
                 f.error
@@ -391,9 +420,17 @@ impl Visit {
             );
         };
 
+        // Admission: the manifest, again after each 503 `busy` (Retry-After).
         let path = format!("/api/models/{}", self.config.slug);
-        let m = self.fetch(&client, Kind::Manifest, &path, true).await;
+        let m = self
+            .fetch_retrying(&mut conn, Kind::Manifest, &path, true, who, &mut reqs)
+            .await;
         reqs.push(m.req);
+        // Reconstruction is timed from the request that was admitted; the
+        // wait before it is kept apart.
+        let t0 = self.epoch + Duration::from_micros(m.req.start_us);
+        result.admission_wait_ms = t0.duration_since(arrived).as_secs_f64() * 1e3;
+        result.refusals = reqs.len() as u32 - 1;
         let manifest: serde_json::Value = match (&m.body, m.req.status) {
             (Some(b), 200) => serde_json::from_slice(b).unwrap_or_default(),
             _ => {
@@ -420,13 +457,9 @@ impl Visit {
         }
         if let Some(textures) = manifest["textures"].as_array() {
             for t in textures {
+                let url = t["url"].as_str().unwrap_or("");
                 let f = self
-                    .fetch(
-                        &client,
-                        Kind::Texture,
-                        t["url"].as_str().unwrap_or(""),
-                        false,
-                    )
+                    .fetch_retrying(&mut conn, Kind::Texture, url, false, who, &mut reqs)
                     .await;
                 reqs.push(f.req);
                 if f.req.status != 200 {
@@ -436,7 +469,9 @@ impl Visit {
             }
         }
 
-        let base = self.fetch(&client, Kind::Base, &urls[0], false).await;
+        let base = self
+            .fetch_retrying(&mut conn, Kind::Base, &urls[0], false, who, &mut reqs)
+            .await;
         reqs.push(base.req);
         if base.req.status != 200 {
             fail(&mut result, &base, "base");
@@ -445,17 +480,25 @@ impl Visit {
         self.decode_wait(0, device).await;
         result.level_ms.push(t0.elapsed().as_secs_f64() * 1e3);
 
-        let mut prefetch: Option<tokio::task::JoinHandle<Fetched>> = None;
+        type Prefetch = (Fetched, Conn, Vec<Req>);
+        let mut prefetch: Option<tokio::task::JoinHandle<Prefetch>> = None;
         for k in 1..=result.target as usize {
             let f = match prefetch.take() {
                 Some(handle) => match handle.await {
-                    Ok(f) => f,
+                    Ok((f, c, retried)) => {
+                        conn = c;
+                        reqs.extend(retried);
+                        f
+                    }
                     Err(e) => {
                         result.failure = Some(format!("prefetch task: {e}"));
                         break;
                     }
                 },
-                None => self.fetch(&client, Kind::Batch, &urls[k], false).await,
+                None => {
+                    self.fetch_retrying(&mut conn, Kind::Batch, &urls[k], false, who, &mut reqs)
+                        .await
+                }
             };
             reqs.push(f.req);
             if f.req.status == 403 || f.req.status == 429 {
@@ -475,9 +518,18 @@ impl Visit {
                 break;
             }
             if k < result.target as usize {
-                let (visit, client, url) = (Arc::clone(&self), client.clone(), urls[k + 1].clone());
+                let visit = Arc::clone(&self);
+                let url = urls[k + 1].clone();
+                let mut c = std::mem::replace(
+                    &mut conn,
+                    Conn::new(&self.config.base_url, "", None, Duration::ZERO),
+                );
                 prefetch = Some(tokio::spawn(async move {
-                    visit.fetch(&client, Kind::Batch, &url, false).await
+                    let mut retried = Vec::new();
+                    let f = visit
+                        .fetch_retrying(&mut c, Kind::Batch, &url, false, who, &mut retried)
+                        .await;
+                    (f, c, retried)
                 }));
             }
             self.decode_wait(k, device).await;
@@ -527,7 +579,7 @@ pub async fn run_crowd(config: CrowdConfig, profile: Arc<DecodeProfile>) -> Resu
             }
             seen.push(pair);
             let start = epoch.elapsed();
-            let (r, q) = Arc::clone(&visit).run(pair.0, pair.1, start).await;
+            let (r, q) = Arc::clone(&visit).run(i, pair.0, pair.1, start).await;
             visitors.push(r);
             requests.extend(q);
         }
@@ -536,7 +588,7 @@ pub async fn run_crowd(config: CrowdConfig, profile: Arc<DecodeProfile>) -> Resu
         for i in 0..config.visitors {
             let (device, audience) = mix(i, config.tablet_share, config.researcher_share);
             let arrive = config.pattern.arrival(i, config.visitors);
-            set.spawn(Arc::clone(&visit).run(device, audience, arrive));
+            set.spawn(Arc::clone(&visit).run(i, device, audience, arrive));
         }
         while let Some(joined) = set.join_next().await {
             let (r, q) = joined.context("visitor task")?;
