@@ -1,11 +1,12 @@
 //! Residuals in the patch's local Frenet frame, losslessly (AD01 §4;
 //! Lee, Lavoué & Dupont 2009 make the rotation integer-to-integer).
 //!
-//! The frame's third axis is the patch normal; the two tangential axes are
-//! left where two Givens rotations put them. (Aligning the first with the
-//! gate edge, as AD01 does, changed no stream by more than 0.01 bit/vertex
-//! here: both tangential components share one adaptive model, so their
-//! orientation hardly matters, and the third rotation cost 1/3 of the time.)
+//! The frame's third axis is the patch normal (two Givens rotations); a
+//! third rotation in the tangent plane turns the first tangent onto the
+//! border polygon's major axis, so that each tangential component can be
+//! coded by the polygon's spread along it. (Aligning the first tangent with
+//! the gate edge, as AD01 does, gained nothing: the edge's direction says
+//! little about where the removed vertex lies; the major axis does.)
 //! Each Givens rotation is applied as three lifting shears with rounding,
 //! so the integer map is a bijection.
 //! Only `+ − × / sqrt` on `f64` are used: IEEE 754 makes them bit-identical
@@ -89,17 +90,37 @@ pub(crate) fn round(x: f64) -> i64 {
 pub(crate) struct Frame {
     xy: Givens,
     zx: Givens,
+    /// In the tangent plane: the major axis onto the first tangent.
+    plane: Givens,
 }
 
 impl Frame {
     /// `normal` need not be unit length; a zero vector gives the identity.
+    /// The tangents are left where the two rotations put them.
     pub(crate) fn new(normal: [i64; 3]) -> Frame {
         let n = normal.map(|c| c as f64);
         let xy = Givens::aligning(n[0], n[1]);
         let (nx, _) = xy.apply_f64(n[0], n[1]);
         // Second rotation brings the normal onto +z: align (z, x) onto the z axis.
         let zx = Givens::aligning(n[2], nx);
-        Frame { xy, zx }
+        Frame {
+            xy,
+            zx,
+            plane: Givens::aligning(0.0, 0.0),
+        }
+    }
+
+    /// Coordinates of a world vector in the tangent plane (before
+    /// [`Frame::align_tangent`]), in f64.
+    pub(crate) fn tangent_f64(&self, v: [f64; 3]) -> (f64, f64) {
+        let (x, y) = self.xy.apply_f64(v[0], v[1]);
+        let (_, x) = self.zx.apply_f64(v[2], x);
+        (x, y)
+    }
+
+    /// Turns the first tangent onto the direction `(x, y)` of the tangent plane.
+    pub(crate) fn align_tangent(&mut self, x: f64, y: f64) {
+        self.plane = Givens::aligning(x, y);
     }
 
     /// World residual → (tangent, bitangent, normal).
@@ -107,11 +128,13 @@ impl Frame {
         let [mut x, mut y, mut z] = r;
         self.xy.forward(&mut x, &mut y);
         self.zx.forward(&mut z, &mut x);
+        self.plane.forward(&mut x, &mut y);
         [x, y, z]
     }
 
     pub(crate) fn to_world(self, l: [i64; 3]) -> [i64; 3] {
         let [mut x, mut y, mut z] = l;
+        self.plane.inverse(&mut x, &mut y);
         self.zx.inverse(&mut z, &mut x);
         self.xy.inverse(&mut x, &mut y);
         [x, y, z]
@@ -135,8 +158,10 @@ mod tests {
         for _ in 0..20_000 {
             let n = [lcg(&mut seed), lcg(&mut seed), lcg(&mut seed)];
             let r = [lcg(&mut seed) / 8, lcg(&mut seed) / 8, lcg(&mut seed) / 8];
-            let f = Frame::new(n);
+            let mut f = Frame::new(n);
             assert_eq!(f.to_world(f.to_local(r)), r, "n {n:?}");
+            f.align_tangent(lcg(&mut seed) as f64, lcg(&mut seed) as f64);
+            assert_eq!(f.to_world(f.to_local(r)), r, "n {n:?}, aligned");
         }
     }
 

@@ -4,7 +4,7 @@
 use crate::entropy::{IntModel, RangeDecoder, RangeEncoder};
 use crate::frenet::{round, Frame};
 use crate::halfedge::Connectivity;
-use crate::patch::Tag;
+use crate::patch::{Tag, MAX_VALENCE};
 
 /// Context for a gate's code: the tags of its two vertices and of the
 /// third vertex of its front face *as the decoder sees it* (the coarse
@@ -19,9 +19,14 @@ pub(crate) fn gate_context(t0: Tag, t1: Tag, third: Tag) -> usize {
 
 pub(crate) const GATE_CONTEXTS: usize = 27;
 
-/// Residual magnitude grows with the patch's size: code each size class
-/// (≈ log2 of the mean border edge length) with its own models.
-pub(crate) const SCALE_CLASSES: usize = 16;
+/// Residual magnitude grows with the patch's size. Tangential components
+/// are coded by the spread of the border polygon along their own axis
+/// (⌊log₂⌋ of its variance there: half-octave classes of a length), the
+/// normal one by ⌊log₂⌋ of the root mean squared border edge length (octave
+/// classes: finer ones cost more in learning than they gain). Both cover
+/// 16-bit quantization.
+pub(crate) const TANGENT_CLASSES: usize = 36;
+pub(crate) const NORMAL_CLASSES: usize = 18;
 /// Adaptive geometry and colour models of one conquest pass; reset per
 /// pass so every batch decodes on its own given the previous level (AD01
 /// resets per layer too). Connectivity models are in [`crate::gates`].
@@ -34,18 +39,25 @@ pub(crate) struct PassModels {
 impl PassModels {
     pub(crate) fn new() -> Self {
         PassModels {
-            tangent: (0..SCALE_CLASSES).map(|_| IntModel::new()).collect(),
-            normal: (0..SCALE_CLASSES).map(|_| IntModel::new()).collect(),
+            tangent: (0..TANGENT_CLASSES).map(|_| IntModel::new()).collect(),
+            normal: (0..NORMAL_CLASSES).map(|_| IntModel::new()).collect(),
             colour: [IntModel::new(), IntModel::new(), IntModel::new()],
         }
     }
 }
 
-/// Barycentric prediction and Frenet frame of one patch (AD01 §4).
+/// ⌊log₂ x⌋ + 1 of a non-negative value (0 below 1).
+fn bit_length(x: f64) -> usize {
+    // `as` saturates: NaN gives 0, huge values u64::MAX.
+    64 - (x as u64).leading_zeros() as usize
+}
+
+/// Prediction and local frame of one patch (AD01 §4, refined).
 pub(crate) struct PatchPrediction {
     pub position: [i64; 3],
     frame: Frame,
-    scale: usize,
+    /// Model classes of the (major tangent, minor tangent, normal) components.
+    classes: [usize; 3],
 }
 
 /// Umbrella vectors of every vertex of the coarse mesh: the sum of
@@ -95,6 +107,15 @@ impl PatchPrediction {
         p
     }
 
+    /// The area centroid of the border polygon (the vertex mean when the
+    /// polygon folds over as seen along its normal), with a frame whose
+    /// first tangent follows the polygon's longer extent.
+    ///
+    /// Scanned surfaces are sampled irregularly: the removed vertex sits
+    /// nearer the area centroid than the vertex mean, and its tangential
+    /// offset spreads along the polygon's longer axis. On the shared scans
+    /// this codes geometry about 4 % smaller than the vertex mean in an
+    /// arbitrarily oriented frame (BENCHMARKS.md).
     pub(crate) fn new(polygon: &[[i32; 3]]) -> Self {
         let d = polygon.len() as i64;
         let mut sum = [0i64; 3];
@@ -103,7 +124,7 @@ impl PatchPrediction {
                 sum[k] += p[k] as i64;
             }
         }
-        let position = sum.map(|s| s.div_euclid(d) + i64::from(2 * s.rem_euclid(d) >= d));
+        let mean = sum.map(|s| s.div_euclid(d) + i64::from(2 * s.rem_euclid(d) >= d));
         // Newell normal of the polygon, relative to its first vertex to keep products small.
         let o = polygon[0];
         let rel = |p: &[i32; 3]| [0, 1, 2].map(|k| (p[k] - o[k]) as i64);
@@ -122,21 +143,36 @@ impl PatchPrediction {
                 .map(|k| ((a[k] - b[k]) as i64).pow(2) as u64)
                 .sum::<u64>();
         }
-        let mean = squared / polygon.len() as u64;
-        let scale = (((64 - mean.leading_zeros()) / 2) as usize).min(SCALE_CLASSES - 1);
+        let mean_squared = squared / polygon.len() as u64;
+        let edge_class = ((64 - mean_squared.leading_zeros() as usize) / 2).min(NORMAL_CLASSES - 1);
+        let mut frame = Frame::new(normal);
+        // The polygon in the tangent plane, relative to its vertex mean.
+        let centre = sum.map(|s| s as f64 / d as f64);
+        let mut plane = [(0.0f64, 0.0f64); MAX_VALENCE];
+        for (q, p) in plane.iter_mut().zip(polygon) {
+            *q = frame.tangent_f64([0, 1, 2].map(|k| p[k] as f64 - centre[k]));
+        }
+        let plane = &plane[..polygon.len()];
+        let (major, minor) = principal_axes(plane, &mut frame);
+        let position = area_centroid(plane, polygon, centre).unwrap_or(mean);
         PatchPrediction {
             position,
-            frame: Frame::new(normal),
-            scale,
+            frame,
+            classes: [
+                bit_length(major).min(TANGENT_CLASSES - 1),
+                bit_length(minor).min(TANGENT_CLASSES - 1),
+                edge_class,
+            ],
         }
     }
 
     pub(crate) fn encode(&self, actual: [i32; 3], m: &mut PassModels, enc: &mut RangeEncoder) {
         let r = [0, 1, 2].map(|k| actual[k] as i64 - self.position[k]);
         let l = self.frame.to_local(r);
-        enc.encode_int(&mut m.tangent[self.scale], l[0] as i32);
-        enc.encode_int(&mut m.tangent[self.scale], l[1] as i32);
-        enc.encode_int(&mut m.normal[self.scale], l[2] as i32);
+        let [major, minor, normal] = self.classes;
+        enc.encode_int(&mut m.tangent[major], l[0] as i32);
+        enc.encode_int(&mut m.tangent[minor], l[1] as i32);
+        enc.encode_int(&mut m.normal[normal], l[2] as i32);
     }
 
     /// Returns `None` when the decoded position falls outside `[0, max]`: a corrupt stream.
@@ -146,10 +182,11 @@ impl PatchPrediction {
         m: &mut PassModels,
         dec: &mut RangeDecoder,
     ) -> Option<[i32; 3]> {
+        let [major, minor, normal] = self.classes;
         let l = [
-            dec.decode_int(&mut m.tangent[self.scale]) as i64,
-            dec.decode_int(&mut m.tangent[self.scale]) as i64,
-            dec.decode_int(&mut m.normal[self.scale]) as i64,
+            dec.decode_int(&mut m.tangent[major]) as i64,
+            dec.decode_int(&mut m.tangent[minor]) as i64,
+            dec.decode_int(&mut m.normal[normal]) as i64,
         ];
         let r = self.frame.to_world(l);
         let mut out = [0i32; 3];
@@ -162,6 +199,59 @@ impl PatchPrediction {
         }
         Some(out)
     }
+}
+
+/// Turns `frame`'s first tangent onto the polygon's major axis (from the
+/// 2×2 covariance of its tangent-plane coordinates `plane`, centred) and
+/// returns the variances along the major and minor axes. Closed form with
+/// `+ − × / sqrt` only, so every platform gets the same bits.
+fn principal_axes(plane: &[(f64, f64)], frame: &mut Frame) -> (f64, f64) {
+    // Sums, not means: the direction does not depend on the scale.
+    let (mut a, mut b, mut c) = (0.0, 0.0, 0.0);
+    for &(x, y) in plane {
+        a += x * x;
+        b += x * y;
+        c += y * y;
+    }
+    let h = (a - c) / 2.0;
+    let r = (h * h + b * b).sqrt();
+    // An eigenvector of the larger eigenvalue, from whichever form is well conditioned.
+    if h >= 0.0 {
+        frame.align_tangent(h + r, b);
+    } else {
+        frame.align_tangent(b, r - h);
+    }
+    let mid = (a + c) / 2.0;
+    let n = plane.len() as f64;
+    ((mid + r) / n, (mid - r).max(0.0) / n)
+}
+
+/// The area centroid of the polygon fanned from `centre` (its vertex mean),
+/// with `plane` its tangent-plane coordinates about `centre`; `None` when a
+/// fan triangle folds over (the polygon is not star-shaped from its mean).
+fn area_centroid(plane: &[(f64, f64)], polygon: &[[i32; 3]], centre: [f64; 3]) -> Option<[i64; 3]> {
+    let d = polygon.len();
+    let mut weighted = [0.0f64; 3];
+    let mut total = 0.0;
+    for i in 0..d {
+        let j = (i + 1) % d;
+        let ((ax, ay), (bx, by)) = (plane[i], plane[j]);
+        let w = ax * by - ay * bx;
+        if w.is_nan() || w <= 0.0 {
+            return None;
+        }
+        total += w;
+        for k in 0..3 {
+            // Three times the fan triangle's centroid, relative to `centre`.
+            let (pa, pb) = (
+                polygon[i][k] as f64 - centre[k],
+                polygon[j][k] as f64 - centre[k],
+            );
+            weighted[k] += w * (pa + pb);
+        }
+    }
+    let scale = 1.0 / (3.0 * total);
+    Some([0, 1, 2].map(|k| round(centre[k] + weighted[k] * scale)))
 }
 
 /// Mean colour of the patch border, the predictor for the removed vertex.
@@ -199,4 +289,52 @@ pub(crate) fn decode_colour(pred: [u8; 3], m: &mut PassModels, dec: &mut RangeDe
         pred[1].wrapping_add(g),
         pred[2].wrapping_add(b),
     ]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn area_centroid_of_an_uneven_polygon_differs_from_its_vertex_mean() {
+        // A square with an extra vertex close to one corner: the vertex mean
+        // is pulled towards that corner, the area centroid is not.
+        let square = [[0, 0, 7], [90, 0, 7], [90, 80, 7], [0, 80, 7]];
+        let p = PatchPrediction::new(&square);
+        assert_eq!(p.position, [45, 40, 7]);
+        let crowded = [[0, 0, 7], [90, 0, 7], [90, 80, 7], [10, 80, 7], [0, 80, 7]];
+        let p = PatchPrediction::new(&crowded);
+        assert_eq!(p.position, [45, 40, 7]);
+        assert_eq!(crowded.iter().map(|v| v[0]).sum::<i32>() / 5, 38);
+    }
+
+    #[test]
+    fn a_polygon_folding_over_its_mean_falls_back_to_the_mean() {
+        // An L whose vertex mean (36.7, 36.7) lies outside it: fanned from
+        // there, triangles fold over. Its area centroid would be (28.7, 28.7).
+        let l_shape = [
+            [0, 0, 0],
+            [100, 0, 0],
+            [100, 10, 0],
+            [10, 10, 0],
+            [10, 100, 0],
+            [0, 100, 0],
+        ];
+        let p = PatchPrediction::new(&l_shape);
+        assert_eq!(p.position, [37, 37, 0]);
+    }
+
+    #[test]
+    fn the_first_tangent_follows_the_polygon_s_longer_extent() {
+        // Long along y, short along x, in the z = 0 plane.
+        let long = [[0, 0, 0], [20, 0, 0], [20, 200, 0], [0, 200, 0]];
+        let p = PatchPrediction::new(&long);
+        let [major, minor, _] = p.classes;
+        assert!(major > minor + 4, "{major} {minor}");
+        // A residual along y comes out on the first (major) tangent.
+        let l = p.frame.to_local([0, 50, 0]);
+        assert_eq!((l[0].abs(), l[1], l[2]), (50, 0, 0), "{l:?}");
+        // And it decodes back exactly.
+        assert_eq!(p.frame.to_world(l), [0, 50, 0]);
+    }
 }
