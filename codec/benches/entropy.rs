@@ -100,7 +100,7 @@ fn bench_decode(c: &mut Criterion) {
         let n_ctx = probs.len();
         g.bench_function(name, |b| {
             b.iter(|| {
-                let mut dec = RangeDecoder::new(black_box(&bytes)).unwrap();
+                let mut dec = RangeDecoder::new(black_box(&bytes));
                 let mut models = [BitModel::default(); 16];
                 let mut ones = 0u32;
                 for &(ctx, _) in &data {
@@ -121,7 +121,7 @@ fn bench_decode(c: &mut Criterion) {
         let bytes = enc.finish();
         g.bench_with_input(BenchmarkId::new("symbol", n), &bytes, |b, bytes| {
             b.iter(|| {
-                let mut dec = RangeDecoder::new(black_box(bytes)).unwrap();
+                let mut dec = RangeDecoder::new(black_box(bytes));
                 let mut m = SymbolModel::new(n);
                 let mut acc = 0usize;
                 for _ in 0..N {
@@ -141,7 +141,7 @@ fn bench_decode(c: &mut Criterion) {
     let bytes = enc.finish();
     g.bench_function("int/laplacian", |b| {
         b.iter(|| {
-            let mut dec = RangeDecoder::new(black_box(&bytes)).unwrap();
+            let mut dec = RangeDecoder::new(black_box(&bytes));
             let mut m = IntModel::new();
             let mut acc = 0i32;
             for _ in 0..N {
@@ -158,7 +158,7 @@ fn bench_decode(c: &mut Criterion) {
     let bytes = enc.finish();
     g.bench_function("raw/8bit", |b| {
         b.iter(|| {
-            let mut dec = RangeDecoder::new(black_box(&bytes)).unwrap();
+            let mut dec = RangeDecoder::new(black_box(&bytes));
             let mut acc = 0u32;
             for _ in 0..N {
                 acc = acc.wrapping_add(dec.decode_raw(8));

@@ -71,7 +71,7 @@ pub(crate) fn decode(
     has_colour: bool,
     max_coordinate: i32,
 ) -> Result<BaseMesh> {
-    let mut dec = RangeDecoder::new(payload)?;
+    let mut dec = RangeDecoder::new(payload);
     let mut corner = IntModel::new();
     let mut next_new = 0u32;
     // Counts were checked against the Limits and the level table by the

@@ -179,11 +179,15 @@ impl ChunkHeader {
     pub(crate) fn write(&self, out: &mut Vec<u8>) {
         out.push(self.tag);
         out.push(VERSION);
-        out.extend_from_slice(&self.level.to_le_bytes());
-        out.extend_from_slice(&self.vertices_before.to_le_bytes());
-        out.extend_from_slice(&self.vertices_after.to_le_bytes());
-        out.extend_from_slice(&self.faces_after.to_le_bytes());
-        out.extend_from_slice(&self.payload_len.to_le_bytes());
+        for v in [
+            self.level as u32,
+            self.vertices_before,
+            self.vertices_after,
+            self.faces_after,
+            self.payload_len,
+        ] {
+            write_varint(out, v);
+        }
     }
 
     /// Splits a chunk into its header and payload, checking the payload is all there.
@@ -201,11 +205,12 @@ impl ChunkHeader {
         }
         let h = ChunkHeader {
             tag,
-            level: r.u16()?,
-            vertices_before: r.u32()?,
-            vertices_after: r.u32()?,
-            faces_after: r.u32()?,
-            payload_len: r.u32()?,
+            level: u16::try_from(r.varint()?)
+                .map_err(|_| Error::stream("chunk level exceeds 65535"))?,
+            vertices_before: r.varint()?,
+            vertices_after: r.varint()?,
+            faces_after: r.varint()?,
+            payload_len: r.varint()?,
         };
         let payload = r.take(h.payload_len as usize)?;
         Ok((h, payload))
@@ -242,12 +247,6 @@ impl<'a> Reader<'a> {
 
     pub(crate) fn u8(&mut self) -> Result<u8> {
         Ok(self.take(1)?[0])
-    }
-
-    pub(crate) fn u16(&mut self) -> Result<u16> {
-        Ok(u16::from_le_bytes(
-            self.take(2)?.try_into().expect("2 bytes"),
-        ))
     }
 
     pub(crate) fn u32(&mut self) -> Result<u32> {

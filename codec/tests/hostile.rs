@@ -54,9 +54,48 @@ const AT_STEP: usize = 20;
 const AT_BATCHES: usize = 24;
 const AT_LEVELS: usize = 28;
 const HEADER_FIXED: usize = 40;
-// Chunk header: tag 0, version 1, level 2..4, vertices before 4..8,
-// vertices after 8..12, faces after 12..16, payload length 16..20.
-const CHUNK_HEADER: usize = 20;
+// Chunk header: tag, version, then varints: level (field 0), vertices before,
+// vertices after, faces after, payload length.
+const BEFORE: usize = 1;
+const AFTER: usize = 2;
+const FACES: usize = 3;
+const PAYLOAD_LEN: usize = 4;
+
+/// The five varint fields of the chunk starting at `bytes[0]`, and the
+/// header's length.
+fn chunk_fields(bytes: &[u8]) -> ([u32; 5], usize) {
+    let mut at = 2;
+    let fields = std::array::from_fn(|_| {
+        let (mut v, mut shift) = (0u32, 0);
+        loop {
+            let b = bytes[at];
+            at += 1;
+            v |= ((b & 0x7f) as u32) << shift;
+            shift += 7;
+            if b & 0x80 == 0 {
+                return v;
+            }
+        }
+    });
+    (fields, at)
+}
+
+/// Rewrites one field of the chunk header at `bytes[chunk_at..]`; the new
+/// value must take as many varint bytes as the old, so nothing moves.
+fn set_chunk_field(bytes: &mut [u8], chunk_at: usize, field: usize, v: u32) {
+    let (mut fields, len) = chunk_fields(&bytes[chunk_at..]);
+    fields[field] = v;
+    let mut header = vec![bytes[chunk_at], bytes[chunk_at + 1]];
+    for f in fields {
+        varint(&mut header, f);
+    }
+    assert_eq!(
+        header.len(),
+        len,
+        "field {field} = {v} changes the header's length"
+    );
+    bytes[chunk_at..chunk_at + len].copy_from_slice(&header);
+}
 
 fn put_u32(bytes: &mut [u8], at: usize, v: u32) {
     bytes[at..at + 4].copy_from_slice(&v.to_le_bytes());
@@ -83,17 +122,24 @@ fn varint(out: &mut Vec<u8>, mut v: u32) {
 }
 
 fn chunk(tag: u8, level: u16, before: u32, after: u32, faces: u32, payload: &[u8]) -> Vec<u8> {
+    chunk_claiming(
+        tag,
+        [level as u32, before, after, faces, payload.len() as u32],
+        payload,
+    )
+}
+
+/// A chunk whose header says `fields` whatever `payload` holds.
+fn chunk_claiming(tag: u8, fields: [u32; 5], payload: &[u8]) -> Vec<u8> {
     let mut out = vec![tag, VERSION];
-    out.extend_from_slice(&level.to_le_bytes());
-    for v in [before, after, faces, payload.len() as u32] {
-        out.extend_from_slice(&v.to_le_bytes());
+    for v in fields {
+        varint(&mut out, v);
     }
     out.extend_from_slice(payload);
     out
 }
 
-/// One pass as the decoder reads it; each section is a lone zero byte (an
-/// empty range-coded stream).
+/// One pass as the decoder reads it; each section holds one byte.
 fn pass(seeds: &[[u32; 2]], inserted: u32) -> Vec<u8> {
     let mut out = Vec::new();
     varint(&mut out, seeds.len() as u32);
@@ -473,10 +519,11 @@ fn payloads_cut_short_with_consistent_lengths_fail() {
     let mut failures = Vec::new();
     for (k, range) in index.batches.iter().enumerate() {
         let batch = &s[range.clone()];
-        let payload = &batch[CHUNK_HEADER..];
+        let (mut fields, header) = chunk_fields(batch);
+        let payload = &batch[header..];
         for cut in 0..payload.len() {
-            let mut short = batch[..CHUNK_HEADER + cut].to_vec();
-            put_u32(&mut short, 16, cut as u32);
+            fields[PAYLOAD_LEN] = cut as u32;
+            let short = chunk_claiming(b'L', fields, &payload[..cut]);
             let mut d = decode(s, Some(k), Limits::default()).unwrap();
             match no_panic(|| d.apply_batch(&short)) {
                 Ok(Err(_)) => {}
@@ -575,7 +622,8 @@ fn malformed_batch_payloads_are_refused() {
     let n = index.header.levels[0].vertices;
     let fresh = || Decoder::new(&s[index.base.clone()], Limits::default()).unwrap();
     let real = &s[index.batches[0].clone()];
-    let (after, faces) = (get_u32(real, 8), get_u32(real, 12));
+    let (fields, header) = chunk_fields(real);
+    let (after, faces) = (fields[AFTER], fields[FACES]);
 
     // Chunk version.
     let mut b = real.to_vec();
@@ -586,15 +634,16 @@ fn malformed_batch_payloads_are_refused() {
         .to_string()
         .contains("chunk version mismatch"));
     // Counts that disagree with the level table.
-    for (at, v) in [(4, n + 1), (8, after + 1), (12, faces + 1)] {
+    for (field, v) in [(BEFORE, n + 1), (AFTER, after + 1), (FACES, faces + 1)] {
         let mut b = real.to_vec();
-        put_u32(&mut b, at, v);
+        set_chunk_field(&mut b, 0, field, v);
         let e = fresh().apply_batch(&b).unwrap_err().to_string();
         assert!(e.contains("disagree with the level table"), "{e}");
     }
     // Payload length past the chunk.
-    let mut b = real.to_vec();
-    put_u32(&mut b, 16, u32::MAX);
+    let mut long = fields;
+    long[PAYLOAD_LEN] = u32::MAX;
+    let b = chunk_claiming(b'L', long, &real[header..]);
     assert!(fresh()
         .apply_batch(&b)
         .unwrap_err()
@@ -685,10 +734,10 @@ fn base_chunk_that_disagrees_with_the_level_table_is_refused() {
     let s = sphere_stream();
     let index = StreamIndex::parse(s).unwrap();
     let at = index.header.byte_len();
-    for field in [8, 12] {
+    for field in [AFTER, FACES] {
         let mut b = s.to_vec();
-        let v = get_u32(&b, at + field);
-        put_u32(&mut b, at + field, v + 1);
+        let v = chunk_fields(&b[at..]).0[field];
+        set_chunk_field(&mut b, at, field, v + 1);
         assert_stream_err(
             decode(&b, None, Limits::default()),
             &["base chunk disagrees"],
@@ -698,14 +747,14 @@ fn base_chunk_that_disagrees_with_the_level_table_is_refused() {
     let mut b = s.to_vec();
     let v = get_u32(&b, level_at(0));
     put_u32(&mut b, level_at(0), v + 1);
-    put_u32(&mut b, at + 8, v + 1);
+    set_chunk_field(&mut b, at, AFTER, v + 1);
     // Caught by the level table's two-faces-per-vertex rule before the base is decoded.
     assert_stream_err(decode(&b, None, Limits::default()), &["level table"]);
     // One face fewer than coded.
     let mut b = s.to_vec();
     let faces = get_u32(&b, level_at(0) + 4);
     put_u32(&mut b, level_at(0) + 4, faces - 1);
-    put_u32(&mut b, at + 12, faces - 1);
+    set_chunk_field(&mut b, at, FACES, faces - 1);
     assert!(decode(&b, None, Limits::default()).is_err());
 }
 
@@ -721,7 +770,7 @@ fn level_table_lying_about_faces_is_refused() {
     let last = index.batches[k - 1].start;
     let faces = get_u32(&b, level_at(k) + 4);
     put_u32(&mut b, level_at(k) + 4, faces + 1);
-    put_u32(&mut b, last + 12, faces + 1);
+    set_chunk_field(&mut b, last, FACES, faces + 1);
     match decode(&b, None, Limits::default()) {
         Err(_) => {}
         Ok(d) => panic!(
@@ -806,8 +855,8 @@ fn overwritten_batch_bytes_are_errors_or_consistent() {
         let batch = &s[range.clone()];
         // The chunk header and the first bytes of the payload, where the pass
         // counts and seeds live.
-        for at in (0..batch.len().min(CHUNK_HEADER + 24)).chain([batch.len() / 2, batch.len() - 1])
-        {
+        let header = chunk_fields(batch).1;
+        for at in (0..batch.len().min(header + 24)).chain([batch.len() / 2, batch.len() - 1]) {
             for v in [0u8, 1, 2, 0x7f, 0x80, 0xfe, 0xff] {
                 let mut b = batch.to_vec();
                 if b[at] == v {
@@ -833,9 +882,17 @@ fn overwritten_batch_bytes_are_errors_or_consistent() {
 
 // ---------------------------------------------------------------- allocation
 
-/// A 64-byte stream whose base level claims 2^32 − 1 vertices and faces,
+/// A 59-byte stream whose base level claims 2^32 − 1 vertices and faces,
 /// with a 4-byte payload.
 fn claims_four_billion() -> Vec<u8> {
+    let b = base_claiming(u32::MAX, u32::MAX);
+    assert_eq!(b.len(), 59);
+    b
+}
+
+/// A stream with no batches whose base claims `vertices` and `faces` (in
+/// the level table and the chunk), with a 4-byte payload.
+fn base_claiming(vertices: u32, faces: u32) -> Vec<u8> {
     let mut b = MAGIC.to_vec();
     b.extend_from_slice(&[VERSION, 0, 12, 0]);
     for v in [0f32, 0.0, 0.0, 1.0] {
@@ -843,12 +900,11 @@ fn claims_four_billion() -> Vec<u8> {
     }
     b.extend_from_slice(&0u32.to_le_bytes()); // no batches
     let payload = [0u8; 4];
-    let base = chunk(b'M', 0, 0, u32::MAX, u32::MAX, &payload);
-    for v in [u32::MAX, u32::MAX, base.len() as u32] {
+    let base = chunk(b'M', 0, 0, vertices, faces, &payload);
+    for v in [vertices, faces, base.len() as u32] {
         b.extend_from_slice(&v.to_le_bytes());
     }
     b.extend_from_slice(&base);
-    assert_eq!(b.len(), 64);
     b
 }
 
@@ -885,13 +941,9 @@ fn hostile_headers_do_not_allocate_what_they_claim() {
     });
     assert!(r.is_err());
 
-    // The base at the default limits: 50 M vertices and 100 M faces in 64 bytes.
-    let mut b = tiny.clone();
+    // The base at the default limits: 50 M vertices and 100 M faces in 59 bytes.
     let l = Limits::default();
-    put_u32(&mut b, level_at(0), l.max_vertices);
-    put_u32(&mut b, level_at(0) + 4, l.max_faces);
-    put_u32(&mut b, HEADER_FIXED + 8, l.max_vertices);
-    put_u32(&mut b, HEADER_FIXED + 12, l.max_faces);
+    let b = base_claiming(l.max_vertices, l.max_faces);
     let r = assert_small_peak("base at the default limits", || decode(&b, None, l));
     assert_stream_err(r, &["truncated entropy-coded payload"]);
 

@@ -57,7 +57,7 @@ impl Level {
             };
         }
         // Phase 1: the traversal finds every patch (nothing inserted yet).
-        let mut codes = StreamCodes(RangeDecoder::new(pass.connectivity)?);
+        let mut codes = StreamCodes(RangeDecoder::new(pass.connectivity));
         umbrellas(&self.conn, &self.positions_q, &mut scratch.umbrellas);
         let traversal = &mut scratch.traversal;
         traversal.run(
@@ -77,8 +77,8 @@ impl Level {
             )));
         }
         let mut s = Streams {
-            geom: RangeDecoder::new(pass.geometry)?,
-            colour: RangeDecoder::new(pass.colour)?,
+            geom: RangeDecoder::new(pass.geometry),
+            colour: RangeDecoder::new(pass.colour),
             models: PassModels::new(),
         };
         let mut decoded = std::mem::take(&mut scratch.decoded);

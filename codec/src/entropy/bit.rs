@@ -125,7 +125,7 @@ mod bit_tests {
     fn entropy_bit_p005_within_5_percent_of_shannon() {
         let n = 100_000;
         let (bits, bytes) = code_bernoulli(50_000, n, 7);
-        let mut dec = RangeDecoder::new(&bytes).unwrap();
+        let mut dec = RangeDecoder::new(&bytes);
         let mut m = BitModel::default();
         for &b in &bits {
             assert_eq!(dec.decode_bit(&mut m), b);
@@ -153,7 +153,7 @@ mod bit_tests {
             let coded = bytes.len() as f64 * 8.0;
             // p = 0.01 / 0.99 is near the 12-bit floor; allow a bit more.
             assert!(coded <= 1.12 * h + 64.0, "p1 {p1}: coded {coded} vs {h}");
-            let mut dec = RangeDecoder::new(&bytes).unwrap();
+            let mut dec = RangeDecoder::new(&bytes);
             let mut m = BitModel::default();
             assert!(bits.iter().all(|&b| dec.decode_bit(&mut m) == b));
             dec.check_overrun().unwrap();

@@ -153,9 +153,13 @@ impl RangeEncoder {
         for _ in 0..5 {
             self.shift_low();
         }
+        // The first byte is LZMA's initial cache byte, always 0 (the coded
+        // value is below 1, so no carry reaches it): the decoder implies it.
+        debug_assert_eq!(self.out.first(), Some(&0));
+        self.out.remove(0);
         // The decoder reads missing bytes as zeros and tolerates 4 of them.
         for _ in 0..4 {
-            if self.out.last() == Some(&0) && self.out.len() > 1 {
+            if self.out.last() == Some(&0) {
                 self.out.pop();
             } else {
                 break;
@@ -178,30 +182,19 @@ pub struct RangeDecoder<'a> {
 }
 
 impl<'a> RangeDecoder<'a> {
-    /// Start decoding `bytes` (as returned by [`RangeEncoder::finish`]).
-    ///
-    /// Fails if `bytes` is empty or does not start with the zero byte every
-    /// stream starts with.
-    pub fn new(bytes: &'a [u8]) -> Result<Self> {
-        match bytes.first() {
-            None => return Err(Error::stream("truncated entropy-coded payload")),
-            Some(0) => {}
-            Some(_) => {
-                return Err(Error::stream(
-                    "entropy-coded payload does not start with a zero byte",
-                ))
-            }
-        }
+    /// Start decoding `bytes` (as returned by [`RangeEncoder::finish`]; an
+    /// empty slice is the empty stream).
+    pub fn new(bytes: &'a [u8]) -> Self {
         let mut dec = RangeDecoder {
             bytes,
-            pos: 1,
+            pos: 0,
             range: u32::MAX,
             code: 0,
         };
         for _ in 0..4 {
             dec.code = (dec.code << 8) | u32::from(dec.next_byte());
         }
-        Ok(dec)
+        dec
     }
 
     /// Err if more than 4 bytes past the end of the input were needed, i.e.
@@ -266,18 +259,24 @@ mod coder_tests {
     use super::*;
 
     #[test]
-    fn entropy_empty_stream_is_one_byte() {
+    fn entropy_empty_stream_is_empty() {
         let bytes = RangeEncoder::new().finish();
-        assert_eq!(bytes, vec![0]);
-        let dec = RangeDecoder::new(&bytes).unwrap();
+        assert_eq!(bytes, Vec::<u8>::new());
+        let dec = RangeDecoder::new(&bytes);
         dec.check_overrun().unwrap();
     }
 
     #[test]
-    fn entropy_decoder_rejects_empty_and_nonzero_start() {
-        assert!(RangeDecoder::new(&[]).is_err());
-        assert!(RangeDecoder::new(&[1, 2, 3, 4, 5]).is_err());
-        assert!(RangeDecoder::new(&[0]).is_ok());
+    fn entropy_leading_zero_byte_is_implied() {
+        // The same symbols decode from the stream whatever its first byte
+        // was: nothing is written for LZMA's initial cache byte.
+        let mut enc = RangeEncoder::new();
+        enc.encode_raw(0xABCD, 16);
+        let bytes = enc.finish();
+        assert_eq!(bytes[0], 0xAB, "{bytes:?}");
+        let mut dec = RangeDecoder::new(&bytes);
+        assert_eq!(dec.decode_raw(16), 0xABCD);
+        dec.check_overrun().unwrap();
     }
 
     #[test]
@@ -295,7 +294,7 @@ mod coder_tests {
             expect.push((v, n));
         }
         let bytes = enc.finish();
-        let mut dec = RangeDecoder::new(&bytes).unwrap();
+        let mut dec = RangeDecoder::new(&bytes);
         for &(v, n) in &expect {
             assert_eq!(dec.decode_raw(n), v, "width {n}");
         }
@@ -311,7 +310,7 @@ mod coder_tests {
         enc.encode_raw(0xFFFF_FFFF, 3);
         enc.encode_raw(0x1_0005, 16);
         let bytes = enc.finish();
-        let mut dec = RangeDecoder::new(&bytes).unwrap();
+        let mut dec = RangeDecoder::new(&bytes);
         assert_eq!(dec.decode_raw(3), 7);
         assert_eq!(dec.decode_raw(16), 5);
     }

@@ -156,7 +156,7 @@ mod int_tests {
             enc.encode_uint(&mut mu, u);
         }
         let bytes = enc.finish();
-        let mut dec = RangeDecoder::new(&bytes).unwrap();
+        let mut dec = RangeDecoder::new(&bytes);
         let mut m = IntModel::new();
         let mut mu = IntModel::new();
         for &v in &vals {

@@ -32,8 +32,8 @@
 //!
 //! # Format notes
 //!
-//! * The first byte of a stream is always `0` (LZMA's leading cache byte);
-//!   [`RangeDecoder::new`] rejects a stream that is empty or starts otherwise.
+//! * LZMA's leading cache byte, always `0`, is not written: the decoder
+//!   implies it, and a stream with nothing coded is empty.
 //! * [`RangeEncoder::finish`] flushes the shortest-tailed value inside the
 //!   final interval and drops up to 4 trailing zero bytes. The decoder reads
 //!   bytes past the end as zeros, so this is lossless; reading *more* than

@@ -251,7 +251,7 @@ mod symbol_tests {
         let coded = bytes.len() as f64 * 8.0;
         let h = h_per * n as f64;
         assert!(coded <= 1.03 * h, "coded {coded} bits vs entropy {h}");
-        let mut dec = RangeDecoder::new(&bytes).unwrap();
+        let mut dec = RangeDecoder::new(&bytes);
         let mut m = SymbolModel::new(weights.len());
         for &x in &syms {
             assert_eq!(dec.decode_symbol(&mut m), x);
@@ -280,7 +280,7 @@ mod symbol_tests {
                 enc.encode_symbol(&mut m, x);
             }
             let bytes = enc.finish();
-            let mut dec = RangeDecoder::new(&bytes).unwrap();
+            let mut dec = RangeDecoder::new(&bytes);
             let mut m = SymbolModel::new(n);
             for &x in &syms {
                 assert_eq!(dec.decode_symbol(&mut m), x, "alphabet {n}");
@@ -317,7 +317,7 @@ mod symbol_tests {
             enc.encode_symbol_below(&mut m, sym, limit);
         }
         let bytes = enc.finish();
-        let mut dec = RangeDecoder::new(&bytes).unwrap();
+        let mut dec = RangeDecoder::new(&bytes);
         let mut m = SymbolModel::with_initial_frequency(n, 16);
         for &(limit, sym) in &steps {
             assert_eq!(dec.decode_symbol_below(&mut m, limit), sym);
@@ -348,7 +348,7 @@ mod symbol_tests {
         let garbage: Vec<u8> = std::iter::once(0)
             .chain((0..4000).map(|_| xorshift(&mut st) as u8))
             .collect();
-        let mut dec = RangeDecoder::new(&garbage).unwrap();
+        let mut dec = RangeDecoder::new(&garbage);
         let mut m = SymbolModel::new(5);
         for k in 0..10_000usize {
             let limit = 1 + k % 5;
