@@ -22,6 +22,7 @@ use crate::entropy::{BitModel, SymbolModel};
 use crate::halfedge::{face, next, prev, Connectivity, NONE};
 use crate::patch::{growth, pattern, Pattern, Tag, MAX_VALENCE, MIN_VALENCE};
 use crate::predict::{gate_context, GATE_CONTEXTS};
+use crate::priors;
 use crate::{Error, Result};
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -38,10 +39,6 @@ pub(crate) const DECIMATION_SYMBOLS: usize = MAX_VALENCE - 1;
 const VALENCE_CLASSES: usize = 3;
 /// How many patch valences fit around a gate: 1 (only 3) ..= 4 (3 to 6).
 const FIT_CLASSES: usize = MAX_VALENCE - MIN_VALENCE + 1;
-/// Start frequency of the decimation models (their increment is 32): the
-/// models are many and reset per pass, so they should not trust their first
-/// few symbols too much. 16 measured best of 1, 8, 16 and 32.
-const INITIAL_FREQUENCY: u32 = 16;
 
 /// Where a gate's code comes from: the stream (decoder) or the encoder's
 /// recorded decisions, coded as they are replayed.
@@ -66,7 +63,13 @@ pub(crate) struct Region {
     pub corner0: [u32; MAX_VALENCE - 2],
 }
 
-/// Adaptive models of the connectivity codes of one pass.
+/// Decimating contexts: gate tags × front valence class × widest fit.
+pub(crate) const DECIMATION_CONTEXTS: usize = GATE_CONTEXTS * VALENCE_CLASSES * FIT_CLASSES;
+/// Cleaning contexts: gate tags × valence classes of front, origin, target.
+pub(crate) const CLEANING_CONTEXTS: usize = GATE_CONTEXTS * VALENCE_CLASSES.pow(3);
+
+/// Adaptive models of the connectivity codes of one pass, starting from
+/// the trained priors ([`crate::priors`]).
 struct ConnModels {
     valence: Vec<SymbolModel>,
     cleaning: Vec<BitModel>,
@@ -74,16 +77,39 @@ struct ConnModels {
 
 impl ConnModels {
     fn new(kind: PassKind) -> Self {
-        let (valence, cleaning) = match kind {
-            PassKind::Decimating => (GATE_CONTEXTS * VALENCE_CLASSES * FIT_CLASSES, 0),
-            PassKind::Cleaning => (0, GATE_CONTEXTS * VALENCE_CLASSES.pow(3)),
-        };
-        ConnModels {
-            valence: vec![
-                SymbolModel::with_initial_frequency(DECIMATION_SYMBOLS, INITIAL_FREQUENCY);
-                valence
-            ],
-            cleaning: vec![BitModel::new(); cleaning],
+        match kind {
+            PassKind::Decimating => ConnModels {
+                valence: priors::DECIMATION
+                    .iter()
+                    .map(|f| SymbolModel::with_frequencies(f))
+                    .collect(),
+                cleaning: Vec::new(),
+            },
+            PassKind::Cleaning => ConnModels {
+                valence: Vec::new(),
+                cleaning: priors::CLEANING
+                    .iter()
+                    .map(|&p0| BitModel::with_p0_4096(p0))
+                    .collect(),
+            },
+        }
+    }
+}
+
+/// How often each code was seen in each context, for training priors.
+#[derive(Clone, Debug)]
+pub struct GateStatistics {
+    /// Per decimating context: how many gates took each symbol.
+    pub decimation: Vec<[u64; DECIMATION_SYMBOLS]>,
+    /// Per cleaning context: how many gates coded 0 and 1.
+    pub cleaning: Vec<[u64; 2]>,
+}
+
+impl Default for GateStatistics {
+    fn default() -> Self {
+        GateStatistics {
+            decimation: vec![[0; DECIMATION_SYMBOLS]; DECIMATION_CONTEXTS],
+            cleaning: vec![[0; 2]; CLEANING_CONTEXTS],
         }
     }
 }
@@ -96,6 +122,8 @@ pub(crate) struct Traversal {
     gates: VecDeque<u32>,
     /// Patches in the order the traversal found them (the insertion order).
     pub regions: Vec<Region>,
+    /// Counts every code by context when set (training, not decoding).
+    pub statistics: Option<Box<GateStatistics>>,
 }
 
 impl Traversal {
@@ -174,7 +202,11 @@ impl Traversal {
                 // Patches of every valence up to the widest that fits are possible.
                 let widest = self.widest_fit(conn, g, g0, g1);
                 let m = (ctx * VALENCE_CLASSES + class(front)) * FIT_CLASSES + widest - MIN_VALENCE;
-                match codes.decimation(&mut models.valence[m], widest - 1)? {
+                let sym = codes.decimation(&mut models.valence[m], widest - 1)?;
+                if let Some(s) = &mut self.statistics {
+                    s.decimation[m][sym.min(DECIMATION_SYMBOLS - 1)] += 1;
+                }
+                match sym {
                     0 => None,
                     sym => {
                         let pat = pattern(MIN_VALENCE - 1 + sym, g0, g1);
@@ -188,7 +220,11 @@ impl Traversal {
                 let m = ((ctx * VALENCE_CLASSES + class(front)) * VALENCE_CLASSES + class(origin))
                     * VALENCE_CLASSES
                     + class(target);
-                if codes.cleaning(&mut models.cleaning[m])? {
+                let removed = codes.cleaning(&mut models.cleaning[m])?;
+                if let Some(s) = &mut self.statistics {
+                    s.cleaning[m][usize::from(removed)] += 1;
+                }
+                if removed {
                     let region = self.find_patch(conn, g, pattern(MIN_VALENCE, g0, g1));
                     Some(region.ok_or_else(|| Error::stream("cleaning patch does not fit"))?)
                 } else {

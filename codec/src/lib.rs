@@ -28,6 +28,7 @@ mod inspect;
 mod mesh;
 mod patch;
 mod predict;
+pub mod priors;
 mod quantize;
 pub mod samples;
 
@@ -38,6 +39,7 @@ pub use encoder::{
 };
 pub use error::{Error, Result};
 pub use format::{Header, LevelInfo, StreamIndex, MAGIC, VERSION};
+pub use gates::GateStatistics;
 pub use inspect::{breakdown, LevelBreakdown};
 pub use mesh::IndexedMesh;
 pub use quantize::Quantization;

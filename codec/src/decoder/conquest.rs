@@ -13,7 +13,7 @@ use crate::{Error, Result};
 /// Scratch state reused across passes so a pass allocates nothing per vertex.
 #[derive(Default)]
 pub(crate) struct Scratch {
-    traversal: Traversal,
+    pub traversal: Traversal,
     decoded: Vec<([i32; 3], Option<[u8; 3]>)>,
     umbrellas: Vec<[i32; 4]>,
 }

@@ -4,7 +4,7 @@ mod conquest;
 
 use crate::base_mesh;
 use crate::format::{ChunkHeader, Header, Reader, BASE_TAG, BATCH_TAG};
-use crate::gates::PassKind;
+use crate::gates::{GateStatistics, PassKind};
 use crate::halfedge::Connectivity;
 use crate::quantize::Quantization;
 use crate::{Error, IndexedMesh, Result};
@@ -124,6 +124,15 @@ impl Decoder {
             limits,
             scratch: Scratch::default(),
         })
+    }
+
+    /// Counts the connectivity codes of the batches applied from now on.
+    pub(crate) fn collect_gate_statistics(&mut self, statistics: Box<GateStatistics>) {
+        self.scratch.traversal.statistics = Some(statistics);
+    }
+
+    pub(crate) fn take_gate_statistics(&mut self) -> Option<Box<GateStatistics>> {
+        self.scratch.traversal.statistics.take()
     }
 
     pub fn header(&self) -> &Header {

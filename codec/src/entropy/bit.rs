@@ -34,6 +34,19 @@ impl BitModel {
         BitModel { p0: PROB_ONE / 2 }
     }
 
+    /// A model starting from a prior: P(bit = 0) = `p0` / 4096, clamped to
+    /// the range an adaptive estimate can reach.
+    pub const fn with_p0_4096(p0: u16) -> Self {
+        let p0 = if p0 < 31 {
+            31
+        } else if p0 > 4065 {
+            4065
+        } else {
+            p0
+        };
+        BitModel { p0 }
+    }
+
     /// The current estimate of P(bit = 1), in units of 2^-12 (for tests and
     /// cost estimates).
     pub fn p1_4096(self) -> u32 {

@@ -62,6 +62,24 @@ impl SymbolModel {
         model
     }
 
+    /// A model starting from the given frequencies (a prior), one per symbol.
+    ///
+    /// # Panics
+    /// If there are not `2..=64` of them, one is 0, or their total is too large.
+    pub fn with_frequencies(frequencies: &[u16]) -> Self {
+        let mut model = Self::new(frequencies.len());
+        let total: u32 = frequencies.iter().map(|&f| u32::from(f)).sum();
+        assert!(
+            frequencies.iter().all(|&f| f >= 1) && total <= MAX_TOTAL,
+            "SymbolModel: frequencies {frequencies:?} out of range"
+        );
+        for (slot, &f) in model.freq.iter_mut().zip(frequencies) {
+            *slot = u32::from(f);
+        }
+        model.total = total;
+        model
+    }
+
     /// The alphabet size.
     pub fn n_symbols(&self) -> usize {
         self.n
