@@ -18,7 +18,7 @@
 
 use std::collections::VecDeque;
 
-use crate::entropy::{BitModel, SymbolModel};
+use crate::entropy::{BitModel, FrequencyModel};
 use crate::halfedge::{face, next, prev, Connectivity, NONE};
 use crate::patch::{growth, pattern, Pattern, Tag, MAX_VALENCE, MIN_VALENCE};
 use crate::predict::{gate_context, GATE_CONTEXTS};
@@ -37,6 +37,8 @@ pub(crate) enum PassKind {
 pub(crate) const DECIMATION_SYMBOLS: usize = MAX_VALENCE - 1;
 /// Coarse valence classes by faces around a vertex: ≤ 4, 5–6, ≥ 7.
 const VALENCE_CLASSES: usize = 3;
+/// The front vertex's coarse valence itself, ≤ 2 … ≥ 9.
+const FRONT_VALENCES: usize = 8;
 /// How many patch valences fit around a gate: 1 (only 3) ..= 4 (3 to 6).
 const FIT_CLASSES: usize = MAX_VALENCE - MIN_VALENCE + 1;
 
@@ -45,7 +47,11 @@ const FIT_CLASSES: usize = MAX_VALENCE - MIN_VALENCE + 1;
 pub(crate) trait GateCodes {
     /// A decimating gate: 0 for a null patch or `valence − 2`, a symbol
     /// below `limit` (≥ 2: null patch or valence 3 are always possible).
-    fn decimation(&mut self, model: &mut SymbolModel, limit: usize) -> Result<usize>;
+    fn decimation(
+        &mut self,
+        model: &mut FrequencyModel<DECIMATION_SYMBOLS>,
+        limit: usize,
+    ) -> Result<usize>;
     /// A cleaning gate: whether a valence-3 vertex was removed there.
     fn cleaning(&mut self, model: &mut BitModel) -> Result<bool>;
 }
@@ -63,15 +69,17 @@ pub(crate) struct Region {
     pub corner0: [u32; MAX_VALENCE - 2],
 }
 
-/// Decimating contexts: gate tags × front valence class × widest fit.
-pub(crate) const DECIMATION_CONTEXTS: usize = GATE_CONTEXTS * VALENCE_CLASSES * FIT_CLASSES;
+/// Decimating contexts: gate tags × front valence × valence classes of the
+/// gate's origin and target × widest fit.
+pub(crate) const DECIMATION_CONTEXTS: usize =
+    GATE_CONTEXTS * FRONT_VALENCES * VALENCE_CLASSES * VALENCE_CLASSES * FIT_CLASSES;
 /// Cleaning contexts: gate tags × valence classes of front, origin, target.
 pub(crate) const CLEANING_CONTEXTS: usize = GATE_CONTEXTS * VALENCE_CLASSES.pow(3);
 
 /// Adaptive models of the connectivity codes of one pass, starting from
 /// the trained priors ([`crate::priors`]).
 struct ConnModels {
-    valence: Vec<SymbolModel>,
+    valence: Vec<FrequencyModel<DECIMATION_SYMBOLS>>,
     cleaning: Vec<BitModel>,
 }
 
@@ -79,18 +87,12 @@ impl ConnModels {
     fn new(kind: PassKind) -> Self {
         match kind {
             PassKind::Decimating => ConnModels {
-                valence: priors::DECIMATION
-                    .iter()
-                    .map(|f| SymbolModel::with_frequencies(f))
-                    .collect(),
+                valence: priors::decimation_models().to_vec(),
                 cleaning: Vec::new(),
             },
             PassKind::Cleaning => ConnModels {
                 valence: Vec::new(),
-                cleaning: priors::CLEANING
-                    .iter()
-                    .map(|&p0| BitModel::with_p0_4096(p0))
-                    .collect(),
+                cleaning: priors::cleaning_models().to_vec(),
             },
         }
     }
@@ -201,7 +203,14 @@ impl Traversal {
             PassKind::Decimating => {
                 // Patches of every valence up to the widest that fits are possible.
                 let widest = self.widest_fit(conn, g, g0, g1);
-                let m = (ctx * VALENCE_CLASSES + class(front)) * FIT_CLASSES + widest - MIN_VALENCE;
+                let front_valence = (umbrellas[front as usize][3] as usize).clamp(2, 9) - 2;
+                let m = (((ctx * FRONT_VALENCES + front_valence) * VALENCE_CLASSES
+                    + class(origin))
+                    * VALENCE_CLASSES
+                    + class(target))
+                    * FIT_CLASSES
+                    + widest
+                    - MIN_VALENCE;
                 let sym = codes.decimation(&mut models.valence[m], widest - 1)?;
                 if let Some(s) = &mut self.statistics {
                     s.decimation[m][sym.min(DECIMATION_SYMBOLS - 1)] += 1;

@@ -3,8 +3,8 @@
 //! removed vertices' positions and colours, then their re-insertion.
 
 use super::Level;
-use crate::entropy::{BitModel, RangeDecoder, SymbolModel};
-use crate::gates::{GateCodes, PassKind, Region, Traversal};
+use crate::entropy::{BitModel, FrequencyModel, RangeDecoder};
+use crate::gates::{GateCodes, PassKind, Region, Traversal, DECIMATION_SYMBOLS};
 use crate::halfedge::{face, NONE};
 use crate::patch::MAX_VALENCE;
 use crate::predict::{decode_colour, predict_colour, umbrellas, PassModels, PatchPrediction};
@@ -31,7 +31,11 @@ pub(crate) struct PassInput<'a> {
 struct StreamCodes<'a>(RangeDecoder<'a>);
 
 impl GateCodes for StreamCodes<'_> {
-    fn decimation(&mut self, model: &mut SymbolModel, limit: usize) -> Result<usize> {
+    fn decimation(
+        &mut self,
+        model: &mut FrequencyModel<DECIMATION_SYMBOLS>,
+        limit: usize,
+    ) -> Result<usize> {
         Ok(self.0.decode_symbol_below(model, limit))
     }
 

@@ -7,8 +7,8 @@
 use std::sync::mpsc::{sync_channel, SyncSender};
 use std::thread::{Scope, ScopedJoinHandle};
 
-use crate::entropy::{BitModel, RangeEncoder, SymbolModel};
-use crate::gates::{GateCodes, PassKind, Traversal};
+use crate::entropy::{BitModel, FrequencyModel, RangeEncoder};
+use crate::gates::{GateCodes, PassKind, Traversal, DECIMATION_SYMBOLS};
 use crate::halfedge::Connectivity;
 use crate::patch::MAX_VALENCE;
 use crate::predict::{encode_colour, predict_colour, umbrellas, PassModels, PatchPrediction};
@@ -256,7 +256,11 @@ impl Replay<'_> {
 }
 
 impl GateCodes for Replay<'_> {
-    fn decimation(&mut self, model: &mut SymbolModel, limit: usize) -> Result<usize> {
+    fn decimation(
+        &mut self,
+        model: &mut FrequencyModel<DECIMATION_SYMBOLS>,
+        limit: usize,
+    ) -> Result<usize> {
         let sym = self.next()?;
         if sym >= limit {
             return Err(Error::Unsupported(

@@ -65,4 +65,4 @@ pub use coder::{RangeDecoder, RangeEncoder};
 #[allow(unused_imports)]
 pub use int::IntModel;
 #[allow(unused_imports)]
-pub use symbol::{SymbolModel, MAX_SYMBOLS};
+pub use symbol::{FrequencyModel, SymbolModel, MAX_SYMBOLS};

@@ -13,32 +13,37 @@ const MAX_TOTAL: u32 = 1 << 16;
 /// Alphabets up to this size are searched without branches when decoding.
 const BRANCHLESS_MAX: usize = 16;
 
-/// Adaptive frequency model over a small alphabet (`2..=64` symbols), coded
-/// with one range-coder step per symbol.
+/// Adaptive frequency model over a small alphabet (`2..=N` symbols, `N` ≤ 64
+/// the capacity it holds inline), coded with one range-coder step per symbol.
 ///
 /// Every frequency starts at 1; a coded symbol's grows by 32, and all are
 /// halved (staying >= 1) when their total passes 2^16. The model lives
 /// inline (no heap), so it is cheap to create and clone.
 #[derive(Clone, Debug, PartialEq, Eq)]
-pub struct SymbolModel {
-    freq: [u32; MAX_SYMBOLS],
+pub struct FrequencyModel<const N: usize> {
+    freq: [u32; N],
     total: u32,
     n: usize,
 }
 
-impl SymbolModel {
+/// The model over up to 64 symbols; [`FrequencyModel`] with a smaller
+/// capacity is smaller to hold and copy (many contexts, reset per pass).
+pub type SymbolModel = FrequencyModel<MAX_SYMBOLS>;
+
+impl<const N: usize> FrequencyModel<N> {
     /// A model over symbols `0..n_symbols`, all equally likely.
     ///
     /// # Panics
     /// If `n_symbols` is not in `2..=64`.
     pub fn new(n_symbols: usize) -> Self {
         assert!(
-            (2..=MAX_SYMBOLS).contains(&n_symbols),
-            "SymbolModel: alphabet size {n_symbols} not in 2..={MAX_SYMBOLS}"
+            (2..=N.min(MAX_SYMBOLS)).contains(&n_symbols),
+            "SymbolModel: alphabet size {n_symbols} not in 2..={}",
+            N.min(MAX_SYMBOLS)
         );
-        let mut freq = [0; MAX_SYMBOLS];
+        let mut freq = [0; N];
         freq[..n_symbols].fill(1);
-        SymbolModel {
+        FrequencyModel {
             freq,
             total: n_symbols as u32,
             n: n_symbols,
@@ -111,7 +116,7 @@ impl RangeEncoder {
     /// # Panics
     /// If `sym` is outside the model's alphabet.
     #[inline]
-    pub fn encode_symbol(&mut self, model: &mut SymbolModel, sym: usize) {
+    pub fn encode_symbol<const N: usize>(&mut self, model: &mut FrequencyModel<N>, sym: usize) {
         assert!(sym < model.n, "encode_symbol: symbol {sym} out of range");
         let r = self.range / model.total;
         let cum: u32 = model.freq[..sym].iter().sum();
@@ -134,7 +139,12 @@ impl RangeEncoder {
     /// # Panics
     /// If `sym >= limit` or `limit` exceeds the alphabet.
     #[inline]
-    pub fn encode_symbol_below(&mut self, model: &mut SymbolModel, sym: usize, limit: usize) {
+    pub fn encode_symbol_below<const N: usize>(
+        &mut self,
+        model: &mut FrequencyModel<N>,
+        sym: usize,
+        limit: usize,
+    ) {
         assert!(
             sym < limit && limit <= model.n,
             "encode_symbol_below: symbol {sym} not below {limit}"
@@ -156,7 +166,11 @@ impl RangeDecoder<'_> {
     /// the same `limit`, and update the model. Always returns a symbol below
     /// `limit` (clamped to the alphabet, and at least 1), whatever the input.
     #[inline]
-    pub fn decode_symbol_below(&mut self, model: &mut SymbolModel, limit: usize) -> usize {
+    pub fn decode_symbol_below<const N: usize>(
+        &mut self,
+        model: &mut FrequencyModel<N>,
+        limit: usize,
+    ) -> usize {
         let limit = limit.clamp(1, model.n);
         let total: u32 = model.freq[..limit].iter().sum();
         let r = self.range / total;
@@ -182,7 +196,7 @@ impl RangeDecoder<'_> {
     /// the model. Always returns a symbol `< model.n_symbols()`, whatever the
     /// input.
     #[inline]
-    pub fn decode_symbol(&mut self, model: &mut SymbolModel) -> usize {
+    pub fn decode_symbol<const N: usize>(&mut self, model: &mut FrequencyModel<N>) -> usize {
         let r = self.range / model.total;
         let last = model.n - 1;
         // Find the symbol whose slot [r * cum, r * (cum + freq)) holds `code`

@@ -16,11 +16,37 @@
 
 mod table;
 
+use std::sync::OnceLock;
+
 use crate::decoder::Decoder;
+use crate::entropy::{BitModel, FrequencyModel};
 use crate::gates::{GateStatistics, CLEANING_CONTEXTS, DECIMATION_CONTEXTS, DECIMATION_SYMBOLS};
 use crate::{Limits, Result, StreamIndex};
 
-pub(crate) use table::{CLEANING, DECIMATION};
+/// The decimating models every pass starts from, one per context.
+pub(crate) fn decimation_models() -> &'static [FrequencyModel<DECIMATION_SYMBOLS>] {
+    static MODELS: OnceLock<Vec<FrequencyModel<DECIMATION_SYMBOLS>>> = OnceLock::new();
+    MODELS.get_or_init(|| {
+        let flat = FrequencyModel::with_frequencies(&[FLAT_FREQUENCY; DECIMATION_SYMBOLS]);
+        let mut models = vec![flat; DECIMATION_CONTEXTS];
+        for &(context, frequencies) in table::DECIMATION {
+            models[context as usize] = FrequencyModel::with_frequencies(&frequencies);
+        }
+        models
+    })
+}
+
+/// The cleaning models every pass starts from, one per context.
+pub(crate) fn cleaning_models() -> &'static [BitModel] {
+    static MODELS: OnceLock<Vec<BitModel>> = OnceLock::new();
+    MODELS.get_or_init(|| {
+        let mut models = vec![BitModel::new(); CLEANING_CONTEXTS];
+        for &(context, p0) in table::CLEANING {
+            models[context as usize] = BitModel::with_p0_4096(p0);
+        }
+        models
+    })
+}
 
 /// Total frequency a trained decimating context starts with: as much weight
 /// as 16 coded symbols (each adds 32). 256 to 1024 measured within 0.01
@@ -43,37 +69,41 @@ impl GateStatistics {
         applied
     }
 
-    /// Initial frequencies of each decimating context: the trained
-    /// distribution (add-one smoothed) scaled to [`PRIOR_WEIGHT`].
-    pub fn decimation_priors(&self) -> Vec<[u16; DECIMATION_SYMBOLS]> {
-        self.decimation
-            .iter()
-            .map(|counts| {
-                let n: u64 = counts.iter().sum();
-                if n == 0 {
-                    return [FLAT_FREQUENCY; DECIMATION_SYMBOLS];
-                }
-                let smoothed = (n + DECIMATION_SYMBOLS as u64) as f64;
-                counts.map(|c| {
-                    let f = (PRIOR_WEIGHT * (c + 1) as f64 / smoothed).round();
-                    f.max(1.0) as u16
-                })
-            })
-            .collect()
+    /// Initial frequencies of each decimating context seen in training: the
+    /// seen distribution (add-one smoothed) scaled to [`PRIOR_WEIGHT`].
+    pub fn decimation_priors(&self) -> Vec<(u16, [u16; DECIMATION_SYMBOLS])> {
+        let mut priors = Vec::new();
+        for (context, counts) in self.decimation.iter().enumerate() {
+            let n: u64 = counts.iter().sum();
+            if n == 0 {
+                continue;
+            }
+            let smoothed = (n + DECIMATION_SYMBOLS as u64) as f64;
+            let frequencies = counts.map(|c| {
+                let f = (PRIOR_WEIGHT * (c + 1) as f64 / smoothed).round();
+                f.max(1.0) as u16
+            });
+            priors.push((context as u16, frequencies));
+        }
+        priors
     }
 
-    /// Initial P(0) of each cleaning context in 1/4096 (add-one smoothed).
-    pub fn cleaning_priors(&self) -> Vec<u16> {
-        self.cleaning
-            .iter()
-            .map(|&[zeros, ones]| {
-                let p0 = (zeros + 1) as f64 / (zeros + ones + 2) as f64;
-                (4096.0 * p0).round() as u16
-            })
-            .collect()
+    /// Initial P(0) of each cleaning context seen in training, in 1/4096
+    /// (add-one smoothed).
+    pub fn cleaning_priors(&self) -> Vec<(u16, u16)> {
+        let mut priors = Vec::new();
+        for (context, &[zeros, ones]) in self.cleaning.iter().enumerate() {
+            if zeros + ones == 0 {
+                continue;
+            }
+            let p0 = (zeros + 1) as f64 / (zeros + ones + 2) as f64;
+            priors.push((context as u16, (4096.0 * p0).round() as u16));
+        }
+        priors
     }
 
-    /// The source of `table.rs` for these statistics.
+    /// The source of `table.rs` for these statistics: the contexts seen in
+    /// training (the others start flat).
     pub fn table_source(&self) -> String {
         use std::fmt::Write as _;
         let mut out = String::from(
@@ -81,19 +111,15 @@ impl GateStatistics {
         );
         let _ = writeln!(
             out,
-            "pub(crate) const DECIMATION: [[u16; {DECIMATION_SYMBOLS}]; {DECIMATION_CONTEXTS}] = ["
+            "pub(super) const DECIMATION: &[(u16, [u16; {DECIMATION_SYMBOLS}])] = &["
         );
-        for f in self.decimation_priors() {
-            let _ = writeln!(out, "    {f:?},");
+        for (context, f) in self.decimation_priors() {
+            let _ = writeln!(out, "    ({context}, {f:?}),");
         }
         out.push_str("];\n\n");
-        let _ = writeln!(
-            out,
-            "pub(crate) const CLEANING: [u16; {CLEANING_CONTEXTS}] = ["
-        );
-        for chunk in self.cleaning_priors().chunks(12) {
-            let row: Vec<String> = chunk.iter().map(|p| p.to_string()).collect();
-            let _ = writeln!(out, "    {},", row.join(", "));
+        out.push_str("pub(super) const CLEANING: &[(u16, u16)] = &[\n");
+        for (context, p0) in self.cleaning_priors() {
+            let _ = writeln!(out, "    ({context}, {p0}),");
         }
         out.push_str("];\n");
         out
@@ -108,11 +134,19 @@ mod tests {
 
     #[test]
     fn trained_tables_are_valid_model_states() {
-        for f in DECIMATION.iter() {
+        let mut last = None;
+        for &(context, f) in table::DECIMATION {
+            assert!((context as usize) < DECIMATION_CONTEXTS);
+            assert!(last < Some(context), "contexts ascend");
+            last = Some(context);
             let total: u32 = f.iter().map(|&x| u32::from(x)).sum();
             assert!(f.iter().all(|&x| x >= 1) && total <= 1 << 16, "{f:?}");
         }
-        assert!(CLEANING.iter().all(|&p| (1..4096).contains(&p)));
+        assert!(table::CLEANING
+            .iter()
+            .all(|&(c, p)| (c as usize) < CLEANING_CONTEXTS && (1..4096).contains(&p)));
+        assert_eq!(decimation_models().len(), DECIMATION_CONTEXTS);
+        assert_eq!(cleaning_models().len(), CLEANING_CONTEXTS);
     }
 
     #[test]
@@ -134,32 +168,26 @@ mod tests {
         let levels = &index.header.levels;
         let inserted = levels.last().unwrap().vertices - levels[0].vertices;
         assert_eq!(patches, u64::from(inserted));
-        // A context never seen starts flat; a seen one leans to what it saw.
+        // Only seen contexts get a prior, leaning to what they saw.
         let priors = stats.decimation_priors();
-        let (seen, counts) = stats
+        let seen = stats
             .decimation
             .iter()
-            .enumerate()
-            .max_by_key(|(_, c)| c.iter().sum::<u64>())
+            .filter(|c| c.iter().sum::<u64>() > 0)
+            .count();
+        assert_eq!(priors.len(), seen);
+        let (busiest, frequencies) = priors
+            .iter()
+            .max_by_key(|(c, _)| stats.decimation[*c as usize].iter().sum::<u64>())
             .unwrap();
+        let counts = stats.decimation[*busiest as usize];
         let top = (0..DECIMATION_SYMBOLS).max_by_key(|&s| counts[s]).unwrap();
-        assert_eq!(
-            priors[seen]
-                .iter()
-                .enumerate()
-                .max_by_key(|(_, &f)| f)
-                .unwrap()
-                .0,
-            top
-        );
-        let unseen = stats
-            .decimation
-            .iter()
-            .position(|c| c.iter().sum::<u64>() == 0)
+        let top_prior = (0..DECIMATION_SYMBOLS)
+            .max_by_key(|&s| frequencies[s])
             .unwrap();
-        assert_eq!(priors[unseen], [FLAT_FREQUENCY; DECIMATION_SYMBOLS]);
+        assert_eq!(top_prior, top);
         // The generated source parses back to the same numbers.
         let source = stats.table_source();
-        assert!(source.contains(&format!("{:?},", priors[seen])));
+        assert!(source.contains(&format!("({busiest}, {frequencies:?}),")));
     }
 }
