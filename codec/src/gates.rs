@@ -10,11 +10,13 @@
 //! - which patch valences still fit around the gate (a patch needs its
 //!   `valence − 2` faces unconquered and inside the mesh): those that do not
 //!   are excluded from the code, and how many fit is a context;
-//! - the coarse valence class of the front vertex (and, for the cleaning
-//!   conquest, of the gate's vertices).
+//! - the coarse valence of the front vertex, and the coarse valence classes
+//!   of the gate's vertices.
 //!
-//! On the shared scans this takes connectivity from 4.5 to about 3.7
-//! bits/vertex at no cost in geometry (BENCHMARKS.md).
+//! Every pass's models start from priors trained on a scan
+//! ([`crate::priors`]), which is what makes this many contexts pay. On the
+//! shared scans this takes connectivity from 4.5 (AD01's tags alone) to
+//! 3.7 bits/vertex at no cost in geometry (BENCHMARKS.md).
 
 use std::collections::VecDeque;
 

@@ -2,10 +2,11 @@
 //! model and the probability every cleaning model starts each pass from.
 //!
 //! Models are reset per pass so that each batch decodes on its own, and with
-//! 324 + 729 contexts a pass spends a good part of its connectivity bits
-//! learning. Starting from code statistics of a real scan instead of flat
-//! models saves about 0.12 bit/vertex on the shared scans, none of which
-//! was trained on (BENCHMARKS.md).
+//! 7776 + 729 contexts a pass would spend a good part of its connectivity
+//! bits learning. Starting from code statistics of a real scan instead of
+//! flat models saves 0.12 bit/vertex with version 2's 324 decimating
+//! contexts, and lets the richer contexts save 0.08 more, on the shared
+//! scans, none of which was trained on (BENCHMARKS.md).
 //!
 //! The tables in `table.rs` are part of the stream format (version 3).
 //! They were trained on the Stanford dragon, 100 k-vertex VRIP
