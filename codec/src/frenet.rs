@@ -31,7 +31,8 @@ impl Givens {
                 b: 0.0,
             };
         }
-        let (mut c, mut s) = (x / r, y / r);
+        let inverse = 1.0 / r;
+        let (mut c, mut s) = (x * inverse, y * inverse);
         // Rotating by π first keeps |a| ≤ 1 (the shear for angles near π blows up).
         let flip = c < 0.0;
         if flip {

@@ -96,8 +96,10 @@ impl PatchPrediction {
         let mut p = Self::new(polygon);
         let mut mean = [0.0f64; 3];
         for u in umbrellas {
+            // One division per border vertex, not three.
+            let inverse = 1.0 / u[3].max(1) as f64;
             for (m, &s) in mean.iter_mut().zip(&u[..3]) {
-                *m += s as f64 / u[3].max(1) as f64;
+                *m += s as f64 * inverse;
             }
         }
         let scale = CURVATURE_EIGHTHS / 8.0 / umbrellas.len() as f64;
