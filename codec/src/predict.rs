@@ -127,27 +127,9 @@ impl PatchPrediction {
             }
         }
         let mean = sum.map(|s| s.div_euclid(d) + i64::from(2 * s.rem_euclid(d) >= d));
-        // Newell normal of the polygon, relative to its first vertex to keep products small.
-        let o = polygon[0];
-        let rel = |p: &[i32; 3]| [0, 1, 2].map(|k| (p[k] - o[k]) as i64);
-        let mut normal = [0i64; 3];
-        for i in 0..polygon.len() {
-            let a = rel(&polygon[i]);
-            let b = rel(&polygon[(i + 1) % polygon.len()]);
-            normal[0] += a[1] * b[2] - a[2] * b[1];
-            normal[1] += a[2] * b[0] - a[0] * b[2];
-            normal[2] += a[0] * b[1] - a[1] * b[0];
-        }
-        let mut squared = 0u64;
-        for i in 0..polygon.len() {
-            let (a, b) = (polygon[i], polygon[(i + 1) % polygon.len()]);
-            squared += (0..3)
-                .map(|k| ((a[k] - b[k]) as i64).pow(2) as u64)
-                .sum::<u64>();
-        }
-        let mean_squared = squared / polygon.len() as u64;
+        let mean_squared = mean_squared_edge(polygon);
         let edge_class = ((64 - mean_squared.leading_zeros() as usize) / 2).min(NORMAL_CLASSES - 1);
-        let mut frame = Frame::new(normal);
+        let mut frame = Frame::new(newell_normal(polygon));
         // The polygon in the tangent plane, relative to its vertex mean.
         let centre = sum.map(|s| s as f64 / d as f64);
         let mut plane = [(0.0f64, 0.0f64); MAX_VALENCE];
@@ -201,6 +183,34 @@ impl PatchPrediction {
         }
         Some(out)
     }
+}
+
+/// Newell normal of the polygon, relative to its first vertex to keep
+/// products small (exact in i64).
+fn newell_normal(polygon: &[[i32; 3]]) -> [i64; 3] {
+    let o = polygon[0];
+    let rel = |p: &[i32; 3]| [0, 1, 2].map(|k| (p[k] - o[k]) as i64);
+    let mut normal = [0i64; 3];
+    for i in 0..polygon.len() {
+        let a = rel(&polygon[i]);
+        let b = rel(&polygon[(i + 1) % polygon.len()]);
+        normal[0] += a[1] * b[2] - a[2] * b[1];
+        normal[1] += a[2] * b[0] - a[0] * b[2];
+        normal[2] += a[0] * b[1] - a[1] * b[0];
+    }
+    normal
+}
+
+/// Mean squared length of the polygon's edges (integer, rounded down).
+fn mean_squared_edge(polygon: &[[i32; 3]]) -> u64 {
+    let mut squared = 0u64;
+    for i in 0..polygon.len() {
+        let (a, b) = (polygon[i], polygon[(i + 1) % polygon.len()]);
+        squared += (0..3)
+            .map(|k| ((a[k] - b[k]) as i64).pow(2) as u64)
+            .sum::<u64>();
+    }
+    squared / polygon.len() as u64
 }
 
 /// Turns `frame`'s first tangent onto the polygon's major axis (from the
