@@ -164,11 +164,32 @@ impl ServeArgs {
     }
 }
 
+/// Names every model stored in a stream format this build cannot decode:
+/// the service refuses them (409 `stale_format`) until they are ingested
+/// again, and the web team should hear that at start-up, not from visitors.
+async fn warn_stale_models(storage: &dyn crate::storage::Storage) {
+    match storage.list_models().await {
+        Ok(models) => {
+            for m in models.iter().filter(|m| !m.servable()) {
+                tracing::warn!(
+                    slug = %m.slug,
+                    stored_format = m.stream_format,
+                    this_build_reads = vitrine_codec::VERSION,
+                    "model is stored in a stream format this build cannot serve; \
+                     ingest it again (vitrine ingest) to show it"
+                );
+            }
+        }
+        Err(e) => tracing::warn!(error = %e, "could not list models to check their stream format"),
+    }
+}
+
 /// Runs until Ctrl-C or SIGTERM. A database that is down at start-up is
 /// waited for; one that goes away later gives 503s until it is back.
 pub async fn run_serve(args: ServeArgs) -> anyhow::Result<()> {
     super::init_tracing();
     let storage = super::open_storage(&args.db, &args.connect_options(), true).await?;
+    warn_stale_models(storage.as_ref()).await;
     let state = AppState::new(storage, args.service_config());
     let _sampler = state.spawn_load_sampler();
     let listener = listen(args.listen)?;

@@ -55,7 +55,9 @@ pub async fn visible_models(
     let all =
         super::cache::through(&state.caches().list, state.metrics(), "list", (), load).await?;
     let mut visible = Vec::with_capacity(all.len());
-    for m in all.iter() {
+    // Models in a stream format this build cannot decode are left out: no
+    // visitor could open them (the start-up log names them).
+    for m in all.iter().filter(|m| m.servable()) {
         // Tokens are checked only when a restricted model is in the list.
         if m.public_access || state.visitor(hints, &m.slug).await?.audience == Audience::Researcher
         {

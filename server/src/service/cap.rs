@@ -201,6 +201,7 @@ mod tests {
             compression_id: 1,
             quantization_bits: 12,
             has_colour: false,
+            stream_format: vitrine_codec::VERSION,
             levels: vertices
                 .iter()
                 .map(|&v| LevelRecord {

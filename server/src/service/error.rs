@@ -39,6 +39,13 @@ pub enum AppError {
     Busy { retry_after: Duration },
     #[error("request timed out")]
     Timeout,
+    /// The model's payloads are in a stream format this build cannot
+    /// decode (stored by an older Vitrine): it must be ingested again.
+    #[error(
+        "model '{slug}' is stored in stream format {stored}; this server reads format {reads}: \
+         ingest it again (vitrine ingest) to show it"
+    )]
+    StaleFormat { slug: String, stored: u8, reads: u8 },
     #[error("internal error: {0}")]
     Internal(String),
 }
@@ -74,6 +81,8 @@ impl AppError {
             AppError::PayloadTooLarge => StatusCode::PAYLOAD_TOO_LARGE,
             AppError::Overloaded { .. } | AppError::Busy { .. } => StatusCode::SERVICE_UNAVAILABLE,
             AppError::Timeout => StatusCode::GATEWAY_TIMEOUT,
+            // The stored state conflicts with this build; nothing a client can retry.
+            AppError::StaleFormat { .. } => StatusCode::CONFLICT,
         }
     }
 
@@ -89,6 +98,7 @@ impl AppError {
             AppError::Overloaded { .. } => "overloaded",
             AppError::Busy { .. } => "busy",
             AppError::Timeout => "timeout",
+            AppError::StaleFormat { .. } => "stale_format",
         }
     }
 

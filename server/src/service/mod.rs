@@ -219,13 +219,22 @@ impl AppState {
         })
     }
 
-    /// Restricted models do not exist for visitors without a token for them.
+    /// Restricted models do not exist for visitors without a token for them;
+    /// a visible model stored in a stream format this build cannot decode is
+    /// refused with a message that says so (checked after visibility, so a
+    /// restricted model's existence is not revealed).
     pub fn ensure_visible(&self, record: &ModelRecord, visitor: &Visitor) -> Result<(), AppError> {
-        if record.policy.public_access || visitor.audience == Audience::Researcher {
-            Ok(())
-        } else {
-            Err(AppError::NotFound("model"))
+        if !(record.policy.public_access || visitor.audience == Audience::Researcher) {
+            return Err(AppError::NotFound("model"));
         }
+        if !record.servable() {
+            return Err(AppError::StaleFormat {
+                slug: record.slug.clone(),
+                stored: record.stream_format,
+                reads: vitrine_codec::VERSION,
+            });
+        }
+        Ok(())
     }
 
     pub fn level_cap(&self, record: &ModelRecord, visitor: &Visitor) -> LevelCap {

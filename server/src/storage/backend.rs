@@ -45,6 +45,10 @@ macro_rules! sql_storage {
                         "quantization_bits",
                     )?,
                     has_colour: row.try_get("has_colour").map_err(get)?,
+                    stream_format: narrow(
+                        row.try_get("codec_version").map_err(get)?,
+                        "codec_version",
+                    )?,
                     levels: Vec::new(),
                     mapping: None,
                     textures: Vec::new(),
@@ -176,6 +180,10 @@ macro_rules! sql_storage {
                             batch_count: narrow(
                                 row.try_get("batch_count").map_err(c)?,
                                 "batch_count",
+                            )?,
+                            stream_format: narrow(
+                                row.try_get("codec_version").map_err(c)?,
+                                "codec_version",
                             )?,
                         })
                     })

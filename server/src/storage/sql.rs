@@ -11,7 +11,7 @@ macro_rules! record_select {
         "SELECT m.id AS model_id, m.slug, m.version, m.title, m.description, \
          m.good_enough_level, m.created_at, p.name AS policy_name, p.public_access, \
          p.public_max_vertex_fraction, p.public_full_resolution, p.token_full_resolution, \
-         c.id AS compression_id, c.quantization_bits, c.has_colour, c.mapping_id, \
+         c.id AS compression_id, c.codec_version, c.quantization_bits, c.has_colour, c.mapping_id, \
          tm.parameters AS mapping_parameters \
          FROM model m JOIN audience_policy p ON p.id = m.policy_id \
          JOIN compression c ON c.model_id = m.id \
@@ -37,7 +37,7 @@ pub(super) const TEXTURES: &str = "SELECT t.id, t.kind, t.media_type, t.byte_len
      FROM texture_mapping tm \
      JOIN texture t ON t.id IN (tm.cell_texture_id, tm.colour_texture_id, tm.colour_low_texture_id) \
      WHERE tm.id = $1 ORDER BY t.id";
-pub(super) const LIST: &str = "SELECT m.slug, m.title, m.version, m.created_at, p.public_access, c.batch_count \
+pub(super) const LIST: &str = "SELECT m.slug, m.title, m.version, m.created_at, p.public_access, c.batch_count, c.codec_version \
      FROM model m JOIN audience_policy p ON p.id = m.policy_id JOIN compression c ON c.model_id = m.id \
      WHERE m.status = 'ready' \
      AND m.version = (SELECT MAX(m2.version) FROM model m2 WHERE m2.slug = m.slug AND m2.status = 'ready') \

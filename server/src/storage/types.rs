@@ -91,6 +91,9 @@ pub struct ModelRecord {
     pub compression_id: i64,
     pub quantization_bits: u8,
     pub has_colour: bool,
+    /// Stream format version the payloads were encoded in (column
+    /// `compression.codec_version`, `codec/FORMAT.md`).
+    pub stream_format: u8,
     /// `levels[0]` is the base mesh, `levels[k]` the mesh after batch `k`.
     pub levels: Vec<LevelRecord>,
     /// The CCC colour mapping, if the model has one.
@@ -104,6 +107,12 @@ impl ModelRecord {
     pub fn batch_count(&self) -> u32 {
         self.levels.len().saturating_sub(1) as u32
     }
+
+    /// Whether this build's decoder (and so its viewer) reads the stored
+    /// payloads: streams of another format version must be re-ingested.
+    pub fn servable(&self) -> bool {
+        self.stream_format == vitrine_codec::VERSION
+    }
 }
 
 /// One line of the model list.
@@ -116,6 +125,15 @@ pub struct ModelSummary {
     pub public_access: bool,
     pub batch_count: u32,
     pub created_at_ms: i64,
+    /// Stream format version of its payloads (`compression.codec_version`).
+    pub stream_format: u8,
+}
+
+impl ModelSummary {
+    /// See [`ModelRecord::servable`].
+    pub fn servable(&self) -> bool {
+        self.stream_format == vitrine_codec::VERSION
+    }
 }
 
 /// A texture and the model whose mapping uses it (a public one, if any).

@@ -124,6 +124,23 @@ impl TestDb {
         })
     }
 
+    /// Runs one SQL statement on the database, beside the storage (a test
+    /// reaching into rows the service never writes that way).
+    pub async fn execute(&self, sql: &str) {
+        use sqlx::Connection;
+        if self.sqlite.is_some() {
+            let mut conn = sqlx::SqliteConnection::connect(&self.url)
+                .await
+                .expect("sqlite");
+            sqlx::query(sql).execute(&mut conn).await.expect(sql);
+        } else {
+            let mut conn = sqlx::PgConnection::connect(&self.url)
+                .await
+                .expect("postgres");
+            sqlx::query(sql).execute(&mut conn).await.expect(sql);
+        }
+    }
+
     /// Another storage on the same database (e.g. a second server).
     pub fn connect_again(&self) -> Arc<dyn Storage> {
         connect(&self.url, &test_connect_options()).expect("storage")

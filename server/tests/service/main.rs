@@ -49,6 +49,7 @@ on_both_backends!(
     story::storage_round_trip,
     story::manifest_and_payloads_match_codec,
     story::etags_and_not_modified,
+    story::stale_stream_format_is_refused,
     caps::caps_by_audience_and_device,
     caps::load_caps_fall_and_recover,
     caps::bad_ids_and_slugs,

@@ -11,7 +11,7 @@ use tower::ServiceExt;
 use vitrine::ingest::{ingest_mesh, IngestOptions, ModelMeta};
 use vitrine::storage::{now_ms, sha256_hex, NewToken, OnExisting, StorageError};
 use vitrine::{app, new_token, AppState};
-use vitrine_codec::{decode, Decoder, Limits, StreamIndex};
+use vitrine_codec::{decode, Decoder, Limits, StreamIndex, VERSION};
 
 pub struct Reply {
     pub status: StatusCode,
@@ -309,4 +309,72 @@ pub async fn etags_and_not_modified(db: TestDb) {
         metrics.contains("vitrine_cache_lookups_total{cache=\"payload\",result=\"miss\"} 2"),
         "{metrics}"
     );
+}
+
+/// A model stored by a build with another stream format (an upgrade) is
+/// refused with its reason instead of failing in the visitor's decoder,
+/// left out of the list, hidden as before when restricted, and served again
+/// once ingested anew.
+pub async fn stale_stream_format_is_refused(db: TestDb) {
+    let s = &*db.storage;
+    let old = ingest_sample(s, "torus", "open")
+        .await
+        .stored
+        .compression_id;
+    let vault = ingest_sample(s, "vault", "researchers")
+        .await
+        .stored
+        .compression_id;
+    ingest_sample(s, "ring", "open").await;
+    let stale = VERSION - 1;
+    db.execute(&format!(
+        "UPDATE compression SET codec_version = {stale} WHERE id IN ({old}, {vault})"
+    ))
+    .await;
+    let state = AppState::new(db.storage.clone(), test_config());
+    let app = app(state.clone());
+    for uri in [
+        "/api/models/torus".to_owned(),
+        format!("/api/compressions/{old}/base"),
+        format!("/api/compressions/{old}/batches/1"),
+    ] {
+        let r = get(&app, &uri, &[]).await;
+        assert_eq!(r.status, StatusCode::CONFLICT, "{uri}");
+        let body = r.json();
+        assert_eq!(body["error"], "stale_format", "{uri}");
+        let message = body["message"].as_str().unwrap();
+        assert!(
+            message.contains(&format!("stream format {stale}"))
+                && message.contains(&format!("reads format {VERSION}"))
+                && message.contains("ingest it again"),
+            "{message}"
+        );
+    }
+    // A restricted model stays invisible without a token, whatever its format.
+    let r = get(&app, "/api/models/vault", &[]).await;
+    assert_eq!(r.status, StatusCode::NOT_FOUND);
+    let list = get(&app, "/api/models", &[]).await.json();
+    let slugs: Vec<&str> = list["models"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|m| m["slug"].as_str().unwrap())
+        .collect();
+    assert_eq!(slugs, ["ring"]);
+
+    // Ingested again by this build: a new version, served.
+    let mut meta = ModelMeta::new("torus", "Torus");
+    meta.policy = "open".into();
+    meta.on_existing = OnExisting::NewVersion;
+    ingest_mesh(s, sample_mesh(), meta, &IngestOptions::default())
+        .await
+        .unwrap();
+    state.invalidate();
+    let r = get(&app, "/api/models/torus", &[]).await;
+    assert_eq!(r.status, StatusCode::OK);
+    let manifest = r.json();
+    assert_eq!(manifest["version"], 2);
+    let base = get(&app, manifest["levels"][0]["url"].as_str().unwrap(), &[]).await;
+    assert_eq!(base.status, StatusCode::OK);
+    Decoder::new(&base.body, Limits::default()).expect("the new version decodes");
 }
