@@ -16,7 +16,15 @@ pub(crate) struct Scratch {
     pub traversal: Traversal,
     decoded: Vec<([i32; 3], Option<[u8; 3]>)>,
     umbrellas: Vec<[i32; 4]>,
+    predictions: Vec<PatchPrediction>,
 }
+
+/// Positions are predicted a block of patches at a time, apart from their
+/// entropy decoding. Each prediction is a long chain of dependent `f64`
+/// square roots and divisions but independent of the others, so with
+/// nothing in between the CPU overlaps several chains; interleaved with the
+/// (serial) range decoder it waited on each in turn.
+const PREDICTION_BLOCK: usize = 32;
 
 pub(crate) struct PassInput<'a> {
     pub kind: PassKind,
@@ -87,8 +95,13 @@ impl Level {
         };
         let mut decoded = std::mem::take(&mut scratch.decoded);
         decoded.clear();
-        for r in &traversal.regions {
-            decoded.push(self.decode_vertex(r, &scratch.umbrellas, &mut s)?);
+        let predictions = &mut scratch.predictions;
+        for block in traversal.regions.chunks(PREDICTION_BLOCK) {
+            predictions.clear();
+            predictions.extend(block.iter().map(|r| self.predict(r, &scratch.umbrellas)));
+            for (r, prediction) in block.iter().zip(predictions.iter()) {
+                decoded.push(self.decode_vertex(r, prediction, &mut s)?);
+            }
         }
         debug_assert_eq!(n + decoded.len(), n + pass.inserted as usize);
         for (r, &(position, colour)) in traversal.regions.iter().zip(&decoded) {
@@ -99,14 +112,9 @@ impl Level {
         s.colour.check_overrun()
     }
 
-    /// Phase 2: the removed vertex's position and colour, predicted from the
-    /// coarse mesh (nothing inserted yet, exactly what the encoder saw).
-    fn decode_vertex(
-        &self,
-        r: &Region,
-        umbrella_of: &[[i32; 4]],
-        s: &mut Streams,
-    ) -> Result<([i32; 3], Option<[u8; 3]>)> {
+    /// Phase 2a: the removed vertex's predicted position, from the coarse
+    /// mesh (nothing inserted yet, exactly what the encoder saw).
+    fn predict(&self, r: &Region, umbrella_of: &[[i32; 4]]) -> PatchPrediction {
         let d = r.valence;
         let mut polygon = [[0i32; 3]; MAX_VALENCE];
         let mut umbrellas = [[0i32; 4]; MAX_VALENCE];
@@ -114,7 +122,18 @@ impl Level {
             polygon[i] = self.positions_q[r.polygon[i] as usize];
             umbrellas[i] = umbrella_of[r.polygon[i] as usize];
         }
-        let position = PatchPrediction::with_curvature(&polygon[..d], &umbrellas[..d])
+        PatchPrediction::with_curvature(&polygon[..d], &umbrellas[..d])
+    }
+
+    /// Phase 2b: the removed vertex's position and colour from the stream.
+    fn decode_vertex(
+        &self,
+        r: &Region,
+        prediction: &PatchPrediction,
+        s: &mut Streams,
+    ) -> Result<([i32; 3], Option<[u8; 3]>)> {
+        let d = r.valence;
+        let position = prediction
             .decode(self.quantization.max_value(), &mut s.models, &mut s.geom)
             .ok_or_else(|| Error::stream("decoded position outside the quantization range"))?;
         let colour = match &self.colours {
