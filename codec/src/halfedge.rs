@@ -53,42 +53,46 @@ impl Connectivity {
             }
             origin.extend_from_slice(t);
         }
-        // Pair half-edges by undirected edge key with an LSD radix sort: it
-        // streams memory, where a hash map or per-vertex search would take a
-        // cache miss per half-edge on multi-million-vertex scans.
-        let mut keys: Vec<(u64, u32)> = (0..origin.len() as u32)
-            .map(|h| {
-                let (a, b) = (origin[h as usize], origin[next(h) as usize]);
-                (((a.min(b) as u64) << 32) | a.max(b) as u64, h)
-            })
-            .collect();
-        radix_sort(&mut keys, vertex_count as u64);
+        // Pair half-edges by undirected edge: bucket them by their smaller
+        // endpoint with a counting sort (two streaming passes; a hash map or
+        // a global sort by edge key costs a cache miss or several passes per
+        // half-edge on multi-million-vertex scans), then order each bucket,
+        // a handful of half-edges, by the larger endpoint. Both steps are
+        // stable, so edges are visited in (smaller, larger) order and each
+        // edge's half-edges by id: errors name the same edge on any machine.
+        let smaller = |h: usize| origin[h].min(origin[next(h as u32) as usize]);
+        let larger = |h: u32| origin[h as usize].max(origin[next(h) as usize]);
+        let mut start = vec![0u32; vertex_count + 1];
+        for h in 0..origin.len() {
+            start[smaller(h) as usize + 1] += 1;
+        }
+        for v in 0..vertex_count {
+            start[v + 1] += start[v];
+        }
+        let mut fill = start.clone();
+        let mut bucketed = vec![0u32; origin.len()];
+        for h in 0..origin.len() {
+            let slot = &mut fill[smaller(h) as usize];
+            bucketed[*slot as usize] = h as u32;
+            *slot += 1;
+        }
         let mut twin = vec![NONE; origin.len()];
-        let mut i = 0;
-        while i < keys.len() {
-            let mut j = i + 1;
-            while j < keys.len() && keys[j].0 == keys[i].0 {
-                j += 1;
-            }
-            match j - i {
-                1 => {}
-                2 => {
-                    let (h, g) = (keys[i].1, keys[i + 1].1);
-                    if origin[h as usize] == origin[g as usize] {
-                        return Err(non_manifold("inconsistently oriented", &origin, h));
+        for v in 0..vertex_count {
+            let bucket = &mut bucketed[start[v] as usize..start[v + 1] as usize];
+            bucket.sort_by_key(|&h| larger(h));
+            for edge in bucket.chunk_by(|&h, &g| larger(h) == larger(g)) {
+                match *edge {
+                    [_] => {}
+                    [h, g] => {
+                        if origin[h as usize] == origin[g as usize] {
+                            return Err(non_manifold("inconsistently oriented", &origin, h));
+                        }
+                        twin[h as usize] = g;
+                        twin[g as usize] = h;
                     }
-                    twin[h as usize] = g;
-                    twin[g as usize] = h;
-                }
-                _ => {
-                    return Err(non_manifold(
-                        "shared by more than two faces",
-                        &origin,
-                        keys[i].1,
-                    ))
+                    _ => return Err(non_manifold("shared by more than two faces", &origin, edge[0])),
                 }
             }
-            i = j;
         }
         let mut out = vec![NONE; vertex_count];
         for (h, &v) in origin.iter().enumerate() {
@@ -199,36 +203,6 @@ impl Connectivity {
             .chunks_exact(3)
             .filter(|t| t[0] != NONE)
             .map(|t| [t[0], t[1], t[2]])
-    }
-}
-
-/// Sorts `(key, value)` pairs by key, where keys are `min << 32 | max` of
-/// two ids below `id_bound`. Stable, 11-bit digits, only the digits in use.
-fn radix_sort(items: &mut Vec<(u64, u32)>, id_bound: u64) {
-    const BITS: u32 = 11;
-    let id_bits = 64 - id_bound.max(1).leading_zeros();
-    let mut scratch = vec![(0u64, 0u32); items.len()];
-    for half in [0u32, 32] {
-        let mut shift = half;
-        while shift < half + id_bits {
-            let mut counts = [0usize; 1 << BITS];
-            for &(k, _) in items.iter() {
-                counts[((k >> shift) & ((1 << BITS) - 1)) as usize] += 1;
-            }
-            let mut sum = 0;
-            for c in counts.iter_mut() {
-                let n = *c;
-                *c = sum;
-                sum += n;
-            }
-            for &item in items.iter() {
-                let d = ((item.0 >> shift) & ((1 << BITS) - 1)) as usize;
-                scratch[counts[d]] = item;
-                counts[d] += 1;
-            }
-            std::mem::swap(items, &mut scratch);
-            shift += BITS;
-        }
     }
 }
 
