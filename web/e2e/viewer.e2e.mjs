@@ -484,6 +484,30 @@ test('a failed download becomes a visible message', async () => {
   await page.close();
 });
 
+test('a model stored in another stream format: the server\'s reason on screen and a vitrine-error event for the page', async () => {
+  const page = await browser.context.newPage();
+  await page.addInitScript(() => {
+    document.addEventListener('vitrine-error', (event) => {
+      /** @type {any} */ (window).__vitrineErrors = [...(/** @type {any} */ (window).__vitrineErrors ?? []), /** @type {any} */ (event).detail.message];
+    });
+  });
+  // What `vitrine serve` answers for such a model (server/tests/service/story.rs
+  // checks the real answer from a database written in an older format).
+  const reason = "model 'torus' is stored in stream format 2; this server reads format 3: ingest it again (vitrine ingest) to show it";
+  await page.route('**/api/models/torus*', (route) =>
+    route.fulfill({ status: 409, contentType: 'application/json', body: JSON.stringify({ error: 'stale_format', message: reason, retry_after_s: null }) }),
+  );
+  await page.goto(`${service.url}/m/torus`);
+  const s = await until(page, `s.status === 'error'`);
+  assert.equal(s.firstFrameMs, null);
+  const shown = await shadowText(page, '.error p');
+  assert.ok(shown.includes(`409 for this model (${reason})`), shown);
+  await page.waitForFunction(() => /** @type {any} */ (window).__vitrineErrors?.length === 1);
+  const heard = await page.evaluate(() => /** @type {any} */ (window).__vitrineErrors[0]);
+  assert.ok(heard.includes(reason), heard);
+  await page.close();
+});
+
 test('a browser without WebGL2 gets a message, not a blank box', async () => {
   const page = await browser.context.newPage();
   await page.addInitScript(() => {

@@ -504,6 +504,8 @@ export class Viewer {
     this.stop();
     this.#set({ status: 'error', message });
     this.ui.showError(message);
+    // The embedding page hears of it too (as of each level: 'vitrine-level').
+    setTimeout(() => this.ui.root.dispatchEvent(new CustomEvent('vitrine-error', { detail: { message }, bubbles: true, composed: true })));
   }
 
   /** @param {Partial<ViewerState>} patch */
