@@ -6,12 +6,48 @@
 //! positions and colours as deltas from the previous vertex.
 
 use crate::entropy::{IntModel, RangeDecoder, RangeEncoder};
+use crate::halfedge::{face, next, prev, Connectivity, NONE};
 use crate::{Error, Result};
 
 pub(crate) struct BaseMesh {
     pub positions: Vec<[i32; 3]>,
     pub colours: Option<Vec<[u8; 3]>>,
     pub triangles: Vec<[u32; 3]>,
+}
+
+/// The live faces of `conn` in the order they are reached by walking across
+/// edges from face to face (depth first, one walk per connected component),
+/// each rotated so that it starts with the edge it was entered by. Numbered by first appearance in this order, a face's first two
+/// corners are vertices of a face just before it and its third is new or
+/// close by, so corner codes stay small; consecutive new vertices are
+/// neighbours, so position deltas do too. Any face order decodes to the same
+/// mesh: this only makes the base cheaper (1 % of the whole stream on igea,
+/// 0.4–0.8 % on smaller scans, against the slot order; a breadth-first walk
+/// did about half as well, and worse on one scan).
+pub(crate) fn face_walk_order(conn: &Connectivity) -> Vec<[u32; 3]> {
+    let slots = conn.face_count_slots();
+    let mut visited = vec![false; slots];
+    let mut order = Vec::with_capacity(slots);
+    let mut stack = Vec::new();
+    for f in 0..slots as u32 {
+        if !conn.face_alive(f) || visited[f as usize] {
+            continue;
+        }
+        visited[f as usize] = true;
+        stack.push(3 * f);
+        while let Some(h) = stack.pop() {
+            // `h` is the half-edge the face was entered by: its corners from `h` on.
+            let (a, b, c) = (h, next(h), prev(h));
+            order.push([a, b, c].map(|h| conn.origin[h as usize]));
+            for g in [a, c, b] {
+                let t = conn.twin[g as usize];
+                if t != NONE && !std::mem::replace(&mut visited[face(t) as usize], true) {
+                    stack.push(t);
+                }
+            }
+        }
+    }
+    order
 }
 
 /// Returns the vertex order that makes `triangles` first-appearance
@@ -145,4 +181,49 @@ pub(crate) fn decode(
         colours,
         triangles,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::halfedge::connectivity;
+    use crate::samples::{icosphere, torus};
+    use std::collections::HashSet;
+
+    /// A face as its rotation starting at its smallest vertex (orientation kept).
+    fn canonical(t: [u32; 3]) -> [u32; 3] {
+        let k = (0..3).min_by_key(|&k| t[k]).unwrap();
+        [t[k], t[(k + 1) % 3], t[(k + 2) % 3]]
+    }
+
+    #[test]
+    fn face_walk_keeps_every_face_and_enters_each_by_a_known_edge() {
+        // Two components: an icosphere and a torus beside it.
+        let mut mesh = icosphere(2);
+        let ring = torus(12, 6, 1.0, 0.3);
+        let offset = mesh.positions.len() as u32;
+        mesh.positions.extend(&ring.positions);
+        mesh.triangles
+            .extend(ring.triangles.iter().map(|t| t.map(|v| v + offset)));
+        let conn = connectivity(&mesh).unwrap();
+        let walk = face_walk_order(&conn);
+        let expected: HashSet<_> = mesh.triangles.iter().map(|&t| canonical(t)).collect();
+        let got: HashSet<_> = walk.iter().map(|&t| canonical(t)).collect();
+        assert_eq!(walk.len(), mesh.triangles.len());
+        assert_eq!(got, expected, "same faces, same orientation");
+        // Every face but each component's first starts with an edge (b, a)
+        // of a face written before it (as a → b): its first two corners are
+        // already numbered.
+        let mut edges = HashSet::new();
+        let mut starts = 0;
+        for t in &walk {
+            if !edges.contains(&(t[1], t[0])) {
+                starts += 1;
+            }
+            for k in 0..3 {
+                edges.insert((t[k], t[(k + 1) % 3]));
+            }
+        }
+        assert_eq!(starts, 2, "one entry without a known edge per component");
+    }
 }

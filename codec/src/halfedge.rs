@@ -90,7 +90,13 @@ impl Connectivity {
                         twin[h as usize] = g;
                         twin[g as usize] = h;
                     }
-                    _ => return Err(non_manifold("shared by more than two faces", &origin, edge[0])),
+                    _ => {
+                        return Err(non_manifold(
+                            "shared by more than two faces",
+                            &origin,
+                            edge[0],
+                        ))
+                    }
                 }
             }
         }

@@ -242,9 +242,8 @@ fn write_stream(
     let input_vertices = quantized.len();
     // Final numbering: base vertices by first appearance, then each batch's
     // vertices in insertion order (coarsest layer first, cleaning before decimation).
-    let base_triangles: Vec<[u32; 3]> = s
-        .conn
-        .triangles()
+    let base_triangles: Vec<[u32; 3]> = base_mesh::face_walk_order(&s.conn)
+        .into_iter()
         .map(|t| t.map(|v| s.ids[v as usize]))
         .collect();
     let mut vertex_order = base_mesh::first_appearance_order(input_vertices, &base_triangles);
