@@ -17,10 +17,11 @@ pub(crate) struct BaseMesh {
 
 /// The live faces of `conn` in the order they are reached by walking across
 /// edges from face to face (depth first, one walk per connected component),
-/// each rotated so that it starts with the edge it was entered by. Numbered by first appearance in this order, a face's first two
-/// corners are vertices of a face just before it and its third is new or
-/// close by, so corner codes stay small; consecutive new vertices are
-/// neighbours, so position deltas do too. Any face order decodes to the same
+/// each rotated so that it starts with the edge it was entered by. Numbered
+/// by first appearance in this order, a face's first two corners are
+/// vertices of a face just before it and its third is new or close by, so
+/// corner codes stay small; consecutive new vertices are neighbours, so
+/// position deltas do too. Any face order decodes to the same
 /// mesh: this only makes the base cheaper (1 % of the whole stream on igea,
 /// 0.4–0.8 % on smaller scans, against the slot order; a breadth-first walk
 /// did about half as well, and worse on one scan).
@@ -39,6 +40,8 @@ pub(crate) fn face_walk_order(conn: &Connectivity) -> Vec<[u32; 3]> {
             // `h` is the half-edge the face was entered by: its corners from `h` on.
             let (a, b, c) = (h, next(h), prev(h));
             order.push([a, b, c].map(|h| conn.origin[h as usize]));
+            // The entry edge's twin is the face this one was entered from,
+            // except for a component's first face.
             for g in [a, c, b] {
                 let t = conn.twin[g as usize];
                 if t != NONE && !std::mem::replace(&mut visited[face(t) as usize], true) {

@@ -199,7 +199,7 @@ async fn manifest(
     }
     let record = state.record_by_slug(&slug).await?;
     let visitor = state.visitor(&hints, &record.slug).await?;
-    state.ensure_visible(&record, &visitor)?;
+    state.ensure_servable(&record, &visitor)?;
     let cap = state.level_cap(&record, &visitor);
     Ok(no_store(Json(build_manifest(
         &state, &record, &visitor, cap,

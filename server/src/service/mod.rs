@@ -223,7 +223,7 @@ impl AppState {
     /// a visible model stored in a stream format this build cannot decode is
     /// refused with a message that says so (checked after visibility, so a
     /// restricted model's existence is not revealed).
-    pub fn ensure_visible(&self, record: &ModelRecord, visitor: &Visitor) -> Result<(), AppError> {
+    pub fn ensure_servable(&self, record: &ModelRecord, visitor: &Visitor) -> Result<(), AppError> {
         if !(record.policy.public_access || visitor.audience == Audience::Researcher) {
             return Err(AppError::NotFound("model"));
         }

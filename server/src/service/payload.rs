@@ -33,7 +33,7 @@ pub async fn base(
     let id = parse_id(&id, "compression id")?;
     let record = state.record_by_compression(id).await?;
     let visitor = state.visitor(&hints, &record.slug).await?;
-    state.ensure_visible(&record, &visitor)?;
+    state.ensure_servable(&record, &visitor)?;
     let etag = etag(&record.levels[0].sha256);
     let cache_control = cache_control(&record, 0);
     if not_modified(&headers, &etag) {
@@ -75,7 +75,7 @@ pub async fn batch(
         .map_err(|_| AppError::NotFound("batch"))?;
     let record = state.record_by_compression(id).await?;
     let visitor = state.visitor(&hints, &record.slug).await?;
-    state.ensure_visible(&record, &visitor)?;
+    state.ensure_servable(&record, &visitor)?;
     if iteration == 0 || iteration > record.batch_count() {
         return Err(AppError::NotFound("batch"));
     }

@@ -63,7 +63,7 @@ async fn model_page(
     }
     let record = state.record_by_slug(&slug).await?;
     let visitor = state.visitor(&hints, &record.slug).await?;
-    state.ensure_visible(&record, &visitor)?;
+    state.ensure_servable(&record, &visitor)?;
     let body = format!(
         "<h1>{title}</h1>\n<p>{description}</p>\n<p>The viewer is not installed on this server; \
          the <a href=\"/api/models/{slug}\">manifest</a> lists the levels it would load.</p>",
