@@ -7,7 +7,9 @@ use crate::entropy::{BitModel, FrequencyModel, RangeDecoder};
 use crate::gates::{GateCodes, PassKind, Region, Traversal, DECIMATION_SYMBOLS};
 use crate::halfedge::{face, NONE};
 use crate::patch::MAX_VALENCE;
-use crate::predict::{decode_colour, predict_colour, umbrellas, PassModels, PatchPrediction};
+use crate::predict::{
+    decode_colour, predict_colour, umbrellas, PassModels, PatchPrediction, PREDICTION_BLOCK,
+};
 use crate::{Error, Result};
 
 /// Scratch state reused across passes so a pass allocates nothing per vertex.
@@ -18,13 +20,6 @@ pub(crate) struct Scratch {
     umbrellas: Vec<[i32; 4]>,
     predictions: Vec<PatchPrediction>,
 }
-
-/// Positions are predicted a block of patches at a time, apart from their
-/// entropy decoding. Each prediction is a long chain of dependent `f64`
-/// square roots and divisions but independent of the others, so with
-/// nothing in between the CPU overlaps several chains; interleaved with the
-/// (serial) range decoder it waited on each in turn.
-const PREDICTION_BLOCK: usize = 32;
 
 pub(crate) struct PassInput<'a> {
     pub kind: PassKind,
@@ -98,7 +93,13 @@ impl Level {
         let predictions = &mut scratch.predictions;
         for block in traversal.regions.chunks(PREDICTION_BLOCK) {
             predictions.clear();
-            predictions.extend(block.iter().map(|r| self.predict(r, &scratch.umbrellas)));
+            predictions.extend(block.iter().map(|r| {
+                PatchPrediction::for_border(
+                    &r.polygon[..r.valence],
+                    &self.positions_q,
+                    &scratch.umbrellas,
+                )
+            }));
             for (r, prediction) in block.iter().zip(predictions.iter()) {
                 decoded.push(self.decode_vertex(r, prediction, &mut s)?);
             }
@@ -112,20 +113,9 @@ impl Level {
         s.colour.check_overrun()
     }
 
-    /// Phase 2a: the removed vertex's predicted position, from the coarse
-    /// mesh (nothing inserted yet, exactly what the encoder saw).
-    fn predict(&self, r: &Region, umbrella_of: &[[i32; 4]]) -> PatchPrediction {
-        let d = r.valence;
-        let mut polygon = [[0i32; 3]; MAX_VALENCE];
-        let mut umbrellas = [[0i32; 4]; MAX_VALENCE];
-        for i in 0..d {
-            polygon[i] = self.positions_q[r.polygon[i] as usize];
-            umbrellas[i] = umbrella_of[r.polygon[i] as usize];
-        }
-        PatchPrediction::with_curvature(&polygon[..d], &umbrellas[..d])
-    }
-
-    /// Phase 2b: the removed vertex's position and colour from the stream.
+    /// Phase 2: the removed vertex's position and colour from the stream,
+    /// given its predicted position (from the coarse mesh, nothing inserted
+    /// yet: exactly what the encoder saw).
     fn decode_vertex(
         &self,
         r: &Region,

@@ -11,7 +11,9 @@ use crate::entropy::{BitModel, FrequencyModel, RangeEncoder};
 use crate::gates::{GateCodes, PassKind, Traversal, DECIMATION_SYMBOLS};
 use crate::halfedge::Connectivity;
 use crate::patch::MAX_VALENCE;
-use crate::predict::{encode_colour, predict_colour, umbrellas, PassModels, PatchPrediction};
+use crate::predict::{
+    encode_colour, predict_colour, umbrellas, PassModels, PatchPrediction, PREDICTION_BLOCK,
+};
 use crate::{Error, Result};
 
 /// What one pass decided, in the simplifier's current vertex ids.
@@ -156,6 +158,7 @@ impl<'scope> PassSink<'scope> {
 pub(crate) struct PassCoder {
     replay: Traversal,
     umbrellas: Vec<[i32; 4]>,
+    predictions: Vec<PatchPrediction>,
 }
 
 impl PassCoder {
@@ -167,20 +170,18 @@ impl PassCoder {
         let mut models = PassModels::new();
         let mut geom = RangeEncoder::new();
         let mut colour = RangeEncoder::new();
-        for &(centre, valence, polygon) in &pass.patches {
-            let border = &polygon[..valence];
-            let mut corners = [[0i32; 3]; MAX_VALENCE];
-            let mut umbrellas = [[0i32; 4]; MAX_VALENCE];
-            for i in 0..valence {
-                corners[i] = mesh.positions[border[i] as usize];
-                umbrellas[i] = self.umbrellas[border[i] as usize];
-            }
-            PatchPrediction::with_curvature(&corners[..valence], &umbrellas[..valence]).encode(
-                mesh.positions[centre as usize],
-                &mut models,
-                &mut geom,
-            );
-            if let Some(colours) = mesh.colours {
+        let predictions = &mut self.predictions;
+        for block in pass.patches.chunks(PREDICTION_BLOCK) {
+            predictions.clear();
+            predictions.extend(block.iter().map(|(_, valence, polygon)| {
+                PatchPrediction::for_border(&polygon[..*valence], mesh.positions, &self.umbrellas)
+            }));
+            for (&(centre, valence, polygon), prediction) in block.iter().zip(predictions.iter()) {
+                prediction.encode(mesh.positions[centre as usize], &mut models, &mut geom);
+                let Some(colours) = mesh.colours else {
+                    continue;
+                };
+                let border = &polygon[..valence];
                 let mut around = [[0u8; 3]; MAX_VALENCE];
                 for (c, &v) in around.iter_mut().zip(border) {
                     *c = colours[v as usize];
