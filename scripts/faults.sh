@@ -84,18 +84,34 @@ ingest() { # db slug [extra...]
 }
 
 server=""
+proxy_pid=""
 serve() { # db [extra flags...]
     local db=$1
     shift
     "$bin" serve --db "$db" --listen "127.0.0.1:$port" --web-dir /nonexistent "$@" 2>>"$work/serve.log" &
     server=$!
     pids+=("$server")
-    for _ in $(seq 1 100); do
+    # Up to 30 s: through a delay line every query of the migrations costs a
+    # round trip or more, and a busy CI machine stretches that further.
+    for _ in $(seq 1 300); do
         curl -fs "$url/readyz" >/dev/null 2>&1 && return 0
         sleep 0.1
     done
-    echo "server did not become ready:" >&2
+    echo "server did not become ready within 30 s:" >&2
     tail -20 "$work/serve.log" >&2
+    return 1
+}
+
+proxy() { # delay-ms: a TCP delay line in front of the throw-away cluster, once it listens
+    "$load" proxy --listen "127.0.0.1:$proxy_port" --to "127.0.0.1:$pg_port" --delay-ms "$1" 2>>"$work/proxy.log" &
+    pids+=("$!")
+    proxy_pid=$!
+    for _ in $(seq 1 100); do
+        (exec 3<>"/dev/tcp/127.0.0.1/$proxy_port") 2>/dev/null && return 0
+        sleep 0.1
+    done
+    echo "the delay line did not listen on $proxy_port:" >&2
+    tail -5 "$work/proxy.log" >&2
     return 1
 }
 
@@ -174,15 +190,18 @@ case_pg_restart() {
 
 case_slow_db() {
     pg_setup || { report SKIP slow_db "no PostgreSQL binaries"; return; }
-    "$load" proxy --listen "127.0.0.1:$proxy_port" --to "127.0.0.1:$pg_port" --delay-ms 50 2>/dev/null &
-    pids+=("$!")
-    local proxy=$!
-    sleep 0.3
+    proxy 50 || { report FAIL slow_db "the delay line did not start"; return; }
+    local proxy=$proxy_pid
     local out=""
     for caps in on off; do
         local flags=(--cache-bytes 0)
         [ $caps = off ] && flags+=(--admit-rate 0 --load-high-inflight 1000000000 --load-high-latency-ms 1000000000 --load-high-queue-ms 1000000000)
-        serve "postgres://postgres@127.0.0.1:$proxy_port/postgres" "${flags[@]}"
+        if ! serve "postgres://postgres@127.0.0.1:$proxy_port/postgres" "${flags[@]}"; then
+            report FAIL slow_db "caps $caps: the server did not become ready through the delay line (see above)"
+            stop_server
+            kill "$proxy"
+            return
+        fi
         if "$load" crowd --url "$url" --slug sample --profile "$profile" --visitors "$crowd_n" \
             --pattern burst >"$work/slow_db_$caps.out" 2>&1; then
             out+="caps $caps: $(tail -n 2 "$work/slow_db_$caps.out" | head -n 1). "
@@ -367,12 +386,20 @@ case_disconnects() {
 
 case_shutdown() {
     pg_setup || { report SKIP shutdown "no PostgreSQL binaries (requests need a slow database to be in flight)"; return; }
-    "$load" proxy --listen "127.0.0.1:$proxy_port" --to "127.0.0.1:$pg_port" --delay-ms 200 2>/dev/null &
-    pids+=("$!")
-    local proxy=$!
-    sleep 0.3
-    serve "postgres://postgres@127.0.0.1:$proxy_port/postgres" --cache-bytes 0 --record-ttl-ms 100 --db-max-connections 64 \
-        --load-high-inflight 1000000000 --load-high-latency-ms 1000000000 --load-high-queue-ms 1000000000
+    proxy 200 || { report FAIL shutdown "the delay line did not start"; return; }
+    local proxy=$proxy_pid
+    # Opening a connection through the 200 ms line takes several round trips:
+    # on a busy machine that outlasted the default 3 s acquire timeout, and the
+    # server retried its migrations until the readiness wait ran out (a CI
+    # failure). This case is about shutdown, not the database: give it 10 s.
+    if ! serve "postgres://postgres@127.0.0.1:$proxy_port/postgres" --db-timeout-ms 10000 \
+        --cache-bytes 0 --record-ttl-ms 100 --db-max-connections 64 \
+        --load-high-inflight 1000000000 --load-high-latency-ms 1000000000 --load-high-queue-ms 1000000000; then
+        report FAIL shutdown "the server did not become ready through the delay line (see above)"
+        stop_server
+        kill "$proxy"
+        return
+    fi
     local pid=$server t0=$SECONDS
     if "$load" crowd --url "$url" --slug sample --profile "$profile" --visitors 80 --pattern steady:4 \
         --sigterm-pid "$pid" --sigterm-after-s 3 >"$work/shutdown.out" 2>&1; then
