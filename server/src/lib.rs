@@ -24,6 +24,7 @@ pub mod service;
 pub mod storage;
 
 pub use commands::{init_tracing, new_token, open_storage, run_ingest, run_serve, run_token};
+pub use commands::{models_table, run_models, ModelsArgs};
 pub use commands::{CccArgs, IngestArgs, ServeArgs, TokenArgs};
 pub use serve::{serve, shutdown_signal, ServeLimits};
 pub use service::{app, ops_app, AppState, ServiceConfig};

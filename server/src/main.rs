@@ -23,6 +23,8 @@ enum Command {
     Serve(vitrine::ServeArgs),
     /// Create an access token for researcher-level audiences.
     Token(vitrine::TokenArgs),
+    /// List the stored models and whether this build serves their stream format.
+    Models(vitrine::ModelsArgs),
     /// Encode a mesh (PLY, OBJ, OFF, glTF/GLB) into a progressive stream file.
     Encode(cli::encode::EncodeArgs),
     /// Decode a stream file up to a level and write PLY, OBJ or GLB.
@@ -54,6 +56,7 @@ fn main() -> anyhow::Result<()> {
         Command::Ingest(args) => runtime()?.block_on(vitrine::run_ingest(args)),
         Command::Serve(args) => runtime()?.block_on(vitrine::run_serve(args)),
         Command::Token(args) => runtime()?.block_on(vitrine::run_token(args)),
+        Command::Models(args) => runtime()?.block_on(vitrine::run_models(args)),
         Command::Encode(args) => cli::encode::run(args),
         Command::Decode(args) => cli::decode::run(args),
         Command::Inspect(args) => cli::inspect::run(args),

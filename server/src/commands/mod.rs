@@ -1,10 +1,12 @@
-//! The `ingest`, `serve` and `token` subcommands, for `main.rs` to wire in.
+//! The `ingest`, `serve`, `token` and `models` subcommands, for `main.rs` to wire in.
 
 mod ingest;
+mod models;
 mod serve;
 mod token;
 
 pub use ingest::{run_ingest, CccArgs, IngestArgs};
+pub use models::{models_table, run_models, ModelsArgs};
 pub use serve::{run_serve, ServeArgs};
 pub use token::{new_token, run_token, TokenArgs};
 

@@ -1,0 +1,68 @@
+//! `vitrine models`: what a database holds, and whether this build serves
+//! it — the check to run after upgrading Vitrine, before `serve`.
+
+use crate::storage::{ConnectOptions, ModelSummary};
+use std::fmt::Write as _;
+
+#[derive(clap::Args, Clone, Debug)]
+pub struct ModelsArgs {
+    #[arg(long, env = "VITRINE_DB", default_value = "sqlite:vitrine.db")]
+    pub db: String,
+    /// Fail (exit status 1) when a model is stored in a stream format this
+    /// build cannot serve, for upgrade scripts.
+    #[arg(long)]
+    pub check: bool,
+}
+
+/// One line per model (its visible version), and how many must be ingested
+/// again because this build does not read their stream format.
+pub fn models_table(models: &[ModelSummary]) -> (String, usize) {
+    let width = models
+        .iter()
+        .map(|m| m.slug.len())
+        .max()
+        .unwrap_or(4)
+        .max(4);
+    let mut out = format!(
+        "{:width$}  version  levels  public  stream format\n",
+        "slug"
+    );
+    let mut stale = 0;
+    for m in models {
+        let format = if m.servable() {
+            m.stream_format.to_string()
+        } else {
+            stale += 1;
+            format!(
+                "{} (this build reads {}: ingest it again)",
+                m.stream_format,
+                vitrine_codec::VERSION
+            )
+        };
+        let public = if m.public_access { "yes" } else { "no" };
+        let _ = writeln!(
+            out,
+            "{:width$}  {:>7}  {:>6}  {public:>6}  {format}",
+            m.slug,
+            m.version,
+            m.batch_count + 1
+        );
+    }
+    let _ = write!(
+        out,
+        "{} model(s); {stale} stored in a stream format this build cannot serve",
+        models.len()
+    );
+    (out, stale)
+}
+
+pub async fn run_models(args: ModelsArgs) -> anyhow::Result<()> {
+    super::init_tracing();
+    let storage = super::open_storage(&args.db, &ConnectOptions::default(), false).await?;
+    let (table, stale) = models_table(&storage.list_models().await?);
+    println!("{table}");
+    if args.check && stale > 0 {
+        anyhow::bail!("{stale} model(s) must be ingested again (vitrine ingest … --new-version)");
+    }
+    Ok(())
+}
