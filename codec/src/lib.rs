@@ -28,7 +28,7 @@ mod inspect;
 mod mesh;
 mod patch;
 mod predict;
-pub mod priors;
+mod priors;
 mod quantize;
 pub mod samples;
 

@@ -71,7 +71,7 @@ impl GateStatistics {
     }
 
     /// Initial frequencies of each decimating context seen in training: the
-    /// seen distribution (add-one smoothed) scaled to [`PRIOR_WEIGHT`].
+    /// seen distribution (add-one smoothed) scaled to a total of 512 (`PRIOR_WEIGHT`).
     pub fn decimation_priors(&self) -> Vec<(u16, [u16; DECIMATION_SYMBOLS])> {
         let mut priors = Vec::new();
         for (context, counts) in self.decimation.iter().enumerate() {
