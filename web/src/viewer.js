@@ -467,7 +467,9 @@ export class Viewer {
     this.#set({ status: 'capped', message });
     this.ui.showNotice(message);
     if (retryAfterS && !this.#retry) {
-      this.#retry = setTimeout(() => this.#recheck(), retryAfterS * 1000);
+      // Plus 0–1 s of jitter, as for a 503: a crowd capped in the same
+      // second must not come back in the same second.
+      this.#retry = setTimeout(() => this.#recheck(), (retryAfterS + Math.random()) * 1000);
     }
   }
 
@@ -483,7 +485,7 @@ export class Viewer {
     if (!this.#worker) return;
     const current = /** @type {Manifest} */ (this.manifest);
     if (!manifest) {
-      this.#retry = setTimeout(() => this.#recheck(), (current.cap.retry_after_s ?? 10) * 1000);
+      this.#retry = setTimeout(() => this.#recheck(), ((current.cap.retry_after_s ?? 10) + Math.random()) * 1000);
       return;
     }
     this.manifest = manifest;

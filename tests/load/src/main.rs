@@ -53,6 +53,11 @@ struct Mix {
     /// Per request, to the last byte.
     #[arg(long, default_value_t = 120)]
     request_timeout_s: u64,
+    /// How long a visitor held by a load cap keeps the page open, reading
+    /// the manifest again after each `Retry-After` as the viewer does and
+    /// refining further when the cap has risen (0: stop at the first cap).
+    #[arg(long, default_value_t = 30.0)]
+    stay_s: f64,
 }
 
 #[derive(Subcommand)]
@@ -382,6 +387,7 @@ async fn run(args: RunArgs) -> Result<()> {
         researcher_share: args.mix.researcher_share,
         tablet_factor: args.mix.tablet_factor,
         request_timeout: Duration::from_secs(args.mix.request_timeout_s),
+        stay: Duration::from_secs_f64(args.mix.stay_s.max(0.0)),
         sigterm: None,
         sequential,
     };
@@ -425,10 +431,10 @@ async fn run(args: RunArgs) -> Result<()> {
                 sum.pattern = args.pattern.to_string();
                 sum.run = run;
                 eprintln!(
-                    "caps {caps}, {n} visitors, run {run}: p99 {:.1} ms (200/304 only {:.1}, to head {:.1}), reconstruction median {:.2} s (× {:.2} lone, p95 × {:.2}; with the admission wait × {:.2} / {:.2}), {} refused at admission (wait ≤ {:.1} s), {} load-capped, errors {:?}, server CPU {:.1} s, harness CPU {:.1} s, peak RSS {:.0} MiB, wall {:.1} s",
+                    "caps {caps}, {n} visitors, run {run}: p99 {:.1} ms (200/304 only {:.1}, to head {:.1}), reconstruction median {:.2} s (× {:.2} lone, p95 × {:.2}; with the admission wait × {:.2} / {:.2}), {} refused at admission (wait ≤ {:.1} s), {} load-capped ({} resumed after {} re-checks, {} still held when leaving), errors {:?}, server CPU {:.1} s, harness CPU {:.1} s, peak RSS {:.0} MiB, wall {:.1} s",
                     sum.p99_ms, sum.p99_ok_ms, sum.head_p99_ms, sum.recon_median_s, sum.ratio_median, sum.ratio_p95,
                     sum.ratio_wait_median, sum.ratio_wait_p95, sum.admission_refused, sum.admission_wait_max_s,
-                    sum.load_capped, sum.errors, sum.server_cpu_s, sum.harness_cpu_s, sum.server_peak_rss_mib, sum.wall_s
+                    sum.load_capped, sum.resumed, sum.rechecks, sum.held_at_end, sum.errors, sum.server_cpu_s, sum.harness_cpu_s, sum.server_peak_rss_mib, sum.wall_s
                 );
                 for (status, count) in &sum.errors {
                     if status != "429" && status != "503" {
@@ -520,6 +526,7 @@ async fn crowd(args: CrowdArgs) -> Result<()> {
         researcher_share: args.mix.researcher_share,
         tablet_factor: args.mix.tablet_factor,
         request_timeout: Duration::from_secs(args.mix.request_timeout_s),
+        stay: Duration::from_secs_f64(args.mix.stay_s.max(0.0)),
         sigterm: args
             .sigterm_pid
             .map(|p| (p, Duration::from_secs_f64(args.sigterm_after_s))),

@@ -45,7 +45,7 @@ pub struct Summary {
     #[serde(default)]
     pub p99_ms_by_kind: BTreeMap<String, f64>,
     pub max_ms: f64,
-    /// Time to the visitor's last level (completed visitors).
+    /// Time to the level where refinement first stopped (completed visitors).
     pub recon_median_s: f64,
     pub recon_p95_s: f64,
     /// Each visitor's time over a lone visitor's time to the same level.
@@ -74,8 +74,17 @@ pub struct Summary {
     /// Public desktop visitors: median level reached.
     pub public_desktop_level: f64,
     pub load_capped: usize,
-    /// Level at which load-capped visitors stopped → how many.
+    /// Level at which a load cap first held visitors → how many.
     pub load_capped_levels: BTreeMap<u32, usize>,
+    /// Visitors who refined further once a load cap lifted.
+    #[serde(default)]
+    pub resumed: usize,
+    /// Visitors still held by a load cap when they left.
+    #[serde(default)]
+    pub held_at_end: usize,
+    /// Manifest reads after a load cap's `Retry-After`.
+    #[serde(default)]
+    pub rechecks: usize,
     pub bytes: u64,
     /// Status (or "no answer") → count, for everything but 200 and 304.
     pub errors: BTreeMap<String, usize>,
@@ -131,13 +140,20 @@ pub fn summarize(outcome: &CrowdOutcome, baselines: &Baselines) -> Summary {
             .collect(),
     );
     let done: Vec<&VisitorResult> = outcome.visitors.iter().filter(|v| v.complete()).collect();
-    let recon = sorted(done.iter().filter_map(|v| v.total_ms()).collect());
+    // Up to where refinement first stopped: a visitor resumed after a load
+    // cap lifted has waited out `Retry-After`, which is the cap's price, not
+    // the crowd's (counted apart below).
+    let recon = sorted(
+        done.iter()
+            .filter_map(|v| Some(v.first_stop()?.1))
+            .collect(),
+    );
     // × lone visitor, from admission and counting the wait for it.
     let (ratios, ratios_wait): (Vec<f64>, Vec<f64>) = done
         .iter()
         .filter_map(|v| {
-            let alone = baselines.time(v.device?, v.audience?, v.reached()?)?;
-            let time = v.total_ms()?;
+            let (level, time) = v.first_stop()?;
+            let alone = baselines.time(v.device?, v.audience?, level)?;
             Some((time / alone, (time + v.admission_wait_ms) / alone))
         })
         .unzip();
@@ -172,7 +188,7 @@ pub fn summarize(outcome: &CrowdOutcome, baselines: &Baselines) -> Summary {
     }
     let mut load_capped_levels = BTreeMap::new();
     for v in outcome.visitors.iter().filter(|v| v.load_capped()) {
-        if let Some(l) = v.reached() {
+        if let Some((l, _)) = v.first_stop() {
             *load_capped_levels.entry(l).or_insert(0) += 1;
         }
     }
@@ -216,6 +232,9 @@ pub fn summarize(outcome: &CrowdOutcome, baselines: &Baselines) -> Summary {
         public_desktop_level: percentile(&levels, 50.0),
         load_capped: outcome.visitors.iter().filter(|v| v.load_capped()).count(),
         load_capped_levels,
+        resumed: outcome.visitors.iter().filter(|v| v.resumed).count(),
+        held_at_end: outcome.visitors.iter().filter(|v| v.held_at_end).count(),
+        rechecks: outcome.visitors.iter().map(|v| v.rechecks as usize).sum(),
         bytes: outcome.requests.iter().map(|r| r.bytes).sum(),
         errors,
         missing_retry_after,
@@ -257,14 +276,14 @@ fn map(m: &BTreeMap<impl std::fmt::Display, usize>) -> String {
 
 pub fn markdown(rows: &[Summary]) -> String {
     let mut s = String::new();
-    s.push_str("| caps | visitors | arrivals | requests | p50 ms | p95 ms | p99 ms | p99 to response head ms | p99 of 200/304 ms | reconstruction median / p95 s | × lone visitor, median / p95 | × lone counting the admission wait, median / p95 | refused at admission (max wait s) | public desktop level (median) | load-capped visitors (at level: n) | failed visitors | non-2xx answers | bytes served | server CPU s (% of a core) | server peak RSS MiB | harness CPU s | max pressure | every run: p99, p95 × lone, load-capped |\n");
+    s.push_str("| caps | visitors | arrivals | requests | p50 ms | p95 ms | p99 ms | p99 to response head ms | p99 of 200/304 ms | reconstruction median / p95 s | × lone visitor, median / p95 | × lone counting the admission wait, median / p95 | refused at admission (max wait s) | public desktop level (median) | load-capped visitors (first held at level: n); resumed after a re-check / still held when leaving (re-checks) | failed visitors | non-2xx answers | bytes served | server CPU s (% of a core) | server peak RSS MiB | harness CPU s | max pressure | every run: p99, p95 × lone, load-capped |\n");
     s.push_str(
         "|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|---:|---|---:|---:|---:|---:|---:|---|\n",
     );
     for r in rows {
         let _ = writeln!(
             s,
-            "| {} | {} | {} | {} | {:.1} | {:.1} | {:.1} | {:.1} | {:.1} | {:.2} / {:.2} | {:.2} / {:.2} | {:.2} / {:.2} | {} ({:.1}) | {} | {} ({}) | {} | {} | {:.1} MB | {:.1} ({:.0} %) | {:.0} | {:.1} | {} | {} |",
+            "| {} | {} | {} | {} | {:.1} | {:.1} | {:.1} | {:.1} | {:.1} | {:.2} / {:.2} | {:.2} / {:.2} | {:.2} / {:.2} | {} ({:.1}) | {} | {} ({}); {} / {} ({}) | {} | {} | {:.1} MB | {:.1} ({:.0} %) | {:.0} | {:.1} | {} | {} |",
             r.caps,
             r.visitors,
             r.pattern,
@@ -285,6 +304,9 @@ pub fn markdown(rows: &[Summary]) -> String {
             r.public_desktop_level,
             r.load_capped,
             map(&r.load_capped_levels),
+            r.resumed,
+            r.held_at_end,
+            r.rechecks,
             r.failed,
             map(&r.errors),
             r.bytes as f64 / 1e6,

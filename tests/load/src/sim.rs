@@ -5,7 +5,10 @@
 //! decode time of that level (native, times a device factor) without using
 //! CPU, as the decoding happens on the visitor's device, not on the server's.
 //! A 403/429 `level_capped` answer stops the visitor at the level it has, as
-//! in the viewer; any other failure ends the visit.
+//! in the viewer; when the cap is a load cap (it carries `Retry-After`, in
+//! the manifest or the 429), the visitor reads the manifest again after that
+//! wait and refines further once the cap has risen, for as long as it stays
+//! (`CrowdConfig::stay`). Any other failure ends the visit.
 
 use crate::http::Conn;
 use anyhow::{Context, Result};
@@ -177,6 +180,8 @@ pub struct CrowdConfig {
     /// Tablets decode this many times slower than the measured (native) time.
     pub tablet_factor: f64,
     pub request_timeout: Duration,
+    /// How long a visitor held by a load cap stays, re-checking it.
+    pub stay: Duration,
     /// Sends SIGTERM to this process this long after the start.
     pub sigterm: Option<(u32, Duration)>,
     /// Only the first visitor of each (device, audience) pair, one after another.
@@ -230,6 +235,21 @@ pub struct VisitorResult {
     /// 503 answers before the manifest was admitted.
     #[serde(default)]
     pub refusals: u32,
+    /// Which visitor of the crowd (for jitter).
+    #[serde(skip)]
+    pub who: usize,
+    /// The level at which a load cap first held refinement.
+    #[serde(default)]
+    pub first_stop: Option<u32>,
+    /// Manifest reads after a load cap, each after its `Retry-After`.
+    #[serde(default)]
+    pub rechecks: u32,
+    /// A re-check found the cap risen and refinement went on.
+    #[serde(default)]
+    pub resumed: bool,
+    /// Still held by a load cap when the visitor left (`--stay-s`).
+    #[serde(default)]
+    pub held_at_end: bool,
 }
 
 impl VisitorResult {
@@ -237,8 +257,12 @@ impl VisitorResult {
         self.level_ms.len().checked_sub(1).map(|l| l as u32)
     }
 
-    pub fn total_ms(&self) -> Option<f64> {
-        self.level_ms.last().copied()
+    /// Where refinement first stopped (a load cap, or the visitor's target)
+    /// and when: what the crowd did to this visitor, before any wait for a
+    /// cap to lift.
+    pub fn first_stop(&self) -> Option<(u32, f64)> {
+        let level = self.first_stop.or(self.reached())?;
+        Some((level, *self.level_ms.get(level as usize)?))
     }
 
     /// The cap this visitor ended at was set by load (manifest or 429).
@@ -399,6 +423,7 @@ impl Visit {
             device: Some(device),
             audience: Some(audience),
             arrive_ms: arrived.duration_since(self.epoch).as_secs_f64() * 1e3,
+            who,
             ..VisitorResult::default()
         };
         let mut reqs = Vec::with_capacity(16);
@@ -443,14 +468,7 @@ impl Visit {
         result.manifest_cap = Some(cap);
         result.manifest_reason = manifest["cap"]["reason"].as_str().map(str::to_owned);
         result.target = cap.min(last);
-        let urls: Vec<String> = manifest["levels"]
-            .as_array()
-            .map(|a| {
-                a.iter()
-                    .map(|l| l["url"].as_str().unwrap_or("").to_owned())
-                    .collect()
-            })
-            .unwrap_or_default();
+        let urls = level_urls(&manifest);
         if urls.len() <= result.target as usize {
             result.failure = Some("manifest lists fewer levels than its cap".into());
             return (result, reqs);
@@ -480,23 +498,91 @@ impl Visit {
         self.decode_wait(0, device).await;
         result.level_ms.push(t0.elapsed().as_secs_f64() * 1e3);
 
+        // Refine to the cap; while a load cap holds (it comes with
+        // `Retry-After`), read the manifest again after that wait and go on
+        // when the cap has risen, as the viewer does, for as long as the
+        // visitor stays.
+        let mut cap = ManifestCap::of(&manifest, last);
+        let mut urls = urls;
+        let mut from = 1;
+        loop {
+            let stop = self
+                .refine(&mut conn, &urls, from, device, t0, &mut result, &mut reqs)
+                .await;
+            let retry_after_s = match stop {
+                Stop::Failed => break,
+                Stop::Refused { retry_after_s } => retry_after_s,
+                Stop::AtCap if result.target < last => cap.retry_after_s,
+                Stop::AtCap => None,
+            };
+            let Some(after) = retry_after_s else { break };
+            let reached = result.reached().unwrap_or(0);
+            result.first_stop.get_or_insert(reached);
+            let wait =
+                Duration::from_secs_f64(after.max(0.0) + jitter(who, 1000 + result.rechecks));
+            if arrived.elapsed() + wait > self.config.stay {
+                result.held_at_end = true;
+                break;
+            }
+            tokio::time::sleep(wait).await;
+            result.rechecks += 1;
+            let m = self
+                .fetch_retrying(&mut conn, Kind::Manifest, &path, true, who, &mut reqs)
+                .await;
+            reqs.push(m.req);
+            from = reached as usize + 1;
+            let Some(manifest) = m
+                .body
+                .as_deref()
+                .filter(|_| m.req.status == 200)
+                .and_then(|b| serde_json::from_slice::<serde_json::Value>(b).ok())
+            else {
+                // No manifest this time: wait as long again (the viewer does).
+                cap.retry_after_s = Some(after);
+                continue;
+            };
+            let levels = level_urls(&manifest);
+            cap = ManifestCap::of(&manifest, last);
+            if cap.level > reached && levels.len() > cap.level as usize {
+                result.resumed = true;
+                result.target = cap.level;
+                urls = levels;
+            }
+        }
+        (result, reqs)
+    }
+
+    /// Batches `from..=result.target`, each decoded (waited for) before the
+    /// next is shown, the next one fetched meanwhile.
+    #[allow(clippy::too_many_arguments)]
+    async fn refine(
+        self: &Arc<Self>,
+        conn: &mut Conn,
+        urls: &[String],
+        from: usize,
+        device: Device,
+        t0: Instant,
+        result: &mut VisitorResult,
+        reqs: &mut Vec<Req>,
+    ) -> Stop {
         type Prefetch = (Fetched, Conn, Vec<Req>);
+        let who = result.who;
         let mut prefetch: Option<tokio::task::JoinHandle<Prefetch>> = None;
-        for k in 1..=result.target as usize {
+        for k in from..=result.target as usize {
             let f = match prefetch.take() {
                 Some(handle) => match handle.await {
                     Ok((f, c, retried)) => {
-                        conn = c;
+                        *conn = c;
                         reqs.extend(retried);
                         f
                     }
                     Err(e) => {
                         result.failure = Some(format!("prefetch task: {e}"));
-                        break;
+                        return Stop::Failed;
                     }
                 },
                 None => {
-                    self.fetch_retrying(&mut conn, Kind::Batch, &urls[k], false, who, &mut reqs)
+                    self.fetch_retrying(conn, Kind::Batch, &urls[k], false, who, reqs)
                         .await
                 }
             };
@@ -509,19 +595,27 @@ impl Visit {
                     .unwrap_or_default();
                 if body["error"] == "level_capped" {
                     let reason = body["reason"].as_str().map(str::to_owned);
-                    result.refused = Some((k as u32, f.req.status, reason));
-                    break;
+                    result
+                        .refused
+                        .get_or_insert((k as u32, f.req.status, reason));
+                    return Stop::Refused {
+                        retry_after_s: f.retry_after_s,
+                    };
                 }
             }
             if f.req.status != 200 {
-                fail(&mut result, &f, &format!("batch {k}"));
-                break;
+                result.failure = Some(
+                    f.error
+                        .clone()
+                        .unwrap_or_else(|| format!("batch {k}: HTTP {}", f.req.status)),
+                );
+                return Stop::Failed;
             }
             if k < result.target as usize {
-                let visit = Arc::clone(&self);
+                let visit = Arc::clone(self);
                 let url = urls[k + 1].clone();
                 let mut c = std::mem::replace(
-                    &mut conn,
+                    conn,
                     Conn::new(&self.config.base_url, "", None, Duration::ZERO),
                 );
                 prefetch = Some(tokio::spawn(async move {
@@ -535,8 +629,47 @@ impl Visit {
             self.decode_wait(k, device).await;
             result.level_ms.push(t0.elapsed().as_secs_f64() * 1e3);
         }
-        (result, reqs)
+        Stop::AtCap
     }
+}
+
+/// Why [`Visit::refine`] stopped.
+enum Stop {
+    /// At the target: the manifest's cap, or the last level.
+    AtCap,
+    /// A batch answered 403/429 `level_capped`.
+    Refused {
+        retry_after_s: Option<f64>,
+    },
+    Failed,
+}
+
+/// The manifest's cap on refinement, and when to ask again (load caps only).
+struct ManifestCap {
+    level: u32,
+    retry_after_s: Option<f64>,
+}
+
+impl ManifestCap {
+    fn of(manifest: &serde_json::Value, last: u32) -> Self {
+        let cap = &manifest["cap"];
+        ManifestCap {
+            level: (cap["level"].as_u64().unwrap_or(0) as u32).min(last),
+            retry_after_s: cap["retry_after_s"].as_f64(),
+        }
+    }
+}
+
+/// Each level's payload URL, base mesh first.
+fn level_urls(manifest: &serde_json::Value) -> Vec<String> {
+    manifest["levels"]
+        .as_array()
+        .map(|a| {
+            a.iter()
+                .map(|l| l["url"].as_str().unwrap_or("").to_owned())
+                .collect()
+        })
+        .unwrap_or_default()
 }
 
 /// Runs a crowd to the end.
