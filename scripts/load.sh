@@ -13,7 +13,10 @@
 #   scripts/load.sh --short    CI (≤ 5 minutes with scripts/faults.sh --short): igea.ply
 #                              (134 k vertices), 1 and 200 visitors with caps on;
 #                              fails on any answer but 200/304/429/503, a 429/503
-#                              without Retry-After, or a p99 over SHORT_P99_MS
+#                              without Retry-After, or a p99 over SHORT_P99_MS; then
+#                              the same crowd against load thresholds it exceeds:
+#                              fails unless load caps engage and every visitor they
+#                              held refines on after re-reading the manifest
 #
 # Environment: RUNS (3), VISITORS ("1,50,100,1000,5000"), PATTERNS ("ramp:10 steady:20",
 # extra 1,000-visitor runs), LOAD_MESH (a mesh instead of the upsampled igea),
@@ -51,6 +54,14 @@ if [ $short = 1 ]; then
     "$load" run --db "$db" --slug short --token "$token" --visitors "1,$n" --caps on \
         --listen 127.0.0.1:18190 --out "$work/out" \
         --check-visitors "$n" --max-p99-ms "${SHORT_P99_MS:-100}"
+    # Load caps that engage and lift: thresholds this crowd exceeds, no
+    # admission control, a 2 s Retry-After. Every visitor a load cap held
+    # must read the manifest again and refine on once the pressure falls.
+    "$load" run --db "$db" --slug short --token "$token" --visitors "1,$n" --caps on \
+        --listen 127.0.0.1:18190 --out "$work/resume" --stay-s 30 \
+        --serve-arg=--load-high-inflight --serve-arg=30 --serve-arg=--load-low-inflight --serve-arg=10 \
+        --serve-arg=--admit-rate --serve-arg=0 --serve-arg=--load-retry-after-s --serve-arg=2 \
+        --check-visitors "$n" --check-resume
     exit 0
 fi
 

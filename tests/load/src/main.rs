@@ -164,6 +164,10 @@ struct RunArgs {
     max_ratio: Option<f64>,
     #[arg(long)]
     check_visitors: Option<usize>,
+    /// Fail unless load caps held some of its visitors and every one of them
+    /// refined on after a re-check (run with thresholds the crowd exceeds).
+    #[arg(long)]
+    check_resume: bool,
 }
 
 #[derive(clap::Args)]
@@ -460,6 +464,12 @@ async fn run(args: RunArgs) -> Result<()> {
                             m.p99_ms
                         ));
                     }
+                }
+                if args.check_resume && (m.load_capped == 0 || m.resumed < m.load_capped) {
+                    violations.push(format!(
+                        "caps on, {n} visitors: {} resumed of {} load-capped ({} still held when leaving)",
+                        m.resumed, m.load_capped, m.held_at_end
+                    ));
                 }
                 if let Some(max) = args.max_ratio {
                     if m.ratio_p95.is_nan() || m.ratio_p95 > max {

@@ -530,7 +530,9 @@ impl Visit {
                 .fetch_retrying(&mut conn, Kind::Manifest, &path, true, who, &mut reqs)
                 .await;
             reqs.push(m.req);
+            // Nothing more unless the cap has risen past what is on screen.
             from = reached as usize + 1;
+            result.target = reached;
             let Some(manifest) = m
                 .body
                 .as_deref()
