@@ -6,7 +6,7 @@ use crate::{Error, Result};
 use std::ops::Range;
 
 pub const MAGIC: [u8; 4] = *b"VTRN";
-pub const VERSION: u8 = 3;
+pub const VERSION: u8 = 4;
 pub(crate) const HEADER_FIXED: usize = 40;
 pub(crate) const LEVEL_ENTRY: usize = 12;
 pub(crate) const BASE_TAG: u8 = b'M';

@@ -242,8 +242,10 @@ fn write_stream(
     let input_vertices = quantized.len();
     // Final numbering: base vertices by first appearance, then each batch's
     // vertices in insertion order (coarsest layer first, cleaning before decimation).
-    let base_triangles: Vec<[u32; 3]> = base_mesh::face_walk_order(&s.conn)
-        .into_iter()
+    let walk = base_mesh::face_walk(&s.conn);
+    let base_triangles: Vec<[u32; 3]> = walk
+        .triangles
+        .iter()
         .map(|t| t.map(|v| s.ids[v as usize]))
         .collect();
     let mut vertex_order = base_mesh::first_appearance_order(input_vertices, &base_triangles);
@@ -272,7 +274,7 @@ fn write_stream(
             .map(|t| t.map(|v| new_id[v as usize]))
             .collect(),
     };
-    let base_payload = base_mesh::encode(&base);
+    let base_payload = base_mesh::encode(&base, &walk.pushed, quantization.max_value());
     let mut base_chunk = Vec::new();
     ChunkHeader {
         tag: BASE_TAG,
