@@ -189,6 +189,7 @@ pub(crate) fn encode(base: &BaseMesh, pushed: &[u8], max_coordinate: i32) -> Vec
     let mut stack: Vec<[u32; 3]> = Vec::new();
     for (t, &bits) in base.triangles.iter().zip(pushed) {
         let first = depth == 0;
+        let seen_before = next_new;
         if first {
             for &v in t {
                 debug_assert!(v <= next_new, "base mesh must be first-appearance numbered");
@@ -209,7 +210,8 @@ pub(crate) fn encode(base: &BaseMesh, pushed: &[u8], max_coordinate: i32) -> Vec
                 add_vertex(x, Origin::Across { p, q, o }, &mut m, &mut enc);
             }
         }
-        let new_third = usize::from(first || t[2] + 1 == next_new);
+        // Only the third corner can be new, but for a component's first face.
+        let new_third = usize::from(first || next_new > seen_before);
         for (bit, entry) in edge_entries(*t).into_iter().enumerate() {
             if bit == 0 && !first {
                 continue;
@@ -293,6 +295,7 @@ pub(crate) fn decode(
             dec.check_overrun()?;
         }
         let first = stack.is_empty();
+        let seen_before = next_new;
         let t = if let Some([p, q, o]) = stack.pop() {
             let back = dec.decode_uint(&mut m.third);
             if back > next_new {
@@ -338,7 +341,8 @@ pub(crate) fn decode(
         if t[0] == t[1] || t[1] == t[2] || t[2] == t[0] {
             return Err(Error::stream("base mesh face repeats a vertex"));
         }
-        let new_third = usize::from(first || t[2] + 1 == next_new);
+        // Only the third corner can be new, but for a component's first face.
+        let new_third = usize::from(first || next_new > seen_before);
         for (bit, entry) in edge_entries(t).into_iter().enumerate() {
             if bit == 0 && !first {
                 continue;
