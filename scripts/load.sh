@@ -54,12 +54,14 @@ if [ $short = 1 ]; then
     "$load" run --db "$db" --slug short --token "$token" --visitors "1,$n" --caps on \
         --listen 127.0.0.1:18190 --out "$work/out" \
         --check-visitors "$n" --max-p99-ms "${SHORT_P99_MS:-100}"
-    # Load caps that engage and lift: thresholds this crowd exceeds, no
+    # Load caps that engage and lift: thresholds this crowd exceeds, sampled
+    # every 50 ms so that they engage within the burst on any machine, no
     # admission control, a 2 s Retry-After. Every visitor a load cap held
     # must read the manifest again and refine on once the pressure falls.
     "$load" run --db "$db" --slug short --token "$token" --visitors "1,$n" --caps on \
         --listen 127.0.0.1:18190 --out "$work/resume" --stay-s 30 \
-        --serve-arg=--load-high-inflight --serve-arg=30 --serve-arg=--load-low-inflight --serve-arg=10 \
+        --serve-arg=--load-high-inflight --serve-arg=10 --serve-arg=--load-low-inflight --serve-arg=3 \
+        --serve-arg=--load-sample-ms --serve-arg=50 \
         --serve-arg=--admit-rate --serve-arg=0 --serve-arg=--load-retry-after-s --serve-arg=2 \
         --check-visitors "$n" --check-resume
     exit 0
