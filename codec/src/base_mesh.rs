@@ -118,6 +118,21 @@ impl Models {
             colour_mean: std::array::from_fn(|_| IntModel::new()),
         }
     }
+
+    /// The models of a new vertex's position residual, by what predicts it.
+    fn position(&mut self, origin: Origin) -> &mut [IntModel; 3] {
+        match origin {
+            Origin::Previous => &mut self.delta,
+            Origin::Across { .. } => &mut self.parallelogram,
+        }
+    }
+
+    fn colour(&mut self, origin: Origin) -> &mut [IntModel; 3] {
+        match origin {
+            Origin::Previous => &mut self.colour_delta,
+            Origin::Across { .. } => &mut self.colour_mean,
+        }
+    }
 }
 
 /// What a new vertex is predicted from: the previous vertex (a component's
@@ -157,59 +172,52 @@ pub(crate) fn encode(base: &BaseMesh, pushed: &[u8], max_coordinate: i32) -> Vec
     let mut enc = RangeEncoder::new();
     let mut m = Models::new();
     let mut next_new = 0u32;
-    // Only the stack's depth matters here: it is empty exactly where a
-    // component starts.
-    let mut depth = 0usize;
-    let mut seen_positions: Vec<[i32; 3]> = Vec::with_capacity(base.positions.len());
-    let mut seen_colours: Vec<[u8; 3]> = Vec::new();
-    let mut add_vertex = |v: u32, origin: Origin, m: &mut Models, enc: &mut RangeEncoder| {
-        let predicted = predict_position(origin, &seen_positions, max_coordinate);
-        let models = match origin {
-            Origin::Previous => &mut m.delta,
-            Origin::Across { .. } => &mut m.parallelogram,
-        };
-        let p = base.positions[v as usize];
+    // Vertices are numbered by first appearance: those seen so far are a
+    // prefix of `base`'s, which is what the decoder predicts from.
+    let add_vertex = |v: u32, origin: Origin, m: &mut Models, enc: &mut RangeEncoder| {
+        let seen = v as usize;
+        let predicted = predict_position(origin, &base.positions[..seen], max_coordinate);
+        let p = base.positions[seen];
+        let models = m.position(origin);
         for k in 0..3 {
             enc.encode_int(&mut models[k], p[k] - predicted[k]);
         }
-        seen_positions.push(p);
         if let Some(colours) = &base.colours {
-            let predicted = predict_colour(origin, &seen_colours);
-            let models = match origin {
-                Origin::Previous => &mut m.colour_delta,
-                Origin::Across { .. } => &mut m.colour_mean,
-            };
-            let c = colours[v as usize];
+            let predicted = predict_colour(origin, &colours[..seen]);
+            let c = colours[seen];
+            let models = m.colour(origin);
             for k in 0..3 {
                 enc.encode_int(&mut models[k], c[k].wrapping_sub(predicted[k]) as i8 as i32);
             }
-            seen_colours.push(c);
         }
     };
     let mut stack: Vec<[u32; 3]> = Vec::new();
     for (t, &bits) in base.triangles.iter().zip(pushed) {
-        let first = depth == 0;
         let seen_before = next_new;
-        if first {
-            for &v in t {
-                debug_assert!(v <= next_new, "base mesh must be first-appearance numbered");
-                enc.encode_uint(&mut m.first_corner, next_new - v);
-                if v == next_new {
+        // The stack is empty exactly where a component starts.
+        let first = match stack.pop() {
+            Some([p, q, o]) => {
+                debug_assert_eq!([t[0], t[1]], [p, q], "faces start with their entry edge");
+                let x = t[2];
+                enc.encode_uint(&mut m.third, next_new - x);
+                if x == next_new {
                     next_new += 1;
-                    add_vertex(v, Origin::Previous, &mut m, &mut enc);
+                    add_vertex(x, Origin::Across { p, q, o }, &mut m, &mut enc);
                 }
+                false
             }
-        } else {
-            depth -= 1;
-            let [p, q, o] = stack.pop().expect("the walk's stack mirrors its depth");
-            debug_assert_eq!([t[0], t[1]], [p, q], "faces start with their entry edge");
-            let x = t[2];
-            enc.encode_uint(&mut m.third, next_new - x);
-            if x == next_new {
-                next_new += 1;
-                add_vertex(x, Origin::Across { p, q, o }, &mut m, &mut enc);
+            None => {
+                for &v in t {
+                    debug_assert!(v <= next_new, "base mesh must be first-appearance numbered");
+                    enc.encode_uint(&mut m.first_corner, next_new - v);
+                    if v == next_new {
+                        next_new += 1;
+                        add_vertex(v, Origin::Previous, &mut m, &mut enc);
+                    }
+                }
+                true
             }
-        }
+        };
         // Only the third corner can be new, but for a component's first face.
         let new_third = usize::from(first || next_new > seen_before);
         for (bit, entry) in edge_entries(*t).into_iter().enumerate() {
@@ -220,7 +228,6 @@ pub(crate) fn encode(base: &BaseMesh, pushed: &[u8], max_coordinate: i32) -> Vec
             enc.encode_bit(&mut m.pushed[bit][new_third], push);
             if push {
                 stack.push(entry);
-                depth += 1;
             }
         }
     }
@@ -264,10 +271,7 @@ pub(crate) fn decode(
             return Err(Error::stream("base mesh uses more vertices than declared"));
         }
         let predicted = predict_position(origin, positions, max_coordinate);
-        let models = match origin {
-            Origin::Previous => &mut m.delta,
-            Origin::Across { .. } => &mut m.parallelogram,
-        };
+        let models = m.position(origin);
         let mut p = [0i32; 3];
         for k in 0..3 {
             p[k] = predicted[k].wrapping_add(dec.decode_int(&mut models[k]));
@@ -280,10 +284,7 @@ pub(crate) fn decode(
         positions.push(p);
         if has_colour {
             let predicted = predict_colour(origin, colours);
-            let models = match origin {
-                Origin::Previous => &mut m.colour_delta,
-                Origin::Across { .. } => &mut m.colour_mean,
-            };
+            let models = m.colour(origin);
             colours.push(std::array::from_fn(|k| {
                 predicted[k].wrapping_add(dec.decode_int(&mut models[k]) as u8)
             }));
