@@ -1,4 +1,6 @@
 //! Profiling aid: `cargo run --release --example decode_loop mesh.ply [decode-runs] [encode-runs]`.
+//! Encoding runs on one core (as `vitrine bench` times it) unless
+//! `VITRINE_PIPELINED=1`.
 use std::time::Instant;
 use vitrine_codec::import::{import_path, ImportOptions};
 use vitrine_codec::repair::{prepare, RepairOptions};
@@ -14,11 +16,15 @@ fn main() {
     .unwrap()
     .0;
     let encode_runs: usize = std::env::args().nth(3).map_or(1, |s| s.parse().unwrap());
+    let options = EncodeOptions {
+        pipelined: std::env::var_os("VITRINE_PIPELINED").is_some(),
+        ..EncodeOptions::default()
+    };
     let mut encode_times = Vec::new();
     let mut e = None;
     for _ in 0..encode_runs.max(1) {
         let t = Instant::now();
-        e = Some(encode(&mesh, &EncodeOptions::default()).unwrap());
+        e = Some(encode(&mesh, &options).unwrap());
         encode_times.push(t.elapsed().as_secs_f64());
     }
     let e = e.unwrap();

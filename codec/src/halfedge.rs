@@ -44,15 +44,8 @@ impl Connectivity {
     /// Builds twins from a triangle list. Fails on a non-manifold or
     /// inconsistently oriented edge: [`crate::repair::prepare`] removes those.
     pub(crate) fn from_triangles(vertex_count: usize, triangles: &[[u32; 3]]) -> Result<Self> {
-        let mut origin = Vec::with_capacity(triangles.len() * 3);
-        for t in triangles {
-            if t.iter().any(|&v| v as usize >= vertex_count) {
-                return Err(Error::Unsupported(format!(
-                    "face {t:?} indexes a missing vertex"
-                )));
-            }
-            origin.extend_from_slice(t);
-        }
+        check_indices(vertex_count, triangles)?;
+        let origin = triangles.as_flattened().to_vec();
         // Pair half-edges by undirected edge: bucket them by their smaller
         // endpoint with a counting sort (two streaming passes; a hash map or
         // a global sort by edge key costs a cache miss or several passes per
@@ -218,6 +211,19 @@ fn non_manifold(what: &str, origin: &[u32], h: u32) -> Error {
 }
 
 /// Builds connectivity for a mesh that passed repair.
+/// An error naming the first face with a corner beyond `vertex_count`.
+pub(crate) fn check_indices(vertex_count: usize, triangles: &[[u32; 3]]) -> Result<()> {
+    match triangles
+        .iter()
+        .find(|t| t.iter().any(|&v| v as usize >= vertex_count))
+    {
+        Some(t) => Err(Error::Unsupported(format!(
+            "face {t:?} indexes a missing vertex"
+        ))),
+        None => Ok(()),
+    }
+}
+
 pub(crate) fn connectivity(mesh: &IndexedMesh) -> Result<Connectivity> {
     Connectivity::from_triangles(mesh.positions.len(), &mesh.triangles)
 }

@@ -42,8 +42,10 @@ struct Patch {
 }
 
 impl<'g> Simplifier<'g> {
+    /// `ids` gives each vertex's input-vertex id.
     pub(crate) fn new(
         conn: Connectivity,
+        ids: Vec<u32>,
         positions: Vec<[i32; 3]>,
         colours: Option<Vec<[u8; 3]>>,
         geometric_guard: bool,
@@ -52,7 +54,7 @@ impl<'g> Simplifier<'g> {
         let n = positions.len();
         Simplifier {
             conn,
-            ids: (0..n as u32).collect(),
+            ids,
             positions,
             colours,
             geometric_guard,
@@ -234,10 +236,7 @@ impl<'g> Simplifier<'g> {
             self.face_done[f as usize] = true;
             self.conquer(front, Tag::Plus);
             for h in [next(g), prev(g)] {
-                let t = self.conn.twin[h as usize];
-                if t != NONE {
-                    gates.push_back(t);
-                }
+                self.push_gate(self.conn.twin[h as usize], gates);
             }
         }
     }
@@ -428,8 +427,20 @@ impl<'g> Simplifier<'g> {
         self.state[p.centre as usize] = REMOVED;
         self.live_vertices -= 1;
         for &o in &outer[1..d] {
-            if o != NONE {
-                gates.push_back(o);
+            self.push_gate(o, gates);
+        }
+    }
+
+    /// Queues gate `h` unless it is a border (`NONE`) or its face is dead or
+    /// already conquered: faces are neither revived nor un-conquered within
+    /// a pass, so such a gate would be skipped when popped anyway (as in
+    /// [`crate::gates`], which keeps most gates out of the FIFO this way).
+    #[inline]
+    fn push_gate(&self, h: u32, gates: &mut VecDeque<u32>) {
+        if h != NONE {
+            let f = face(h);
+            if self.conn.face_alive(f) && !self.face_done[f as usize] {
+                gates.push_back(h);
             }
         }
     }

@@ -2,17 +2,19 @@
 
 mod coding;
 mod conquest;
+mod locality;
 
 use crate::base_mesh::{self, BaseMesh};
 use crate::format::{
     write_section, write_varint, ChunkHeader, Header, LevelInfo, BASE_TAG, BATCH_TAG, VERSION,
 };
-use crate::halfedge::connectivity;
+use crate::halfedge::{check_indices, connectivity, Connectivity};
 use crate::patch::MAX_VALENCE;
 use crate::quantize::Quantization;
 use crate::{Error, IndexedMesh, Result};
 use coding::{PassOutput, PassSink};
 use conquest::{PassKind, Simplifier};
+use locality::LocalityOrder;
 
 /// Below this fraction of valence-3 vertices a layer skips its cleaning conquest.
 const CLEANING_MIN_FRACTION: f64 = 0.1;
@@ -152,8 +154,16 @@ pub fn encode_guarded(
         .iter()
         .map(|&p| quantization.quantize(p))
         .collect();
-    let conn = connectivity(mesh)?;
     let input_vertices = mesh.positions.len();
+    check_indices(input_vertices, &mesh.triangles)?;
+    let mut order = LocalityOrder::of(&positions, &mesh.triangles, quantization.max_value());
+    let conn = match Connectivity::from_triangles(input_vertices, &order.triangles) {
+        Ok(conn) => conn,
+        // Name the culprit in the caller's vertex ids: the input's own order.
+        Err(e) => return Err(connectivity(mesh).err().unwrap_or(e)),
+    };
+    // The connectivity holds the faces now; a scan's worth of memory back.
+    order.triangles = Vec::new();
     if conn.out.contains(&crate::halfedge::NONE) {
         return Err(Error::Unsupported(
             "mesh has vertices no face uses (run repair first)".into(),
@@ -165,10 +175,13 @@ pub fn encode_guarded(
     }
     .max(options.min_base_vertices as usize);
 
+    let local_positions = order.permute(&positions);
+    let local_colours = mesh.colors.as_deref().map(|c| order.permute(c));
     let mut s = Simplifier::new(
         conn,
-        positions.clone(),
-        mesh.colors.clone(),
+        order.vertices,
+        local_positions,
+        local_colours,
         options.geometric_guard,
         guard,
     );
