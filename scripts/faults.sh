@@ -102,6 +102,17 @@ serve() { # db [extra flags...]
     return 1
 }
 
+stop_proxy() {
+    [ -z "$proxy_pid" ] || kill "$proxy_pid" 2>/dev/null || true
+    proxy_pid=""
+}
+
+give_up() { # case detail: a FAIL that ends the case, its server and delay line with it
+    report FAIL "$1" "$2"
+    stop_server
+    stop_proxy
+}
+
 proxy() { # delay-ms: a TCP delay line in front of the throw-away cluster, once it listens
     "$load" proxy --listen "127.0.0.1:$proxy_port" --to "127.0.0.1:$pg_port" --delay-ms "$1" 2>>"$work/proxy.log" &
     pids+=("$!")
@@ -191,29 +202,24 @@ case_pg_restart() {
 case_slow_db() {
     pg_setup || { report SKIP slow_db "no PostgreSQL binaries"; return; }
     proxy 50 || { report FAIL slow_db "the delay line did not start"; return; }
-    local proxy=$proxy_pid
     local out=""
     for caps in on off; do
         local flags=(--cache-bytes 0)
         [ $caps = off ] && flags+=(--admit-rate 0 --load-high-inflight 1000000000 --load-high-latency-ms 1000000000 --load-high-queue-ms 1000000000)
-        if ! serve "postgres://postgres@127.0.0.1:$proxy_port/postgres" "${flags[@]}"; then
-            report FAIL slow_db "caps $caps: the server did not become ready through the delay line (see above)"
-            stop_server
-            kill "$proxy"
+        serve "postgres://postgres@127.0.0.1:$proxy_port/postgres" "${flags[@]}" || {
+            give_up slow_db "caps $caps: the server did not become ready through the delay line (see above)"
             return
-        fi
+        }
         if "$load" crowd --url "$url" --slug sample --profile "$profile" --visitors "$crowd_n" \
             --pattern burst >"$work/slow_db_$caps.out" 2>&1; then
             out+="caps $caps: $(tail -n 2 "$work/slow_db_$caps.out" | head -n 1). "
         else
-            report FAIL slow_db "caps $caps: $(tail -n 4 "$work/slow_db_$caps.out")"
-            stop_server
-            kill "$proxy"
+            give_up slow_db "caps $caps: $(tail -n 4 "$work/slow_db_$caps.out")"
             return
         fi
         stop_server
     done
-    kill "$proxy"
+    stop_proxy
     report PASS slow_db "+50 ms on every PostgreSQL answer (TCP delay line), payload cache off, $crowd_n visitors at once. $out"
 }
 
@@ -387,19 +393,16 @@ case_disconnects() {
 case_shutdown() {
     pg_setup || { report SKIP shutdown "no PostgreSQL binaries (requests need a slow database to be in flight)"; return; }
     proxy 200 || { report FAIL shutdown "the delay line did not start"; return; }
-    local proxy=$proxy_pid
     # Opening a connection through the 200 ms line takes several round trips:
     # on a busy machine that outlasted the default 3 s acquire timeout, and the
     # server retried its migrations until the readiness wait ran out (a CI
     # failure). This case is about shutdown, not the database: give it 10 s.
-    if ! serve "postgres://postgres@127.0.0.1:$proxy_port/postgres" --db-timeout-ms 10000 \
+    serve "postgres://postgres@127.0.0.1:$proxy_port/postgres" --db-timeout-ms 10000 \
         --cache-bytes 0 --record-ttl-ms 100 --db-max-connections 64 \
-        --load-high-inflight 1000000000 --load-high-latency-ms 1000000000 --load-high-queue-ms 1000000000; then
-        report FAIL shutdown "the server did not become ready through the delay line (see above)"
-        stop_server
-        kill "$proxy"
+        --load-high-inflight 1000000000 --load-high-latency-ms 1000000000 --load-high-queue-ms 1000000000 || {
+        give_up shutdown "the server did not become ready through the delay line (see above)"
         return
-    fi
+    }
     local pid=$server t0=$SECONDS
     if "$load" crowd --url "$url" --slug sample --profile "$profile" --visitors 80 --pattern steady:4 \
         --sigterm-pid "$pid" --sigterm-after-s 3 >"$work/shutdown.out" 2>&1; then
@@ -408,10 +411,10 @@ case_shutdown() {
         server=""
         report PASS shutdown "SIGTERM at 3 s into a crowd of 80 arriving over 4 s (database +200 ms, payload cache off): $(grep -m1 '^SIGTERM' "$work/shutdown.out"); server exit status $status after $((SECONDS - t0)) s"
     else
-        report FAIL shutdown "$(tail -n 4 "$work/shutdown.out")"
-        stop_server
+        give_up shutdown "$(tail -n 4 "$work/shutdown.out")"
+        return
     fi
-    kill "$proxy"
+    stop_proxy
 }
 
 case_hostile() {
