@@ -246,6 +246,34 @@ mod tests {
     }
 
     #[test]
+    fn has_edge_agrees_with_the_face_list_on_borders_and_closed_surfaces() {
+        use crate::samples::icosphere;
+        // Two holes: the umbrellas of vertices 0 and 40 taken out.
+        let mut open = icosphere(2);
+        open.triangles
+            .retain(|t| !t.contains(&0) && !t.contains(&40));
+        for (mesh, bordered) in [(icosphere(2), false), (open, true)] {
+            let n = mesh.positions.len();
+            let c = Connectivity::from_triangles(n, &mesh.triangles).unwrap();
+            let mut edges = std::collections::HashSet::new();
+            for t in &mesh.triangles {
+                for k in 0..3 {
+                    let (a, b) = (t[k], t[(k + 1) % 3]);
+                    edges.insert((a.min(b), a.max(b)));
+                }
+            }
+            assert_eq!(c.twin.contains(&NONE), bordered);
+            // Vertices without faces (the holes' centres) have no fan to ask.
+            for a in (0..n as u32).filter(|&a| c.out[a as usize] != NONE) {
+                for b in 0..n as u32 {
+                    let expected = edges.contains(&(a.min(b), a.max(b)));
+                    assert_eq!(c.has_edge(a, b), expected, "{a}–{b}");
+                }
+            }
+        }
+    }
+
+    #[test]
     fn rejects_edge_with_three_faces() {
         let tris = [[0, 1, 2], [1, 0, 3], [0, 1, 4]];
         assert!(Connectivity::from_triangles(5, &tris).is_err());
