@@ -204,7 +204,7 @@ impl Traversal {
         let region = match kind {
             PassKind::Decimating => {
                 // Patches of every valence up to the widest that fits are possible.
-                let widest = self.widest_fit(conn, g, g0, g1);
+                let (widest, entries) = self.widest_fit(conn, g, g0, g1);
                 let front_valence = (umbrellas[front as usize][3] as usize).clamp(2, 9) - 2;
                 let m = (((ctx * FRONT_VALENCES + front_valence) * VALENCE_CLASSES
                     + class(origin))
@@ -221,7 +221,7 @@ impl Traversal {
                     0 => None,
                     sym => {
                         let pat = pattern(MIN_VALENCE - 1 + sym, g0, g1);
-                        Some(self.find_patch(conn, g, pat).ok_or_else(|| {
+                        Some(self.find_patch(conn, g, pat, &entries).ok_or_else(|| {
                             Error::stream("patch faces do not match their pattern")
                         })?)
                     }
@@ -236,7 +236,8 @@ impl Traversal {
                     s.cleaning[m][usize::from(removed)] += 1;
                 }
                 if removed {
-                    let region = self.find_patch(conn, g, pattern(MIN_VALENCE, g0, g1));
+                    // A triangle: the gate's face alone, no face to walk to.
+                    let region = self.find_patch(conn, g, pattern(MIN_VALENCE, g0, g1), &[g; 4]);
                     Some(region.ok_or_else(|| Error::stream("cleaning patch does not fit"))?)
                 } else {
                     None
@@ -263,33 +264,48 @@ impl Traversal {
     }
 
     /// The largest valence whose patch faces exist around the gate and are
-    /// unconquered (3 at least: the gate's own face is free). A superset of
-    /// what [`Traversal::find_patch`] accepts, which also checks the polygon.
+    /// unconquered (3 at least: the gate's own face is free), and the
+    /// half-edge each of those faces is entered by (the gate first, then
+    /// the faces in [`growth`] order). A superset of what
+    /// [`Traversal::find_patch`] accepts, which also checks the polygon.
     #[inline]
-    fn widest_fit(&self, c: &Connectivity, g: u32, g0: Tag, g1: Tag) -> usize {
+    fn widest_fit(&self, c: &Connectivity, g: u32, g0: Tag, g1: Tag) -> (usize, Entries) {
         let mut faces = [face(g); MAX_VALENCE - 2];
+        // The half-edge each face was entered by: every grown face is one
+        // step on from an earlier one (its parent), so one twin load each.
+        let mut entries = [g; MAX_VALENCE - 2];
         for (n, added) in growth(g0, g1).iter().enumerate() {
-            let mut h = g;
-            for &step in &added.steps[..added.len as usize] {
-                let out = if step == 1 { next(h) } else { prev(h) };
-                h = c.twin[out as usize];
-                if h == NONE {
-                    return MIN_VALENCE + n;
-                }
+            let from = entries[added.parent as usize];
+            let out = match added.steps[added.len as usize - 1] {
+                1 => next(from),
+                _ => prev(from),
+            };
+            let h = c.twin[out as usize];
+            if h == NONE {
+                return (MIN_VALENCE + n, entries);
             }
             let f = face(h);
             if self.face_done[f as usize] || faces[..=n].contains(&f) {
-                return MIN_VALENCE + n;
+                return (MIN_VALENCE + n, entries);
             }
             faces[n + 1] = f;
+            entries[n + 1] = h;
         }
-        MAX_VALENCE
+        (MAX_VALENCE, entries)
     }
 
-    /// Walks the `valence − 2` faces of the retriangulated patch from the
-    /// gate; `None` when they do not fit (a border, a conquered face, a
-    /// repeated vertex).
-    fn find_patch(&self, c: &Connectivity, g: u32, pat: &Pattern) -> Option<Region> {
+    /// The `valence − 2` faces of the retriangulated patch at the gate, from
+    /// the half-edges [`Traversal::widest_fit`] entered them by (it found
+    /// them on the mesh, unconquered and distinct, for every valence up to
+    /// the widest, and a code never names a wider one); `None` when their
+    /// corners do not make the pattern's polygon (a repeated vertex).
+    fn find_patch(
+        &self,
+        c: &Connectivity,
+        g: u32,
+        pat: &Pattern,
+        entries: &Entries,
+    ) -> Option<Region> {
         let d = pat.valence;
         let count = d - 2;
         let advance = |mut h: u32, steps: u8| {
@@ -301,17 +317,9 @@ impl Traversal {
         let mut corner0 = [NONE; MAX_VALENCE - 2];
         // Corner 0 of the gate triangle is `gate_corner` steps before the gate.
         corner0[pat.gate_triangle as usize] = advance(g, 3 - pat.gate_corner);
-        for &[from, k, to, r] in &pat.walk[..d - 3] {
-            let h = c.twin[advance(corner0[from as usize], k) as usize];
-            if h == NONE {
-                return None;
-            }
-            let f = face(h);
-            if self.face_done[f as usize]
-                || corner0[..count].iter().any(|&x| x != NONE && face(x) == f)
-            {
-                return None;
-            }
+        // The pattern's walk reaches its faces in growth order (tested in
+        // `patch`): walk step `i` enters by `entries[i + 1]`.
+        for (&[_, _, to, r], &h) in pat.walk[..d - 3].iter().zip(&entries[1..]) {
             corner0[to as usize] = advance(h, 3 - r);
         }
         let mut polygon = [NONE; MAX_VALENCE];
@@ -381,6 +389,10 @@ impl Traversal {
         }
     }
 }
+
+/// The half-edges a patch's faces are entered by: the gate, then one per
+/// face grown around it ([`Traversal::widest_fit`]).
+type Entries = [u32; MAX_VALENCE - 2];
 
 /// Gate vertices are always tagged in a well-formed pass; a hostile one
 /// must still not panic, so an untagged vertex reads as `+`.

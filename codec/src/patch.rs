@@ -187,6 +187,11 @@ impl Pattern {
 pub(crate) struct Growth {
     pub len: u8,
     pub steps: [u8; MAX_VALENCE - 3],
+    /// The face this walk passes last before its own: 0 for the gate's,
+    /// `n + 1` for the face grown at step `n` (always an earlier one: every
+    /// walk's prefix is a face of the smaller patch). Walking on from there
+    /// takes one step, the last of `steps`.
+    pub parent: u8,
 }
 
 pub(crate) fn growth(t0: Tag, t1: Tag) -> &'static [Growth; MAX_VALENCE - MIN_VALENCE] {
@@ -205,6 +210,18 @@ pub(crate) fn growth(t0: Tag, t1: Tag) -> &'static [Growth; MAX_VALENCE - MIN_VA
                         .expect("a larger patch adds a face");
                     g.len = added.len() as u8;
                     g.steps[..added.len()].copy_from_slice(added);
+                }
+                for n in 0..row.len() {
+                    let prefix = &row[n].steps[..row[n].len as usize - 1];
+                    row[n].parent = if prefix.is_empty() {
+                        0
+                    } else {
+                        let earlier = row[..n]
+                            .iter()
+                            .position(|e| &e.steps[..e.len as usize] == prefix)
+                            .expect("a walk's prefix is an earlier face");
+                        earlier as u8 + 1
+                    };
                 }
                 table.push(row);
             }
@@ -265,6 +282,30 @@ mod tests {
                     let added = growth(t0, t1)[valence - MIN_VALENCE];
                     let added = &added.steps[..added.len as usize];
                     assert!(big.iter().any(|w| w == added) && !small.iter().any(|w| w == added));
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn pattern_walks_reach_their_faces_in_growth_order() {
+        // The gate traversal enters a patch's faces by the half-edges its
+        // fit test found in growth order, so walk step i must be growth i,
+        // each one step on from its parent.
+        for t0 in [Tag::Plus, Tag::Minus] {
+            for t1 in [Tag::Plus, Tag::Minus] {
+                let grown = growth(t0, t1);
+                for valence in MIN_VALENCE..=MAX_VALENCE {
+                    let walks = pattern(valence, t0, t1).walks();
+                    for (i, w) in walks[1..].iter().enumerate() {
+                        let g = grown[i];
+                        assert_eq!(w[..], g.steps[..g.len as usize], "{valence} {t0:?} {t1:?}");
+                        let parent = match g.parent {
+                            0 => &[][..],
+                            p => &walks[p as usize][..],
+                        };
+                        assert_eq!(parent, &w[..w.len() - 1]);
+                    }
                 }
             }
         }
