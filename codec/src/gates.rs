@@ -134,12 +134,11 @@ impl Traversal {
     /// Walks one pass over `conn` from `seeds` (one gate `a → b` per
     /// connected component), asking `codes` for each gate's code and
     /// collecting at most `max_patches` patches in [`Traversal::regions`].
-    /// `umbrellas` are the coarse mesh's ([`crate::predict::umbrellas`]);
-    /// their counts are the vertices' valences.
+    /// `valences` are the coarse mesh's ([`crate::predict::umbrellas`]).
     pub(crate) fn run(
         &mut self,
         conn: &Connectivity,
-        umbrellas: &[[i32; 4]],
+        valences: &[u8],
         kind: PassKind,
         seeds: &[[u32; 2]],
         max_patches: usize,
@@ -169,7 +168,7 @@ impl Traversal {
             self.conquer(b, Tag::Minus);
             self.gates.push_back(h);
             while let Some(g) = self.gates.pop_front() {
-                self.gate(conn, umbrellas, g, kind, max_patches, &mut models, codes)?;
+                self.gate(conn, valences, g, kind, max_patches, &mut models, codes)?;
             }
         }
         Ok(())
@@ -179,7 +178,7 @@ impl Traversal {
     fn gate(
         &mut self,
         conn: &Connectivity,
-        umbrellas: &[[i32; 4]],
+        valences: &[u8],
         g: u32,
         kind: PassKind,
         max_patches: usize,
@@ -195,7 +194,7 @@ impl Traversal {
         let t0 = self.tag[origin as usize];
         let t1 = self.tag[target as usize];
         let ctx = gate_context(t0, t1, self.tag[front as usize]);
-        let class = |v: u32| match umbrellas[v as usize][3] {
+        let class = |v: u32| match valences[v as usize] {
             ..=4 => 0,
             5 | 6 => 1,
             _ => 2,
@@ -205,7 +204,7 @@ impl Traversal {
             PassKind::Decimating => {
                 // Patches of every valence up to the widest that fits are possible.
                 let (widest, entries) = self.widest_fit(conn, g, g0, g1);
-                let front_valence = (umbrellas[front as usize][3] as usize).clamp(2, 9) - 2;
+                let front_valence = (valences[front as usize] as usize).clamp(2, 9) - 2;
                 let m = (((ctx * FRONT_VALENCES + front_valence) * VALENCE_CLASSES
                     + class(origin))
                     * VALENCE_CLASSES

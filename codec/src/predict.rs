@@ -65,7 +65,16 @@ pub(crate) struct PatchPrediction {
 /// sequential sweep over the faces; exact integers, so the encoder (after a
 /// pass) and the decoder (before undoing it) get the same values whatever
 /// their face order.
-pub(crate) fn umbrellas(conn: &Connectivity, positions: &[[i32; 3]], out: &mut Vec<[i32; 4]>) {
+///
+/// `valences` gets the counts again, saturated to a byte: the gate
+/// traversal's contexts read only those, and at a byte a vertex they stay
+/// in cache where the 16-byte umbrellas missed it.
+pub(crate) fn umbrellas(
+    conn: &Connectivity,
+    positions: &[[i32; 3]],
+    out: &mut Vec<[i32; 4]>,
+    valences: &mut Vec<u8>,
+) {
     out.clear();
     out.resize(positions.len(), [0; 4]);
     for t in conn.origin.chunks_exact(3) {
@@ -81,6 +90,8 @@ pub(crate) fn umbrellas(conn: &Connectivity, positions: &[[i32; 3]], out: &mut V
             u[3] += 1;
         }
     }
+    valences.clear();
+    valences.extend(out.iter().map(|u| u[3].clamp(0, 255) as u8));
 }
 
 /// How far the fine surface bulges out of the border polygon, from the

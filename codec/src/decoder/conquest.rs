@@ -18,6 +18,7 @@ pub(crate) struct Scratch {
     pub traversal: Traversal,
     decoded: Vec<([i32; 3], Option<[u8; 3]>)>,
     umbrellas: Vec<[i32; 4]>,
+    valences: Vec<u8>,
     predictions: Vec<PatchPrediction>,
 }
 
@@ -65,11 +66,16 @@ impl Level {
         }
         // Phase 1: the traversal finds every patch (nothing inserted yet).
         let mut codes = StreamCodes(RangeDecoder::new(pass.connectivity));
-        umbrellas(&self.conn, &self.positions_q, &mut scratch.umbrellas);
+        umbrellas(
+            &self.conn,
+            &self.positions_q,
+            &mut scratch.umbrellas,
+            &mut scratch.valences,
+        );
         let traversal = &mut scratch.traversal;
         traversal.run(
             &self.conn,
-            &scratch.umbrellas,
+            &scratch.valences,
             pass.kind,
             &pass.seeds,
             pass.inserted as usize,

@@ -158,6 +158,7 @@ impl<'scope> PassSink<'scope> {
 pub(crate) struct PassCoder {
     replay: Traversal,
     umbrellas: Vec<[i32; 4]>,
+    valences: Vec<u8>,
     predictions: Vec<PatchPrediction>,
 }
 
@@ -165,7 +166,12 @@ impl PassCoder {
     pub(crate) fn code(&mut self, mesh: CoarseMesh<'_>, pass: PassRecord) -> Result<PassOutput> {
         // Codes and geometry both use the whole coarse mesh, which is what
         // the decoder has before it inserts anything.
-        umbrellas(mesh.conn, mesh.positions, &mut self.umbrellas);
+        umbrellas(
+            mesh.conn,
+            mesh.positions,
+            &mut self.umbrellas,
+            &mut self.valences,
+        );
         let connectivity = self.code_decisions(mesh, &pass)?;
         let mut models = PassModels::new();
         let mut geom = RangeEncoder::new();
@@ -219,7 +225,7 @@ impl PassCoder {
         self.replay
             .run(
                 mesh.conn,
-                &self.umbrellas,
+                &self.valences,
                 pass.kind,
                 &pass.seeds,
                 pass.patches.len(),
