@@ -58,6 +58,27 @@ pub(crate) trait GateCodes {
     fn cleaning(&mut self, model: &mut BitModel) -> Result<bool>;
 }
 
+/// The mesh a traversal walks, and what becomes of each patch it finds.
+pub(crate) trait PatchSink {
+    fn conn(&self) -> &Connectivity;
+    /// Called once the patch is claimed. The decoder re-inserts the
+    /// removed vertex's fan right there, while the patch's half-edges are
+    /// still in cache; the traversal sees the same mesh either way (see
+    /// [`Traversal::run`]).
+    fn found(&mut self, region: &Region);
+}
+
+/// A mesh that is only walked (the encoder's replay).
+pub(crate) struct Walked<'a>(pub &'a Connectivity);
+
+impl PatchSink for Walked<'_> {
+    fn conn(&self) -> &Connectivity {
+        self.0
+    }
+
+    fn found(&mut self, _: &Region) {}
+}
+
 /// A patch found by the traversal: the removed vertex's border polygon and
 /// the coarse half-edges it will be re-inserted into.
 #[derive(Clone, Copy)]
@@ -131,28 +152,36 @@ pub(crate) struct Traversal {
 }
 
 impl Traversal {
-    /// Walks one pass over `conn` from `seeds` (one gate `a → b` per
+    /// Walks one pass over `mesh` from `seeds` (one gate `a → b` per
     /// connected component), asking `codes` for each gate's code and
     /// collecting at most `max_patches` patches in [`Traversal::regions`].
     /// `valences` are the coarse mesh's ([`crate::predict::umbrellas`]).
+    ///
+    /// `mesh` may change each patch it is told of into anything whose
+    /// faces are new (appended) or the patch's own slots: those count as
+    /// conquered, and the traversal never looks inside conquered faces (a
+    /// fit test stops at them, gates in them are skipped), nor at a vertex
+    /// the pass inserts. So it finds the same patches and codes whether or
+    /// not the sink re-inserts vertices as it goes.
     pub(crate) fn run(
         &mut self,
-        conn: &Connectivity,
+        mesh: &mut impl PatchSink,
         valences: &[u8],
         kind: PassKind,
         seeds: &[[u32; 2]],
         max_patches: usize,
         codes: &mut impl GateCodes,
     ) -> Result<()> {
-        let n = conn.out.len();
+        let n = mesh.conn().out.len();
         self.tag.clear();
         self.tag.resize(n, Tag::None);
         self.face_done.clear();
-        self.face_done.resize(conn.face_count_slots(), false);
+        self.face_done.resize(mesh.conn().face_count_slots(), false);
         self.regions.clear();
         self.gates.clear();
         let mut models = ConnModels::new(kind);
         for &[a, b] in seeds {
+            let conn = mesh.conn();
             if a as usize >= n || b as usize >= n || conn.out[a as usize] == NONE {
                 return Err(Error::stream(
                     "seed gate names a vertex that does not exist yet",
@@ -168,7 +197,20 @@ impl Traversal {
             self.conquer(b, Tag::Minus);
             self.gates.push_back(h);
             while let Some(g) = self.gates.pop_front() {
-                self.gate(conn, valences, g, kind, max_patches, &mut models, codes)?;
+                let found = self.gate(
+                    mesh.conn(),
+                    valences,
+                    g,
+                    kind,
+                    max_patches,
+                    &mut models,
+                    codes,
+                )?;
+                if let Some(region) = found {
+                    mesh.found(&region);
+                    // Faces the sink appended are conquered (a fan is never walked).
+                    self.face_done.resize(mesh.conn().face_count_slots(), true);
+                }
             }
         }
         Ok(())
@@ -184,10 +226,10 @@ impl Traversal {
         max_patches: usize,
         models: &mut ConnModels,
         codes: &mut impl GateCodes,
-    ) -> Result<()> {
+    ) -> Result<Option<Region>> {
         let f = face(g);
         if self.face_done[f as usize] {
-            return Ok(());
+            return Ok(None);
         }
         let (origin, target) = (conn.origin[g as usize], conn.target(g));
         let front = conn.origin[prev(g) as usize];
@@ -250,7 +292,7 @@ impl Traversal {
             for h in [next(g), prev(g)] {
                 self.push_gate(conn.twin[h as usize]);
             }
-            return Ok(());
+            return Ok(None);
         };
         if self.regions.len() >= max_patches {
             return Err(Error::stream(
@@ -259,7 +301,7 @@ impl Traversal {
         }
         self.claim_patch(&region, pattern(region.valence, g0, g1));
         self.regions.push(region);
-        Ok(())
+        Ok(Some(region))
     }
 
     /// The largest valence whose patch faces exist around the gate and are

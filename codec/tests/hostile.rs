@@ -539,6 +539,47 @@ fn payloads_cut_short_with_consistent_lengths_fail() {
     assert!(failures.is_empty(), "{failures:#?}");
 }
 
+/// The decoder re-inserts vertices while it walks a batch, so a batch that
+/// fails part-way leaves a level half-built: everything after it must be
+/// refused, not walked. A batch refused before it touched the level (its
+/// framing) changes nothing, and the right batch still applies after it,
+/// exactly.
+#[test]
+fn a_batch_failing_part_way_refuses_what_follows() {
+    let s = sphere_stream();
+    let index = StreamIndex::parse(s).unwrap();
+    let k = index.batches.len() - 1;
+    let batch = &s[index.batches[k].clone()];
+    let whole = decode(s, None, Limits::default()).unwrap();
+    let (mut refused, mut untouched) = (0, 0);
+    for at in 0..batch.len() {
+        let mut flipped = batch.to_vec();
+        flipped[at] ^= 0xff;
+        let mut d = decode(s, Some(k), Limits::default()).unwrap();
+        if d.apply_batch(&flipped).is_ok() {
+            continue; // a flip the codes absorb: a different, valid level
+        }
+        match no_panic(|| d.apply_batch(batch)).unwrap_or_else(|p| panic!("byte {at}: {p}")) {
+            Err(e) => {
+                assert!(
+                    e.to_string().contains("earlier batch failed"),
+                    "byte {at}: {e}"
+                );
+                refused += 1;
+            }
+            Ok(()) => {
+                assert_eq!(d.indices(), whole.indices(), "byte {at}");
+                assert_eq!(d.quantized_positions(), whole.quantized_positions());
+                untouched += 1;
+            }
+        }
+    }
+    assert!(
+        refused > 0 && untouched > 0,
+        "{refused} refused, {untouched} untouched"
+    );
+}
+
 // ---------------------------------------------------------------- batches out of place
 
 #[test]

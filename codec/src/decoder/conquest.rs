@@ -4,8 +4,8 @@
 
 use super::Level;
 use crate::entropy::{BitModel, FrequencyModel, RangeDecoder};
-use crate::gates::{GateCodes, PassKind, Region, Traversal, DECIMATION_SYMBOLS};
-use crate::halfedge::{face, NONE};
+use crate::gates::{GateCodes, PassKind, PatchSink, Region, Traversal, DECIMATION_SYMBOLS};
+use crate::halfedge::{face, Connectivity, NONE};
 use crate::patch::MAX_VALENCE;
 use crate::predict::{
     decode_colour, predict_colour, umbrellas, PassModels, PatchPrediction, PREDICTION_BLOCK,
@@ -64,7 +64,8 @@ impl Level {
                 _ => Err(Error::stream("pass without seeds claims inserted vertices")),
             };
         }
-        // Phase 1: the traversal finds every patch (nothing inserted yet).
+        // Phase 1: the traversal finds every patch and re-inserts its
+        // vertex's fan (the vertex gets its position in phase 2).
         let mut codes = StreamCodes(RangeDecoder::new(pass.connectivity));
         umbrellas(
             &self.conn,
@@ -74,7 +75,7 @@ impl Level {
         );
         let traversal = &mut scratch.traversal;
         traversal.run(
-            &self.conn,
+            &mut Fans(&mut self.conn),
             &scratch.valences,
             pass.kind,
             &pass.seeds,
@@ -110,9 +111,9 @@ impl Level {
                 decoded.push(self.decode_vertex(r, prediction, &mut s)?);
             }
         }
-        debug_assert_eq!(n + decoded.len(), n + pass.inserted as usize);
-        for (r, &(position, colour)) in traversal.regions.iter().zip(&decoded) {
-            self.insert_vertex(r, position, colour);
+        debug_assert_eq!(n + decoded.len(), self.conn.out.len());
+        for &(position, colour) in &decoded {
+            self.push_vertex(position, colour);
         }
         scratch.decoded = decoded;
         s.geom.check_overrun()?;
@@ -120,8 +121,9 @@ impl Level {
     }
 
     /// Phase 2: the removed vertex's position and colour from the stream,
-    /// given its predicted position (from the coarse mesh, nothing inserted
-    /// yet: exactly what the encoder saw).
+    /// given its predicted position (from the coarse mesh's positions and
+    /// umbrellas, which inserting fans does not change: exactly what the
+    /// encoder saw).
     fn decode_vertex(
         &self,
         r: &Region,
@@ -148,43 +150,55 @@ impl Level {
         };
         Ok((position, colour))
     }
+}
 
-    /// Phase 3: replace the patch's faces by the fan of the new vertex.
-    fn insert_vertex(&mut self, r: &Region, position: [i32; 3], colour: Option<[u8; 3]>) {
+/// The decoder's side of a traversal: each patch found becomes the fan of
+/// its re-inserted vertex at once.
+struct Fans<'a>(&'a mut Connectivity);
+
+impl PatchSink for Fans<'_> {
+    fn conn(&self) -> &Connectivity {
+        self.0
+    }
+
+    /// Replaces the patch's faces by the fan of a new vertex (the next id).
+    fn found(&mut self, r: &Region) {
+        let conn = &mut *self.0;
         let d = r.valence;
-        // Read the outer half-edges now: neighbouring patches inserted since
-        // phase 1 have re-linked them.
+        // The outer half-edges as they are now: a neighbouring patch
+        // re-inserted since this one was found has re-linked them.
         let mut outer = [NONE; MAX_VALENCE];
         for (o, &h) in outer.iter_mut().zip(&r.boundary[..d]) {
-            *o = self.conn.twin[h as usize];
+            *o = conn.twin[h as usize];
         }
-        let v = self.push_vertex(position, colour);
+        let v = conn.out.len() as u32;
+        conn.out.push(NONE);
         // Faces (v, p_i, p_i+1): reuse the patch's d − 2 slots, append two.
         let mut slots = [NONE; MAX_VALENCE];
         for (i, slot) in slots.iter_mut().enumerate().take(d) {
             *slot = if i < d - 2 {
                 face(r.corner0[i])
             } else {
-                self.conn.append_face()
+                conn.append_face()
             };
         }
         for i in 0..d {
             let base = 3 * slots[i];
             let (a, b) = (r.polygon[i], r.polygon[(i + 1) % d]);
-            self.conn.origin[base as usize] = v;
-            self.conn.origin[base as usize + 1] = a;
-            self.conn.origin[base as usize + 2] = b;
+            conn.origin[base as usize] = v;
+            conn.origin[base as usize + 1] = a;
+            conn.origin[base as usize + 2] = b;
             let o = outer[i];
-            self.conn.twin[base as usize + 1] = o;
+            conn.twin[base as usize + 1] = o;
             if o != NONE {
-                self.conn.twin[o as usize] = base + 1;
+                conn.twin[o as usize] = base + 1;
             }
             // v → p_i pairs with p_i → v, the third half-edge of the previous face.
             let prev_face = 3 * slots[(i + d - 1) % d];
-            self.conn.twin[base as usize] = prev_face + 2;
-            self.conn.twin[prev_face as usize + 2] = base;
-            self.conn.out[a as usize] = base + 1;
+            conn.twin[base as usize] = prev_face + 2;
+            conn.twin[prev_face as usize + 2] = base;
+            conn.out[a as usize] = base + 1;
         }
-        self.conn.out[v as usize] = 3 * slots[0];
+        conn.out[v as usize] = 3 * slots[0];
     }
 }

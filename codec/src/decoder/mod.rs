@@ -42,15 +42,14 @@ impl Level {
         self.positions_q.len()
     }
 
-    pub(crate) fn push_vertex(&mut self, q: [i32; 3], colour: Option<[u8; 3]>) -> u32 {
-        let v = self.positions_q.len() as u32;
+    /// Position and colour of the next vertex whose fan is already in
+    /// `conn` (inserted during the traversal).
+    pub(crate) fn push_vertex(&mut self, q: [i32; 3], colour: Option<[u8; 3]>) {
         self.positions_q.push(q);
         self.positions.push(self.quantization.dequantize(q));
         if let (Some(colours), Some(c)) = (&mut self.colours, colour) {
             colours.push(c);
         }
-        self.conn.out.push(crate::halfedge::NONE);
-        v
     }
 }
 
@@ -67,13 +66,18 @@ impl Level {
 /// }
 /// # Ok(()) }
 /// ```
-/// After an error the decoder's buffers are unspecified: drop it.
+/// After an error the decoder's buffers are unspecified: drop it. (A batch
+/// refused before it touched the level, for its header or counts, leaves
+/// the decoder as it was; one that fails part-way makes every later batch
+/// an error.)
 pub struct Decoder {
     header: Header,
     level: Level,
     applied: usize,
     limits: Limits,
     scratch: Scratch,
+    /// A batch failed after it began to change the level.
+    broken: bool,
 }
 
 impl Decoder {
@@ -123,6 +127,7 @@ impl Decoder {
             applied: 0,
             limits,
             scratch: Scratch::default(),
+            broken: false,
         })
     }
 
@@ -150,6 +155,11 @@ impl Decoder {
 
     /// Applies the next refinement batch (a chunk as listed by [`crate::StreamIndex`]).
     pub fn apply_batch(&mut self, chunk_bytes: &[u8]) -> Result<()> {
+        if self.broken {
+            return Err(Error::stream(
+                "an earlier batch failed part-way: decode again from the base",
+            ));
+        }
         let (chunk, payload) = ChunkHeader::parse(chunk_bytes, BATCH_TAG)?;
         let expected = self.applied + 1;
         if chunk.level as usize != expected || expected > self.header.batch_count() {
@@ -199,8 +209,16 @@ impl Decoder {
         }
         self.level.conn.origin.reserve(6 * grow);
         self.level.conn.twin.reserve(6 * grow);
-        self.level.undo_pass(&cleaning, &mut self.scratch)?;
-        self.level.undo_pass(&decimating, &mut self.scratch)?;
+        let undone = self
+            .level
+            .undo_pass(&cleaning, &mut self.scratch)
+            .and_then(|()| self.level.undo_pass(&decimating, &mut self.scratch));
+        if undone.is_err() {
+            // Fans may be in without their vertices' positions: refuse
+            // whatever comes next rather than walk a half-built level.
+            self.broken = true;
+        }
+        undone?;
         self.applied = expected;
         Ok(())
     }

@@ -8,7 +8,7 @@ use std::sync::mpsc::{sync_channel, SyncSender};
 use std::thread::{Scope, ScopedJoinHandle};
 
 use crate::entropy::{BitModel, FrequencyModel, RangeEncoder};
-use crate::gates::{GateCodes, PassKind, Traversal, DECIMATION_SYMBOLS};
+use crate::gates::{GateCodes, PassKind, Traversal, Walked, DECIMATION_SYMBOLS};
 use crate::halfedge::Connectivity;
 use crate::patch::MAX_VALENCE;
 use crate::predict::{
@@ -224,7 +224,7 @@ impl PassCoder {
         };
         self.replay
             .run(
-                mesh.conn,
+                &mut Walked(mesh.conn),
                 &self.valences,
                 pass.kind,
                 &pass.seeds,
