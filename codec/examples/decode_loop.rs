@@ -1,4 +1,5 @@
-//! Profiling aid: `cargo run --release --example decode_loop mesh.ply [decode-runs] [encode-runs]`.
+//! Profiling aid: `cargo run --release --example decode_loop mesh.ply [decode-runs] [encode-runs]`,
+//! or `decode_loop stream.vtr [decode-runs]` to time decoding a stream written before.
 //! Encoding runs on one core (as `vitrine bench` times it) unless
 //! `VITRINE_PIPELINED=1`.
 use std::time::Instant;
@@ -9,6 +10,26 @@ use vitrine_codec::{decode, encode, EncodeOptions, Limits};
 fn main() {
     let path = std::env::args().nth(1).expect("mesh path");
     let runs: usize = std::env::args().nth(2).map_or(10, |s| s.parse().unwrap());
+    if path.ends_with(".vtr") {
+        // A stream written before: decode only (compares decoders on the same bytes).
+        let bytes = std::fs::read(&path).unwrap();
+        let mut times = Vec::new();
+        let mut n = 0;
+        for _ in 0..runs.max(1) {
+            let t = Instant::now();
+            let d = decode(&bytes, None, Limits::default()).unwrap();
+            times.push(t.elapsed().as_secs_f64());
+            n = d.vertex_count();
+        }
+        times.sort_by(f64::total_cmp);
+        let median = times[times.len() / 2];
+        println!(
+            "decode median {:.1} ms = {:.2} Mv/s",
+            median * 1e3,
+            n as f64 / median / 1e6
+        );
+        return;
+    }
     let mesh = prepare(
         import_path(path.as_ref(), &ImportOptions::default()).unwrap(),
         &RepairOptions::default(),
