@@ -45,6 +45,15 @@ impl Connectivity {
     /// inconsistently oriented edge: [`crate::repair::prepare`] removes those.
     pub(crate) fn from_triangles(vertex_count: usize, triangles: &[[u32; 3]]) -> Result<Self> {
         check_indices(vertex_count, triangles)?;
+        Self::from_indexed_triangles(vertex_count, triangles)
+    }
+
+    /// [`Connectivity::from_triangles`] for faces whose corners are known to
+    /// index `vertex_count` vertices (it panics otherwise).
+    pub(crate) fn from_indexed_triangles(
+        vertex_count: usize,
+        triangles: &[[u32; 3]],
+    ) -> Result<Self> {
         let origin = triangles.as_flattened().to_vec();
         // Pair half-edges by undirected edge: bucket them by their smaller
         // endpoint with a counting sort (two streaming passes; a hash map or
@@ -210,7 +219,6 @@ fn non_manifold(what: &str, origin: &[u32], h: u32) -> Error {
     Error::Unsupported(format!("edge ({a}, {b}) is non-manifold: {what}"))
 }
 
-/// Builds connectivity for a mesh that passed repair.
 /// An error naming the first face with a corner beyond `vertex_count`.
 pub(crate) fn check_indices(vertex_count: usize, triangles: &[[u32; 3]]) -> Result<()> {
     match triangles
@@ -224,6 +232,7 @@ pub(crate) fn check_indices(vertex_count: usize, triangles: &[[u32; 3]]) -> Resu
     }
 }
 
+/// Builds connectivity for a mesh that passed repair.
 pub(crate) fn connectivity(mesh: &IndexedMesh) -> Result<Connectivity> {
     Connectivity::from_triangles(mesh.positions.len(), &mesh.triangles)
 }

@@ -157,7 +157,8 @@ pub fn encode_guarded(
     let input_vertices = mesh.positions.len();
     check_indices(input_vertices, &mesh.triangles)?;
     let mut order = LocalityOrder::of(&positions, &mesh.triangles, quantization.max_value());
-    let conn = match Connectivity::from_triangles(input_vertices, &order.triangles) {
+    // Renumbered from checked faces: every corner indexes a vertex.
+    let conn = match Connectivity::from_indexed_triangles(input_vertices, &order.triangles) {
         Ok(conn) => conn,
         // Name the culprit in the caller's vertex ids: the input's own order.
         Err(e) => return Err(connectivity(mesh).err().unwrap_or(e)),
