@@ -383,9 +383,14 @@ test('ccc: every level shows the painted colours of the final level (screenshots
     assert.ok(score.pixels > 0.1 * WIDTH * HEIGHT, `level ${k}: the model is in view`);
     // Below 2 % of the vertices the silhouette and the checks' borders move
     // with the coarse geometry (the colours stay the painted ones): a looser
-    // bound on how many pixels land on the other side of a border.
+    // bound on how many pixels land on the other side of a border. How far
+    // they move depends on which vertices the base keeps: since the encoder
+    // orders the mesh for locality (session 7) this torus's 287-vertex base
+    // puts 10.3 % of pixels across a border (its Hausdorff distance to the
+    // full torus 0.042 against 0.032 before, while `vitrine colour-bench`
+    // finds its 24-view image error lower, 8.7 against 9.0).
     const coarse = manifest.levels[k].vertices < 0.02 * manifest.levels[n].vertices;
-    assert.ok(score.mean < 0.03 && score.far < (coarse ? 0.1 : 0.05), `level ${k} vs final: ${JSON.stringify(score)}`);
+    assert.ok(score.mean < 0.03 && score.far < (coarse ? 0.12 : 0.05), `level ${k} vs final: ${JSON.stringify(score)}`);
   }
 });
 
