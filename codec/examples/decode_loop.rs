@@ -7,27 +7,39 @@ use vitrine_codec::import::{import_path, ImportOptions};
 use vitrine_codec::repair::{prepare, RepairOptions};
 use vitrine_codec::{decode, encode, EncodeOptions, Limits};
 
+/// Prints the median of `times` (seconds) and the speed it gives over `vertices`.
+fn report(what: &str, mut times: Vec<f64>, vertices: usize) {
+    if times.is_empty() {
+        return;
+    }
+    times.sort_by(f64::total_cmp);
+    let median = times[times.len() / 2];
+    println!(
+        "{what} median {:.1} ms = {:.2} Mv/s",
+        median * 1e3,
+        vertices as f64 / median / 1e6
+    );
+}
+
+/// Decodes `bytes` (every level) `runs` times and reports the median.
+fn time_decodes(bytes: &[u8], runs: usize) {
+    let mut times = Vec::new();
+    let mut vertices = 0;
+    for _ in 0..runs {
+        let t = Instant::now();
+        let d = decode(bytes, None, Limits::default()).unwrap();
+        times.push(t.elapsed().as_secs_f64());
+        vertices = std::hint::black_box(d.vertex_count());
+    }
+    report("decode", times, vertices);
+}
+
 fn main() {
     let path = std::env::args().nth(1).expect("mesh path");
     let runs: usize = std::env::args().nth(2).map_or(10, |s| s.parse().unwrap());
     if path.ends_with(".vtr") {
         // A stream written before: decode only (compares decoders on the same bytes).
-        let bytes = std::fs::read(&path).unwrap();
-        let mut times = Vec::new();
-        let mut n = 0;
-        for _ in 0..runs.max(1) {
-            let t = Instant::now();
-            let d = decode(&bytes, None, Limits::default()).unwrap();
-            times.push(t.elapsed().as_secs_f64());
-            n = d.vertex_count();
-        }
-        times.sort_by(f64::total_cmp);
-        let median = times[times.len() / 2];
-        println!(
-            "decode median {:.1} ms = {:.2} Mv/s",
-            median * 1e3,
-            n as f64 / median / 1e6
-        );
+        time_decodes(&std::fs::read(&path).unwrap(), runs.max(1));
         return;
     }
     let mesh = prepare(
@@ -48,29 +60,6 @@ fn main() {
         e = Some(encode(&mesh, &options).unwrap());
         encode_times.push(t.elapsed().as_secs_f64());
     }
-    let e = e.unwrap();
-    encode_times.sort_by(f64::total_cmp);
-    let median = encode_times[encode_times.len() / 2];
-    println!(
-        "encode median {:.1} ms = {:.2} Mv/s",
-        median * 1e3,
-        mesh.positions.len() as f64 / median / 1e6
-    );
-    let mut times = Vec::new();
-    for _ in 0..runs {
-        let t = Instant::now();
-        let d = decode(&e.bytes, None, Limits::default()).unwrap();
-        times.push(t.elapsed().as_secs_f64());
-        std::hint::black_box(d.indices().len());
-    }
-    if runs == 0 {
-        return;
-    }
-    times.sort_by(f64::total_cmp);
-    let n = mesh.positions.len() as f64;
-    println!(
-        "decode median {:.1} ms = {:.2} Mv/s",
-        times[runs / 2] * 1e3,
-        n / times[runs / 2] / 1e6
-    );
+    report("encode", encode_times, mesh.positions.len());
+    time_decodes(&e.unwrap().bytes, runs);
 }
