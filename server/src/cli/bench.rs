@@ -8,10 +8,12 @@ use anyhow::{bail, Context};
 use clap::Args;
 use serde::{Deserialize, Serialize};
 use std::collections::HashMap;
+use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::Instant;
-use vitrine_codec::{breakdown, decode, encode, EncodeOptions, Limits};
+use vitrine_codec::export::write_ply;
+use vitrine_codec::{breakdown, decode, encode, EncodeOptions, IndexedMesh, Limits};
 
 #[derive(Args, Debug)]
 pub struct BenchArgs {
@@ -38,6 +40,10 @@ pub struct BenchOneArgs {
     pub bits: u8,
     #[arg(long, default_value_t = 5)]
     pub runs: usize,
+    /// Also write the mesh as encoded (positions and triangles, after
+    /// import and repair) to this binary PLY, for a peer coder to read.
+    #[arg(long)]
+    pub write_mesh: Option<PathBuf>,
 }
 
 #[derive(Serialize, Deserialize, Debug)]
@@ -77,7 +83,23 @@ fn peak_rss_mib() -> f64 {
 }
 
 pub fn run_one(args: BenchOneArgs) -> anyhow::Result<()> {
+    println!("{}", serde_json::to_string(&measure(&args)?)?);
+    Ok(())
+}
+
+/// Encodes and decodes one mesh `args.runs` times; sizes, median speeds and
+/// this process's peak memory.
+fn measure(args: &BenchOneArgs) -> anyhow::Result<BenchResult> {
     let (mesh, _) = super::load_mesh(&args.input)?;
+    if let Some(path) = &args.write_mesh {
+        let geometry = IndexedMesh {
+            colors: None,
+            ..mesh.clone()
+        };
+        let mut file = std::io::BufWriter::new(std::fs::File::create(path)?);
+        write_ply(&geometry, &mut file)?;
+        file.flush()?;
+    }
     let options = EncodeOptions {
         quantization_bits: args.bits,
         // Speeds are per core: code the passes on the encoding thread.
@@ -125,8 +147,7 @@ pub fn run_one(args: BenchOneArgs) -> anyhow::Result<()> {
         decode_ms: median(decode_ms),
         peak_rss_mib: peak_rss_mib(),
     };
-    println!("{}", serde_json::to_string(&result)?);
-    Ok(())
+    Ok(result)
 }
 
 fn mesh_files(inputs: &[PathBuf]) -> anyhow::Result<Vec<PathBuf>> {
@@ -160,7 +181,9 @@ fn mesh_files(inputs: &[PathBuf]) -> anyhow::Result<Vec<PathBuf>> {
     Ok(out)
 }
 
-/// Draco's bits per vertex and decode speed per mesh file name.
+/// Draco's bits per vertex and decode speed per mesh, keyed by the name of
+/// the file `files` holds (each written by `bench-one --write-mesh` as
+/// `<mesh file name>.ply`, so the key is the original name).
 fn run_draco(
     script: &Path,
     files: &[PathBuf],
@@ -179,14 +202,20 @@ fn run_draco(
             String::from_utf8_lossy(&out.stderr)
         );
     }
+    Ok(draco_rows(&String::from_utf8_lossy(&out.stdout)))
+}
+
+/// Parses `peer_draco.py`'s tab-separated rows (after its header line).
+fn draco_rows(table: &str) -> HashMap<String, (f64, f64)> {
     let mut map = HashMap::new();
-    for line in String::from_utf8_lossy(&out.stdout).lines().skip(1) {
+    for line in table.lines().skip(1) {
         let cols: Vec<&str> = line.split('\t').collect();
         if cols.len() >= 9 {
-            let name = Path::new(cols[0])
+            let written = Path::new(cols[0])
                 .file_name()
                 .map(|s| s.to_string_lossy().into_owned())
                 .unwrap_or_default();
+            let name = written.strip_suffix(".ply").unwrap_or(&written).to_owned();
             map.insert(
                 name,
                 (
@@ -196,34 +225,47 @@ fn run_draco(
             );
         }
     }
-    Ok(map)
+    map
 }
 
 pub fn run(args: BenchArgs) -> anyhow::Result<()> {
     let files = mesh_files(&args.inputs)?;
     let exe = std::env::current_exe()?;
+    // Draco is given the very meshes we encode (welded, repaired, without
+    // unused vertices), so both sizes count the same vertices and faces.
+    let peer_meshes = match &args.draco {
+        Some(_) => Some(tempfile::tempdir().context("a folder for Draco's meshes")?),
+        None => None,
+    };
     let mut results = Vec::new();
+    let mut written = Vec::new();
     for file in &files {
         eprintln!("bench {}", file.display());
-        let out = Command::new(&exe)
-            .arg("bench-one")
-            .arg(file)
-            .args([
-                "--bits",
-                &args.bits.to_string(),
-                "--runs",
-                &args.runs.to_string(),
-            ])
-            .output()?;
+        let mut one = Command::new(&exe);
+        one.arg("bench-one").arg(file).args([
+            "--bits",
+            &args.bits.to_string(),
+            "--runs",
+            &args.runs.to_string(),
+        ]);
+        let peer_mesh = peer_meshes.as_ref().and_then(|dir| {
+            let name = file.file_name()?.to_string_lossy().into_owned();
+            Some(dir.path().join(format!("{name}.ply")))
+        });
+        if let Some(path) = &peer_mesh {
+            one.arg("--write-mesh").arg(path);
+        }
+        let out = one.output()?;
         if !out.status.success() {
             eprintln!("  skipped: {}", String::from_utf8_lossy(&out.stderr).trim());
             continue;
         }
         results.push(serde_json::from_slice::<BenchResult>(&out.stdout)?);
+        written.extend(peer_mesh);
     }
     let draco = match &args.draco {
-        Some(script) => Some(run_draco(script, &files, args.bits)?),
-        None => None,
+        Some(script) if !written.is_empty() => Some(run_draco(script, &written, args.bits)?),
+        _ => None,
     };
     let table = markdown(&results, draco.as_ref(), args.bits, args.runs);
     println!("{table}");
@@ -305,4 +347,65 @@ fn markdown(
         );
     }
     s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use vitrine_codec::import::{import_path, ImportOptions};
+    use vitrine_codec::samples;
+
+    /// Draco must be handed the mesh we encode, not the file: an OBJ whose
+    /// seams duplicate vertices is welded by our import, so the file holds
+    /// more vertices than either coder should count.
+    #[test]
+    fn the_peer_gets_the_mesh_as_encoded() {
+        let dir = tempfile::tempdir().unwrap();
+        let mut torus = samples::torus(24, 12, 1.0, 0.3);
+        samples::paint(&mut torus);
+        // Every face gets corners of its own: 3 vertices per face in the file.
+        let unwelded = IndexedMesh {
+            positions: torus
+                .triangles
+                .iter()
+                .flat_map(|t| t.map(|v| torus.positions[v as usize]))
+                .collect(),
+            triangles: (0..torus.triangles.len() as u32)
+                .map(|f| [3 * f, 3 * f + 1, 3 * f + 2])
+                .collect(),
+            colors: None,
+        };
+        let input = dir.path().join("seams.obj");
+        let mut file = std::fs::File::create(&input).unwrap();
+        vitrine_codec::export::write_obj(&unwelded, &mut file).unwrap();
+        drop(file);
+        let written = dir.path().join("seams.obj.ply");
+        let result = measure(&BenchOneArgs {
+            input: input.clone(),
+            bits: 12,
+            runs: 1,
+            write_mesh: Some(written.clone()),
+        })
+        .unwrap();
+        let peer = import_path(&written, &ImportOptions::default()).unwrap();
+        let (encoded, _) = super::super::load_mesh(&input).unwrap();
+        assert_eq!(result.vertices, torus.positions.len());
+        assert_eq!(peer.positions.len(), result.vertices);
+        assert_eq!(peer.triangles.len(), result.faces);
+        assert_eq!(peer.positions, encoded.positions);
+        assert_eq!(peer.triangles, encoded.triangles);
+        assert!(peer.colors.is_none(), "Draco is compared on positions only");
+    }
+
+    #[test]
+    fn draco_rows_are_keyed_by_the_original_file_name() {
+        let table = "mesh\tvertices\tfaces\tbits\tbytes\tbpv\tencode_ms\tdecode_ms\tdecode_Mv_s\n\
+                     bunny.ply.ply\t34834\t69451\t12\t52729\t12.11\t80.0\t9.5\t3.67\n\
+                     /tmp/x/suzanne.obj.ply\t508\t968\t12\t1930\t30.30\t1.0\t0.2\t2.65\n\
+                     short\trow\n";
+        let rows = draco_rows(table);
+        assert_eq!(rows.len(), 2);
+        assert_eq!(rows["bunny.ply"], (12.11, 3.67));
+        assert_eq!(rows["suzanne.obj"], (30.30, 2.65));
+    }
 }
