@@ -2,8 +2,10 @@
 //! (boundaries allowed) that the progressive encoder accepts.
 //!
 //! Everything runs on flat arrays in O(n α(n)) time plus small per-vertex
-//! sorts: half-edges are bucketed by their lower vertex with a counting sort,
-//! edges are the runs of equal upper vertex inside each bucket, orientation
+//! sorts, over the faces radix-sorted by their lowest vertex so that memory
+//! is visited nearly in order whatever order the file came in (the input's
+//! face order is restored at the end): half-edges are bucketed by their
+//! lower vertex with a counting sort, edges are the runs of equal upper vertex inside each bucket, orientation
 //! spreads breadth-first over manifold edges, and vertex fans are the
 //! components of a union-find over face corners.
 
@@ -94,11 +96,15 @@ fn to_corner(h: u32) -> u32 {
     3 * f + NEXT[(h % 3) as usize] as u32
 }
 
-/// Half-edges grouped by undirected edge: bucketed by lower vertex, sorted
-/// by upper vertex, in face order within an edge.
+/// Half-edges grouped by undirected edge: bucketed by lower vertex with a
+/// counting sort, sorted by upper vertex within a bucket, in face order
+/// within an edge. Each item carries its edge's upper vertex beside the
+/// half-edge (`upper << 32 | h`), so sorting a bucket and finding its edges
+/// read no face: on a scan whose faces come in scattered order, those reads
+/// missed the cache and were most of the repair's time.
 struct Edges {
     offsets: Vec<u32>,
-    items: Vec<u32>,
+    items: Vec<u64>,
 }
 
 impl Edges {
@@ -113,11 +119,12 @@ impl Edges {
             offsets[v + 1] += offsets[v];
         }
         let mut cursor = offsets.clone();
-        let mut items = vec![0u32; tris.len() * 3];
+        let mut items = vec![0u64; tris.len() * 3];
         for (f, t) in tris.iter().enumerate() {
             for k in 0..3 {
-                let lo = t[k].min(t[NEXT[k]]) as usize;
-                items[cursor[lo] as usize] = (3 * f + k) as u32;
+                let (a, b) = (t[k], t[NEXT[k]]);
+                let lo = a.min(b) as usize;
+                items[cursor[lo] as usize] = (a.max(b) as u64) << 32 | (3 * f + k) as u64;
                 cursor[lo] += 1;
             }
         }
@@ -125,29 +132,30 @@ impl Edges {
         for v in 0..nv {
             let s = &mut items[offsets[v] as usize..offsets[v + 1] as usize];
             if s.len() > 1 {
-                // Stable: face order survives within each edge.
-                s.sort_by_key(|&h| from(tris, h).max(to(tris, h)));
+                // Keys are unique and half-edges ascend with their faces, so
+                // face order survives within each edge.
+                s.sort_unstable();
             }
         }
         Edges { offsets, items }
     }
 
     /// Calls `f` with the half-edges of every undirected edge.
-    fn for_each(&self, tris: &[[u32; 3]], mut f: impl FnMut(&[u32])) {
+    fn for_each(&self, mut f: impl FnMut(&[u32])) {
+        let mut edge: Vec<u32> = Vec::new();
         for w in self.offsets.windows(2) {
             let bucket = &self.items[w[0] as usize..w[1] as usize];
             let mut start = 0;
             while start < bucket.len() {
-                let h = bucket[start];
-                let hi = from(tris, h).max(to(tris, h));
-                let mut end = start + 1;
-                while end < bucket.len() && {
-                    let g = bucket[end];
-                    from(tris, g).max(to(tris, g)) == hi
-                } {
-                    end += 1;
-                }
-                f(&bucket[start..end]);
+                let upper = bucket[start] >> 32;
+                let end = start
+                    + bucket[start..]
+                        .iter()
+                        .take_while(|&&item| item >> 32 == upper)
+                        .count();
+                edge.clear();
+                edge.extend(bucket[start..end].iter().map(|&item| item as u32));
+                f(&edge);
                 start = end;
             }
         }
@@ -236,7 +244,7 @@ fn duplicate_faces(tris: &[[u32; 3]], edges: &Edges) -> Vec<bool> {
     let mut dup = vec![false; tris.len()];
     let third = |h: u32| tris[h as usize / 3][NEXT[NEXT[h as usize % 3]]];
     let mut scratch: Vec<(u32, u32)> = Vec::new();
-    edges.for_each(tris, |hs| {
+    edges.for_each(|hs| {
         if hs.len() < 2 {
             return;
         }
@@ -382,6 +390,13 @@ pub fn prepare(mesh: IndexedMesh, opts: &RepairOptions) -> Result<(IndexedMesh, 
     }
     drop(triangles);
     drop(remap);
+    // Work on the faces in the order of their lowest vertex, so that the
+    // passes below, which visit edges by vertex, touch faces near each other
+    // in memory (a scan's faces often come scattered); the input's order
+    // comes back at the end. Stable radix sorts: sequential passes only.
+    let mut faces: Vec<([u32; 3], u32)> = tris.into_iter().zip(face_of).collect();
+    radsort::sort_by_key(&mut faces, |(t, _)| t[0].min(t[1]).min(t[2]));
+    let (mut tris, mut face_of): (Vec<[u32; 3]>, Vec<u32>) = faces.into_iter().unzip();
 
     // 3. Drop duplicate faces (found through their shared edges).
     let nv0 = pos.len();
@@ -425,7 +440,7 @@ pub fn prepare(mesh: IndexedMesh, opts: &RepairOptions) -> Result<(IndexedMesh, 
         let nv = pos.len();
         let mut uf = Corners::new(nc);
         let mut bad: Vec<u32> = Vec::new(); // flattened: len, then half-edges
-        edges.for_each(&tris, |hs| match hs.len() {
+        edges.for_each(|hs| match hs.len() {
             1 => {}
             2 if from(&tris, hs[0]) != from(&tris, hs[1]) => uf.glue(hs[0], hs[1]),
             _ => {
@@ -525,6 +540,11 @@ pub fn prepare(mesh: IndexedMesh, opts: &RepairOptions) -> Result<(IndexedMesh, 
     drop(edges);
     report.non_manifold_vertices = split_mark.iter().filter(|&&m| m).count();
 
+    // Back to the input's face order.
+    let mut faces: Vec<([u32; 3], u32)> = tris.into_iter().zip(face_of).collect();
+    radsort::sort_by_key(&mut faces, |&(_, input)| input);
+    let mut tris: Vec<[u32; 3]> = faces.into_iter().map(|(t, _)| t).collect();
+
     // 6. Drop unreferenced vertices, keeping order.
     let mut new_id = vec![NONE; pos.len()];
     for t in &tris {
@@ -590,7 +610,7 @@ fn orient(tris: &mut [[u32; 3]], edges: &Edges) -> usize {
     let nf = tris.len();
     let mut mate = vec![NONE; nf * 3];
     let mut conflict = false;
-    edges.for_each(tris, |hs| {
+    edges.for_each(|hs| {
         if hs.len() == 2 {
             mate[hs[0] as usize] = hs[1];
             mate[hs[1] as usize] = hs[0];
@@ -666,7 +686,7 @@ pub fn check_manifold(mesh: &IndexedMesh) -> Result<()> {
     }
     let mut uf = Corners::new(tris.len() * 3);
     let mut problem = None;
-    edges.for_each(tris, |hs| {
+    edges.for_each(|hs| {
         if problem.is_some() {
             return;
         }
@@ -743,6 +763,33 @@ mod tests {
         let (out, report) = prepare(m.clone(), &RepairOptions::default()).unwrap();
         assert_eq!(out, m);
         assert_eq!(report, RepairReport::default());
+        check_manifold(&out).unwrap();
+    }
+
+    /// Repair works on the faces sorted by their lowest vertex; what it
+    /// returns must still be in the input's order, less the faces it drops.
+    #[test]
+    fn scattered_faces_come_back_in_input_order() {
+        let g = grid(8);
+        let n = g.triangles.len();
+        // A stride coprime to the face count scatters the faces over the grid.
+        let mut t: Vec<[u32; 3]> = (0..n).map(|i| g.triangles[i * 37 % n]).collect();
+        let kept = t.clone();
+        t.insert(40, kept[7]); // a duplicate of an earlier face: dropped
+        t.insert(90, [5, 5, 6]); // degenerate: dropped
+        t[3].swap(1, 2); // against its neighbours: flipped back
+        let (out, report) =
+            prepare(mesh(g.positions.clone(), t), &RepairOptions::default()).unwrap();
+        assert_eq!(report.duplicate_faces, 1, "{report:?}");
+        assert_eq!(report.degenerate_faces, 1, "{report:?}");
+        assert_eq!(report.flipped_faces, 1, "{report:?}");
+        let cyclic =
+            |a: [u32; 3], b: [u32; 3]| (0..3).any(|r| b == [a[r], a[(r + 1) % 3], a[(r + 2) % 3]]);
+        assert_eq!(out.triangles.len(), kept.len());
+        for (f, (&got, &want)) in out.triangles.iter().zip(&kept).enumerate() {
+            assert!(cyclic(got, want), "face {f}: {got:?} for {want:?}");
+        }
+        assert_eq!(out.positions, g.positions);
         check_manifold(&out).unwrap();
     }
 
