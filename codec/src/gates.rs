@@ -99,25 +99,56 @@ pub(crate) const DECIMATION_CONTEXTS: usize =
 /// Cleaning contexts: gate tags × valence classes of front, origin, target.
 pub(crate) const CLEANING_CONTEXTS: usize = GATE_CONTEXTS * VALENCE_CLASSES.pow(3);
 
-/// Adaptive models of the connectivity codes of one pass, starting from
-/// the trained priors ([`crate::priors`]).
+/// Adaptive models of the connectivity codes of one pass, each starting
+/// from its trained prior ([`crate::priors`]).
+///
+/// A context is copied from its prior when the pass first uses it, not all
+/// of them when the pass starts: there are 7,776 decimating contexts
+/// (250 KB), and a pass over a small mesh touches few of them, so copying
+/// them all cost more than decoding such a pass. Each context remembers the
+/// pass that last set it up.
+#[derive(Default)]
 struct ConnModels {
     valence: Vec<FrequencyModel<DECIMATION_SYMBOLS>>,
+    valence_pass: Vec<u32>,
     cleaning: Vec<BitModel>,
+    cleaning_pass: Vec<u32>,
+    /// The current pass, from 1 (0 marks a context no pass has used).
+    pass: u32,
 }
 
 impl ConnModels {
-    fn new(kind: PassKind) -> Self {
-        match kind {
-            PassKind::Decimating => ConnModels {
-                valence: priors::decimation_models().to_vec(),
-                cleaning: Vec::new(),
-            },
-            PassKind::Cleaning => ConnModels {
-                valence: Vec::new(),
-                cleaning: priors::cleaning_models().to_vec(),
-            },
+    fn start_pass(&mut self) {
+        if self.valence.is_empty() {
+            self.valence = priors::decimation_models().to_vec();
+            self.valence_pass = vec![0; DECIMATION_CONTEXTS];
+            self.cleaning = priors::cleaning_models().to_vec();
+            self.cleaning_pass = vec![0; CLEANING_CONTEXTS];
         }
+        self.pass = self.pass.wrapping_add(1);
+        if self.pass == 0 {
+            self.valence_pass.fill(0);
+            self.cleaning_pass.fill(0);
+            self.pass = 1;
+        }
+    }
+
+    #[inline]
+    fn valence(&mut self, m: usize) -> &mut FrequencyModel<DECIMATION_SYMBOLS> {
+        if self.valence_pass[m] != self.pass {
+            self.valence_pass[m] = self.pass;
+            self.valence[m] = priors::decimation_models()[m].clone();
+        }
+        &mut self.valence[m]
+    }
+
+    #[inline]
+    fn cleaning(&mut self, m: usize) -> &mut BitModel {
+        if self.cleaning_pass[m] != self.pass {
+            self.cleaning_pass[m] = self.pass;
+            self.cleaning[m] = priors::cleaning_models()[m];
+        }
+        &mut self.cleaning[m]
     }
 }
 
@@ -145,6 +176,7 @@ pub(crate) struct Traversal {
     tag: Vec<Tag>,
     face_done: Vec<bool>,
     gates: VecDeque<u32>,
+    models: ConnModels,
     /// Patches in the order the traversal found them (the insertion order).
     pub regions: Vec<Region>,
     /// Counts every code by context when set (training, not decoding).
@@ -179,7 +211,7 @@ impl Traversal {
         self.face_done.resize(mesh.conn().face_count_slots(), false);
         self.regions.clear();
         self.gates.clear();
-        let mut models = ConnModels::new(kind);
+        self.models.start_pass();
         for &[a, b] in seeds {
             let conn = mesh.conn();
             if a as usize >= n || b as usize >= n || conn.out[a as usize] == NONE {
@@ -197,15 +229,7 @@ impl Traversal {
             self.conquer(b, Tag::Minus);
             self.gates.push_back(h);
             while let Some(g) = self.gates.pop_front() {
-                let found = self.gate(
-                    mesh.conn(),
-                    valences,
-                    g,
-                    kind,
-                    max_patches,
-                    &mut models,
-                    codes,
-                )?;
+                let found = self.gate(mesh.conn(), valences, g, kind, max_patches, codes)?;
                 if let Some(region) = found {
                     mesh.found(&region);
                     // Faces the sink appended are conquered (a fan is never walked).
@@ -224,7 +248,6 @@ impl Traversal {
         g: u32,
         kind: PassKind,
         max_patches: usize,
-        models: &mut ConnModels,
         codes: &mut impl GateCodes,
     ) -> Result<Option<Region>> {
         let f = face(g);
@@ -254,7 +277,7 @@ impl Traversal {
                     * FIT_CLASSES
                     + widest
                     - MIN_VALENCE;
-                let sym = codes.decimation(&mut models.valence[m], widest - 1)?;
+                let sym = codes.decimation(self.models.valence(m), widest - 1)?;
                 if let Some(s) = &mut self.statistics {
                     s.decimation[m][sym.min(DECIMATION_SYMBOLS - 1)] += 1;
                 }
@@ -272,7 +295,7 @@ impl Traversal {
                 let m = ((ctx * VALENCE_CLASSES + class(front)) * VALENCE_CLASSES + class(origin))
                     * VALENCE_CLASSES
                     + class(target);
-                let removed = codes.cleaning(&mut models.cleaning[m])?;
+                let removed = codes.cleaning(self.models.cleaning(m))?;
                 if let Some(s) = &mut self.statistics {
                     s.cleaning[m][usize::from(removed)] += 1;
                 }
@@ -442,5 +465,41 @@ fn as_gate_tag(t: Tag) -> Tag {
         Tag::Plus
     } else {
         t
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::entropy::RangeEncoder;
+
+    /// Adapts context `m` of both kinds as coding would.
+    fn adapt(models: &mut ConnModels, m: usize) {
+        let mut enc = RangeEncoder::new();
+        enc.encode_symbol_below(models.valence(m), 2, DECIMATION_SYMBOLS);
+        enc.encode_bit(models.cleaning(m), true);
+    }
+
+    #[test]
+    fn each_pass_starts_every_context_from_its_prior() {
+        let mut models = ConnModels::default();
+        models.start_pass();
+        adapt(&mut models, 7);
+        assert_ne!(models.valence(7), &priors::decimation_models()[7]);
+        assert_ne!(models.cleaning(7), &priors::cleaning_models()[7]);
+        models.start_pass();
+        assert_eq!(models.valence(7), &priors::decimation_models()[7]);
+        assert_eq!(models.cleaning(7), &priors::cleaning_models()[7]);
+        // When the pass counter wraps around to a number a context was
+        // last set up in, that context still starts afresh.
+        let mut models = ConnModels::default();
+        models.start_pass();
+        assert_eq!(models.pass, 1);
+        adapt(&mut models, 7);
+        models.pass = u32::MAX;
+        models.start_pass();
+        assert_eq!(models.pass, 1);
+        assert_eq!(models.cleaning(7), &priors::cleaning_models()[7]);
+        assert_eq!(models.valence(7), &priors::decimation_models()[7]);
     }
 }

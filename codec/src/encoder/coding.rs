@@ -97,7 +97,7 @@ pub(crate) enum PassSink<'scope> {
         coder: ScopedJoinHandle<'scope, Result<Vec<PassOutput>>>,
     },
     InPlace {
-        coder: PassCoder,
+        coder: Box<PassCoder>,
         outputs: Vec<PassOutput>,
     },
 }
@@ -120,7 +120,7 @@ impl<'scope> PassSink<'scope> {
             }
         }
         PassSink::InPlace {
-            coder: PassCoder::default(),
+            coder: Box::default(),
             outputs: Vec::new(),
         }
     }
