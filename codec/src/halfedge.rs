@@ -5,6 +5,7 @@
 //! arithmetic and only `origin` and `twin` are stored. A half-edge runs from
 //! `origin[h]` to `origin[next(h)]`. Dead face slots have `origin[3f] == NONE`.
 
+use crate::edges::Edges;
 use crate::{Error, IndexedMesh, Result};
 
 pub(crate) const NONE: u32 = u32::MAX;
@@ -55,53 +56,23 @@ impl Connectivity {
         triangles: &[[u32; 3]],
     ) -> Result<Self> {
         let origin = triangles.as_flattened().to_vec();
-        // Pair half-edges by undirected edge: bucket them by their smaller
-        // endpoint with a counting sort (two streaming passes; a hash map or
-        // a global sort by edge key costs a cache miss or several passes per
-        // half-edge on multi-million-vertex scans), then order each bucket,
-        // a handful of half-edges, by the larger endpoint. Both steps are
-        // stable, so edges are visited in (smaller, larger) order and each
-        // edge's half-edges by id: errors name the same edge on any machine.
-        let smaller = |h: usize| origin[h].min(origin[next(h as u32) as usize]);
-        let larger = |h: u32| origin[h as usize].max(origin[next(h) as usize]);
-        let mut start = vec![0u32; vertex_count + 1];
-        for h in 0..origin.len() {
-            start[smaller(h) as usize + 1] += 1;
-        }
-        for v in 0..vertex_count {
-            start[v + 1] += start[v];
-        }
-        let mut fill = start.clone();
-        let mut bucketed = vec![0u32; origin.len()];
-        for h in 0..origin.len() {
-            let slot = &mut fill[smaller(h) as usize];
-            bucketed[*slot as usize] = h as u32;
-            *slot += 1;
-        }
         let mut twin = vec![NONE; origin.len()];
-        for v in 0..vertex_count {
-            let bucket = &mut bucketed[start[v] as usize..start[v + 1] as usize];
-            bucket.sort_by_key(|&h| larger(h));
-            for edge in bucket.chunk_by(|&h, &g| larger(h) == larger(g)) {
-                match *edge {
-                    [_] => {}
-                    [h, g] => {
-                        if origin[h as usize] == origin[g as usize] {
-                            return Err(non_manifold("inconsistently oriented", &origin, h));
-                        }
-                        twin[h as usize] = g;
-                        twin[g as usize] = h;
-                    }
-                    _ => {
-                        return Err(non_manifold(
-                            "shared by more than two faces",
-                            &origin,
-                            edge[0],
-                        ))
-                    }
+        Edges::build(triangles, vertex_count).try_for_each(|edge| match *edge {
+            [_] => Ok(()),
+            [h, g] => {
+                if origin[h as usize] == origin[g as usize] {
+                    return Err(non_manifold("inconsistently oriented", &origin, h));
                 }
+                twin[h as usize] = g;
+                twin[g as usize] = h;
+                Ok(())
             }
-        }
+            _ => Err(non_manifold(
+                "shared by more than two faces",
+                &origin,
+                edge[0],
+            )),
+        })?;
         let mut out = vec![NONE; vertex_count];
         for (h, &v) in origin.iter().enumerate() {
             out[v as usize] = h as u32;
@@ -221,6 +192,10 @@ fn non_manifold(what: &str, origin: &[u32], h: u32) -> Error {
 
 /// An error naming the first face with a corner beyond `vertex_count`.
 pub(crate) fn check_indices(vertex_count: usize, triangles: &[[u32; 3]]) -> Result<()> {
+    if 3 * triangles.len() as u64 >= NONE as u64 {
+        // Half-edges are numbered in 32 bits.
+        return Err(Error::Limit(format!("{} faces", triangles.len())));
+    }
     match triangles
         .iter()
         .find(|t| t.iter().any(|&v| v as usize >= vertex_count))

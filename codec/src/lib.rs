@@ -17,6 +17,7 @@
 mod base_mesh;
 pub mod colour_metric;
 mod decoder;
+mod edges;
 mod encoder;
 mod entropy;
 mod error;

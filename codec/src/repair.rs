@@ -4,11 +4,11 @@
 //! Everything runs on flat arrays in O(n α(n)) time plus small per-vertex
 //! sorts, over the faces radix-sorted by their lowest vertex so that memory
 //! is visited nearly in order whatever order the file came in (the input's
-//! face order is restored at the end): half-edges are bucketed by their
-//! lower vertex with a counting sort, edges are the runs of equal upper vertex inside each bucket, orientation
-//! spreads breadth-first over manifold edges, and vertex fans are the
-//! components of a union-find over face corners.
+//! face order is restored at the end): edges are grouped by
+//! [`crate::edges`], orientation spreads breadth-first over manifold edges,
+//! and vertex fans are the components of a union-find over face corners.
 
+use crate::edges::Edges;
 use crate::{Error, IndexedMesh, Result};
 
 /// What [`prepare`] may change.
@@ -94,72 +94,6 @@ fn to(tris: &[[u32; 3]], h: u32) -> u32 {
 fn to_corner(h: u32) -> u32 {
     let f = h / 3;
     3 * f + NEXT[(h % 3) as usize] as u32
-}
-
-/// Half-edges grouped by undirected edge: bucketed by lower vertex with a
-/// counting sort, sorted by upper vertex within a bucket, in face order
-/// within an edge. Each item carries its edge's upper vertex beside the
-/// half-edge (`upper << 32 | h`), so sorting a bucket and finding its edges
-/// read no face: on a scan whose faces come in scattered order, those reads
-/// missed the cache and were most of the repair's time.
-struct Edges {
-    offsets: Vec<u32>,
-    items: Vec<u64>,
-}
-
-impl Edges {
-    fn build(tris: &[[u32; 3]], nv: usize) -> Edges {
-        let mut offsets = vec![0u32; nv + 1];
-        for t in tris {
-            for k in 0..3 {
-                offsets[t[k].min(t[NEXT[k]]) as usize + 1] += 1;
-            }
-        }
-        for v in 0..nv {
-            offsets[v + 1] += offsets[v];
-        }
-        let mut cursor = offsets.clone();
-        let mut items = vec![0u64; tris.len() * 3];
-        for (f, t) in tris.iter().enumerate() {
-            for k in 0..3 {
-                let (a, b) = (t[k], t[NEXT[k]]);
-                let lo = a.min(b) as usize;
-                items[cursor[lo] as usize] = (a.max(b) as u64) << 32 | (3 * f + k) as u64;
-                cursor[lo] += 1;
-            }
-        }
-        drop(cursor);
-        for v in 0..nv {
-            let s = &mut items[offsets[v] as usize..offsets[v + 1] as usize];
-            if s.len() > 1 {
-                // Keys are unique and half-edges ascend with their faces, so
-                // face order survives within each edge.
-                s.sort_unstable();
-            }
-        }
-        Edges { offsets, items }
-    }
-
-    /// Calls `f` with the half-edges of every undirected edge.
-    fn for_each(&self, mut f: impl FnMut(&[u32])) {
-        let mut edge: Vec<u32> = Vec::new();
-        for w in self.offsets.windows(2) {
-            let bucket = &self.items[w[0] as usize..w[1] as usize];
-            let mut start = 0;
-            while start < bucket.len() {
-                let upper = bucket[start] >> 32;
-                let end = start
-                    + bucket[start..]
-                        .iter()
-                        .take_while(|&&item| item >> 32 == upper)
-                        .count();
-                edge.clear();
-                edge.extend(bucket[start..end].iter().map(|&item| item as u32));
-                f(&edge);
-                start = end;
-            }
-        }
-    }
 }
 
 /// Union-find over face corners (path halving, lower index wins).
