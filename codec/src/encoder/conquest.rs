@@ -160,23 +160,30 @@ impl<'g> Simplifier<'g> {
                 3 * face_map[face(h) as usize] + h % 3
             }
         };
-        let mut origin = Vec::with_capacity(3 * faces as usize);
-        let mut twin = Vec::with_capacity(3 * faces as usize);
+        // In place: a face or vertex only ever moves down (its new index is
+        // at most its old one), and each slot is read before anything is
+        // written over it. No new arrays, so no fresh pages to fault in on a
+        // multi-million-vertex scan.
+        let conn = &mut self.conn;
         for f in 0..slots {
-            if face_map[f] != NONE {
+            let m = face_map[f];
+            if m != NONE {
                 for k in 0..3 {
-                    origin.push(vertex_map[self.conn.origin[3 * f + k] as usize]);
-                    twin.push(remap_half_edge(self.conn.twin[3 * f + k]));
+                    let (from, to) = (3 * f + k, 3 * m as usize + k);
+                    conn.origin[to] = vertex_map[conn.origin[from] as usize];
+                    conn.twin[to] = remap_half_edge(conn.twin[from]);
                 }
             }
         }
-        let mut out = vec![NONE; n];
-        for (v, &h) in self.conn.out.iter().enumerate() {
+        conn.origin.truncate(3 * faces as usize);
+        conn.twin.truncate(3 * faces as usize);
+        for v in 0..vertex_map.len() {
+            let h = conn.out[v];
             if h != NONE {
-                out[vertex_map[v] as usize] = remap_half_edge(h);
+                conn.out[vertex_map[v] as usize] = remap_half_edge(h);
             }
         }
-        self.conn = Connectivity { origin, twin, out };
+        conn.out.truncate(n);
         self.state.truncate(n);
         self.tag.truncate(n);
     }
