@@ -165,8 +165,7 @@ impl<'g> Simplifier<'g> {
         // written over it. No new arrays, so no fresh pages to fault in on a
         // multi-million-vertex scan.
         let conn = &mut self.conn;
-        for f in 0..slots {
-            let m = face_map[f];
+        for (f, &m) in face_map.iter().enumerate() {
             if m != NONE {
                 for k in 0..3 {
                     let (from, to) = (3 * f + k, 3 * m as usize + k);
@@ -177,10 +176,10 @@ impl<'g> Simplifier<'g> {
         }
         conn.origin.truncate(3 * faces as usize);
         conn.twin.truncate(3 * faces as usize);
-        for v in 0..vertex_map.len() {
+        for (v, &m) in vertex_map.iter().enumerate() {
             let h = conn.out[v];
             if h != NONE {
-                conn.out[vertex_map[v] as usize] = remap_half_edge(h);
+                conn.out[m as usize] = remap_half_edge(h);
             }
         }
         conn.out.truncate(n);
