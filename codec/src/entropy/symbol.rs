@@ -50,23 +50,6 @@ impl<const N: usize> FrequencyModel<N> {
         }
     }
 
-    /// A model whose symbols all start at frequency `initial` (≥ 1) instead
-    /// of 1: a larger start adapts more slowly, which suits the many sparse
-    /// contexts of a model that is reset often.
-    ///
-    /// # Panics
-    /// If `n_symbols` is not in `2..=64` or `initial` is 0 or too large for the total.
-    pub fn with_initial_frequency(n_symbols: usize, initial: u32) -> Self {
-        let mut model = Self::new(n_symbols);
-        assert!(
-            initial >= 1 && initial * n_symbols as u32 <= MAX_TOTAL,
-            "SymbolModel: initial frequency {initial} out of range"
-        );
-        model.freq[..n_symbols].fill(initial);
-        model.total = initial * n_symbols as u32;
-        model
-    }
-
     /// A model starting from the given frequencies (a prior), one per symbol.
     ///
     /// # Panics
@@ -335,7 +318,9 @@ mod symbol_tests {
     #[test]
     fn entropy_symbol_below_round_trips_and_excluded_symbols_cost_nothing() {
         let mut s = 7u64;
-        let n = 5;
+        // Five symbols, each starting at frequency 16.
+        let start = [16u16; 5];
+        let n = start.len();
         // Each step admits symbols 0..limit for a random limit and codes one of them.
         let steps: Vec<(usize, usize)> = (0..20_000)
             .map(|_| {
@@ -344,13 +329,13 @@ mod symbol_tests {
             })
             .collect();
         let mut enc = RangeEncoder::new();
-        let mut m = SymbolModel::with_initial_frequency(n, 16);
+        let mut m = SymbolModel::with_frequencies(&start);
         for &(limit, sym) in &steps {
             enc.encode_symbol_below(&mut m, sym, limit);
         }
         let bytes = enc.finish();
         let mut dec = RangeDecoder::new(&bytes);
-        let mut m = SymbolModel::with_initial_frequency(n, 16);
+        let mut m = SymbolModel::with_frequencies(&start);
         for &(limit, sym) in &steps {
             assert_eq!(dec.decode_symbol_below(&mut m, limit), sym);
         }
@@ -360,7 +345,7 @@ mod symbol_tests {
         // near log2(limit) per step (the model is adaptive, not told the limit's
         // uniform law, so a little above).
         let mut full = RangeEncoder::new();
-        let mut m = SymbolModel::with_initial_frequency(n, 16);
+        let mut m = SymbolModel::with_frequencies(&start);
         for &(_, sym) in &steps {
             full.encode_symbol(&mut m, sym);
         }
