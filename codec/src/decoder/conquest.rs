@@ -4,7 +4,7 @@
 
 use super::Level;
 use crate::entropy::{BitModel, FrequencyModel, RangeDecoder};
-use crate::gates::{GateCodes, PassKind, PatchSink, Region, Traversal, DECIMATION_SYMBOLS};
+use crate::gates::{Border, GateCodes, PassKind, PatchSink, Region, Traversal, DECIMATION_SYMBOLS};
 use crate::halfedge::{face, Connectivity, NONE};
 use crate::patch::MAX_VALENCE;
 use crate::predict::{
@@ -83,10 +83,10 @@ impl Level {
             &mut codes,
         )?;
         codes.0.check_overrun()?;
-        if traversal.regions.len() != pass.inserted as usize {
+        if traversal.borders.len() != pass.inserted as usize {
             return Err(Error::stream(format!(
                 "pass inserted {} vertices, its header says {}",
-                traversal.regions.len(),
+                traversal.borders.len(),
                 pass.inserted
             )));
         }
@@ -98,7 +98,7 @@ impl Level {
         let mut decoded = std::mem::take(&mut scratch.decoded);
         decoded.clear();
         let predictions = &mut scratch.predictions;
-        for block in traversal.regions.chunks(PREDICTION_BLOCK) {
+        for block in traversal.borders.chunks(PREDICTION_BLOCK) {
             predictions.clear();
             predictions.extend(block.iter().map(|r| {
                 PatchPrediction::for_border(
@@ -126,7 +126,7 @@ impl Level {
     /// encoder saw).
     fn decode_vertex(
         &self,
-        r: &Region,
+        r: &Border,
         prediction: &PatchPrediction,
         s: &mut Streams,
     ) -> Result<([i32; 3], Option<[u8; 3]>)> {

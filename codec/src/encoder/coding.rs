@@ -233,10 +233,10 @@ impl PassCoder {
             )
             .map_err(|_| disagree())?;
         let same_patches = replay.decisions.as_slice().is_empty()
-            && self.replay.regions.len() == pass.patches.len()
+            && self.replay.borders.len() == pass.patches.len()
             && self
                 .replay
-                .regions
+                .borders
                 .iter()
                 .zip(&pass.patches)
                 .all(|(r, (_, d, polygon))| r.valence == *d && r.polygon[..*d] == polygon[..*d]);
