@@ -395,19 +395,27 @@ async function loadComplex(page) {
   return { complex: new CellComplex(parameters, cells), cells, browserCells: rgba(decoded.cells), atlas: rgba(decoded.atlas) };
 }
 
+/** @type {Promise<ReturnType<import('../src/codec.js').StreamDecoder['level']>[]> | undefined} */
+let decodedLevels;
+
 /**
- * Level `k` as the WebAssembly decoder builds it from the served base mesh
- * and batches.
- * @param {number} k
+ * Every level as the WebAssembly decoder builds it from the served base
+ * mesh and batches: one decoder applies each batch once, for all the tests.
  */
-async function decodeLevel(k) {
-  const codec = await VitrineCodec.instantiate(readFileSync(wasmPath));
-  const bytes = async (/** @type {string} */ url) => new Uint8Array(await (await fetch(`${service.url}${url}`)).arrayBuffer());
-  const decoder = codec.decoder(await bytes(manifest.levels[0].url));
-  for (const level of manifest.levels.slice(1, k + 1)) decoder.apply(await bytes(level.url));
-  const out = decoder.level();
-  decoder.free();
-  return out;
+function decodeLevels() {
+  decodedLevels ??= (async () => {
+    const codec = await VitrineCodec.instantiate(readFileSync(wasmPath));
+    const bytes = async (/** @type {string} */ url) => new Uint8Array(await (await fetch(`${service.url}${url}`)).arrayBuffer());
+    const decoder = codec.decoder(await bytes(manifest.levels[0].url));
+    const levels = [decoder.level()];
+    for (const level of manifest.levels.slice(1)) {
+      decoder.apply(await bytes(level.url));
+      levels.push(decoder.level());
+    }
+    decoder.free();
+    return levels;
+  })();
+  return decodedLevels;
 }
 
 /**
@@ -480,7 +488,7 @@ test('ccc: every level shows the painted colours: each matches a CPU rendering o
     colour ??= await loadComplex(page);
     /** @type {Record<string, number>} */
     const kinds = {};
-    const score = gpuVsCpu(gpu, await cpuRendering(page, await decodeLevel(k), colour, kinds));
+    const score = gpuVsCpu(gpu, await cpuRendering(page, (await decodeLevels())[k], colour, kinds));
     t.diagnostic(`level ${k} of ${n} (${manifest.levels[k].vertices} vertices), GPU vs CPU rendering of this level: ${JSON.stringify(score)}; lookups ${JSON.stringify(kinds)}`);
     assert.ok(score.pixels > 0.1 * WIDTH * HEIGHT, `level ${k}: the model is in view`);
     assert.ok(score.mean < 3 && score.off < 0.01, `level ${k}, GPU vs CPU rendering: ${JSON.stringify(score)}`);
@@ -521,7 +529,7 @@ test('ccc: the final level matches a CPU rendering with the JavaScript lookup; t
   }
   /** @type {Record<string, number>} */
   const kinds = {};
-  const cpu = await cpuRendering(page, await decodeLevel(manifest.last_level), colour, kinds);
+  const cpu = await cpuRendering(page, (await decodeLevels())[manifest.last_level], colour, kinds);
   const { pixels, mean, off } = gpuVsCpu(gpu.rgba, cpu);
   t.diagnostic(`GPU vs CPU reference: ${pixels} pixels, mean max-channel difference ${mean.toFixed(2)}, ${(100 * off).toFixed(2)} % off by more than 24; lookups ${JSON.stringify(kinds)}`);
   assert.ok((kinds.tile ?? 0) > 0.95 * Object.values(kinds).reduce((a, b) => a + b, 0), `nearly every fragment finds a tile: ${JSON.stringify(kinds)}`);
