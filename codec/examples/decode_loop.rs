@@ -1,7 +1,8 @@
 //! Profiling aid: `cargo run --release --example decode_loop mesh.ply [decode-runs] [encode-runs]`,
 //! or `decode_loop stream.vtr [decode-runs]` to time decoding a stream written before.
 //! Encoding runs on one core (as `vitrine bench` times it) unless
-//! `VITRINE_PIPELINED=1`.
+//! `VITRINE_PIPELINED=1`; `VITRINE_STREAM_OUT=path` keeps the stream (to
+//! compare two builds' bytes, or time decoders on it).
 use std::time::Instant;
 use vitrine_codec::import::{import_path, ImportOptions};
 use vitrine_codec::repair::{prepare, RepairOptions};
@@ -61,5 +62,9 @@ fn main() {
         encode_times.push(t.elapsed().as_secs_f64());
     }
     report("encode", encode_times, mesh.positions.len());
-    time_decodes(&e.unwrap().bytes, runs);
+    let bytes = e.unwrap().bytes;
+    if let Some(out) = std::env::var_os("VITRINE_STREAM_OUT") {
+        std::fs::write(out, &bytes).unwrap();
+    }
+    time_decodes(&bytes, runs);
 }

@@ -77,6 +77,36 @@ fn texture_gives_the_vertex_colours_back() {
 }
 
 #[test]
+fn the_complex_is_the_same_whatever_the_number_of_threads() {
+    // Its cells are rendered, and its triangles swept (14,400 of them: two
+    // tasks), on every core: the images must not depend on how many.
+    let mesh = painted_torus();
+    let q = Quantization::for_positions(&mesh.positions, 12).unwrap();
+    let build = |threads| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        let source = ColourSource::PerVertex(&mesh);
+        pool.install(|| ccc::build(&mesh, &q, source, &CccOptions::default()))
+            .expect("builds")
+            .0
+    };
+    let one = build(1);
+    assert!(one.report.cells > 100, "{:?}", one.report);
+    for threads in [2, 5] {
+        let several = build(threads);
+        assert_eq!(several.report, one.report, "{threads} threads");
+        assert!(several.cell_png == one.cell_png, "{threads} threads");
+        assert!(several.colour_jpeg == one.colour_jpeg, "{threads} threads");
+        assert!(
+            several.colour_low_jpeg == one.colour_low_jpeg,
+            "{threads} threads"
+        );
+    }
+}
+
+#[test]
 fn every_level_stays_inside_the_cells() {
     let mesh = painted_torus();
     let q = Quantization::for_positions(&mesh.positions, 12).unwrap();
