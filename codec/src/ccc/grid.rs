@@ -116,21 +116,43 @@ pub fn for_each_overlapped_cube(
     margin: f64,
     mut f: impl FnMut(IVec3),
 ) {
+    let half = DVec3::splat(grid.cell_size * 0.5 + margin);
+    for (c, centre) in cubes_near(grid, tri, margin) {
+        if triangle_overlaps_box(tri, centre, half) {
+            f(c);
+        }
+    }
+}
+
+/// Whether the triangle overlaps a cube whose index satisfies `wanted`.
+/// `wanted` is asked first, so the exact test runs on those cubes alone,
+/// and the search stops at the first overlap: the guard asks this of every
+/// new face of every candidate patch, and usually every cube near a face is
+/// a cell.
+pub fn overlaps_a_cube(grid: &Grid, tri: [DVec3; 3], wanted: impl Fn(usize) -> bool) -> bool {
+    let half = DVec3::splat(grid.cell_size * 0.5);
+    cubes_near(grid, tri, 0.0)
+        .any(|(c, centre)| wanted(grid.index(c)) && triangle_overlaps_box(tri, centre, half))
+}
+
+/// The cubes of the grid the triangle's bounding box (grown by `margin`)
+/// touches, with their centres.
+fn cubes_near(
+    grid: &Grid,
+    tri: [DVec3; 3],
+    margin: f64,
+) -> impl Iterator<Item = (IVec3, DVec3)> + '_ {
     let lo = tri[0].min(tri[1]).min(tri[2]);
     let hi = tri[0].max(tri[1]).max(tri[2]);
     let (a, b) = grid.cube_range(lo, hi, margin);
-    let half = DVec3::splat(grid.cell_size * 0.5 + margin);
-    for z in a.z..=b.z {
-        for y in a.y..=b.y {
-            for x in a.x..=b.x {
+    (a.z..=b.z).flat_map(move |z| {
+        (a.y..=b.y).flat_map(move |y| {
+            (a.x..=b.x).map(move |x| {
                 let c = IVec3::new(x, y, z);
-                let centre = grid.cube_min(c) + DVec3::splat(grid.cell_size * 0.5);
-                if triangle_overlaps_box(tri, centre, half) {
-                    f(c);
-                }
-            }
-        }
-    }
+                (c, grid.cube_min(c) + DVec3::splat(grid.cell_size * 0.5))
+            })
+        })
+    })
 }
 
 #[cfg(test)]
@@ -180,6 +202,37 @@ mod tests {
             DVec3::ZERO,
             half
         ));
+    }
+
+    #[test]
+    fn a_wanted_cube_is_met_exactly_when_the_sweep_meets_one() {
+        let g = Grid::around(d(0., 0., 0.), d(6., 6., 6.), 1.0);
+        // Every third cube is wanted.
+        let wanted = |i: usize| i % 3 == 0;
+        let mut seed = 11u64;
+        let mut coordinate = || {
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (seed >> 40) as f64 / (1u64 << 24) as f64 * 6.0
+        };
+        let (mut met, mut missed) = (0, 0);
+        for _ in 0..5_000 {
+            let a = d(coordinate(), coordinate(), coordinate());
+            // Small triangles, as a patch's faces are, near a cube's size.
+            let mut near = || a + (d(coordinate(), coordinate(), coordinate()) - 3.0) * 0.3;
+            let tri = [a, near(), near()];
+            let mut swept = false;
+            for_each_overlapped_cube(&g, tri, 0.0, |c| swept |= wanted(g.index(c)));
+            assert_eq!(overlaps_a_cube(&g, tri, wanted), swept, "{tri:?}");
+            if swept {
+                met += 1;
+            } else {
+                missed += 1;
+            }
+        }
+        // Both answers were exercised.
+        assert!(met > 500 && missed > 500, "{met} {missed}");
     }
 
     #[test]

@@ -3,7 +3,7 @@
 
 use glam::DVec3;
 
-use super::grid::{for_each_overlapped_cube, Grid};
+use super::grid::{overlaps_a_cube, Grid};
 use crate::{CandidatePatch, PatchGuard, Quantization};
 
 /// Refuses retriangulations with a face that crosses an empty cube.
@@ -26,17 +26,14 @@ impl CellGuard {
     /// Whether the triangle (quantized corners) overlaps cells only.
     pub fn triangle_in_cells(&self, tri: [[i32; 3]; 3]) -> bool {
         let tri = tri.map(|q| DVec3::from(self.quantization.dequantize(q).map(f64::from)));
-        let mut inside = true;
         let lo = tri[0].min(tri[1]).min(tri[2]);
         let hi = tri[0].max(tri[1]).max(tri[2]);
         if !self.grid.contains(self.grid.cube_of(lo)) || !self.grid.contains(self.grid.cube_of(hi))
         {
             return false;
         }
-        for_each_overlapped_cube(&self.grid, tri, 0.0, |c| {
-            inside &= self.occupied[self.grid.index(c)];
-        });
-        inside
+        // Inside the cells unless it meets a cube that is not one.
+        !overlaps_a_cube(&self.grid, tri, |i| !self.occupied[i])
     }
 }
 
