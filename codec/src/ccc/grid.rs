@@ -208,7 +208,7 @@ mod tests {
     fn a_wanted_cube_is_met_exactly_when_the_sweep_meets_one() {
         let g = Grid::around(d(0., 0., 0.), d(6., 6., 6.), 1.0);
         // Every third cube is wanted.
-        let wanted = |i: usize| i % 3 == 0;
+        let wanted = |i: usize| i.is_multiple_of(3);
         let mut seed = 11u64;
         let mut coordinate = || {
             seed = seed
