@@ -11,13 +11,11 @@ use crate::storage::{
 use anyhow::{bail, Context};
 use serde_json::json;
 use std::time::{Duration, Instant};
-use vitrine_codec::ccc::{
-    encode_coloured, vertex_colours_from_texture, CccOptions, CccParameters, CccReport,
-    CellComplex, ColourMode, TextureMapping,
-};
-use vitrine_codec::import::TexturedSurface;
-use vitrine_codec::quality::{stream_quality, LevelQuality, Original, QualityOptions};
 use vitrine_codec::{BaseTarget, EncodeOptions, Encoded, IndexedMesh, StreamIndex};
+use vitrine_colour::ccc::{CccOptions, CccParameters, CccReport, CellComplex, TextureMapping};
+use vitrine_colour::{encode_coloured, vertex_colours_from_texture, ColourMode};
+use vitrine_mesh::import::TexturedSurface;
+use vitrine_quality::{stream_quality, LevelQuality, Original, QualityOptions};
 
 /// What a model is called and who may see it.
 #[derive(Clone, Debug)]
@@ -62,13 +60,13 @@ pub struct SourceInfo {
 pub struct IngestOptions {
     pub encode: EncodeOptions,
     /// How colour travels (`ccc`, `vertex`, `vertex-metric`, `none`; see
-    /// `vitrine_codec::ccc::ColourMode`). `None`: `vertex` when the mesh has
+    /// `vitrine_colour::ColourMode`). `None`: `vertex` when the mesh has
     /// colour or a texture, else `none`.
     pub colour: Option<ColourMode>,
     /// The cell complex's options, in `ccc` mode.
     pub ccc: CccOptions,
     /// Measure every level against the original before storing
-    /// (`vitrine_codec::quality::stream_quality`: Hausdorff, Roy colour RMSE,
+    /// (`vitrine_quality::stream_quality`: Hausdorff, Roy colour RMSE,
     /// 24-view image RMSE). About a second per level at 50k vertices, so off
     /// by default. Only [`ingest_coloured`] and [`ingest_mesh`] can measure:
     /// [`ingest_encoded`] has no original.
@@ -101,7 +99,7 @@ pub struct MeasuredQuality {
     pub time: Duration,
 }
 
-/// Encodes `mesh` (already repaired: see `vitrine_codec::repair::prepare`)
+/// Encodes `mesh` (already repaired: see `vitrine_mesh::repair::prepare`)
 /// and stores it as a new model or model version.
 pub async fn ingest_mesh(
     storage: &dyn Storage,
@@ -116,7 +114,7 @@ pub async fn ingest_mesh(
 /// `ccc` mode the complex samples the texture (else the per-vertex colour),
 /// stores its three images and parameters in the same transaction as the
 /// model, and the stream carries geometry only; the vertex modes sample the
-/// texture at the vertices (`vitrine_codec::ccc::encode_coloured`).
+/// texture at the vertices (`vitrine_colour::encode_coloured`).
 pub async fn ingest_coloured(
     storage: &dyn Storage,
     mesh: IndexedMesh,
@@ -138,9 +136,14 @@ pub async fn ingest_coloured(
     let (encoded, mapping, encode_time, quality) =
         tokio::task::spawn_blocking(move || -> anyhow::Result<_> {
             let started = Instant::now();
-            let (encoded, mapping) =
-                encode_coloured(&mesh, texture.as_ref(), mode, &encode_options, &ccc, |_| {})
-                    .context("encoding failed")?;
+            let (encoded, mapping) = encode_coloured(
+                &mesh,
+                texture.as_ref(),
+                mode,
+                &ccc,
+                vitrine_codec::Encoder::new(encode_options),
+            )
+            .context("encoding failed")?;
             let encode_time = started.elapsed();
             // Before the transaction: measuring takes seconds, and a write
             // transaction should not stay open (SQLite holds its one writer lock).
@@ -201,7 +204,7 @@ fn measure_quality(
 
 /// Stores a stream the caller encoded, with its CCC colour mapping if it has
 /// one (built for the same mesh and quantization, and the stream encoded
-/// under its guard: `vitrine_codec::ccc::encode_with_ccc`). The mapping's
+/// under its guard: `vitrine_colour::ccc::encode_with_ccc`). The mapping's
 /// three images and parameters go into the same transaction as the model;
 /// they are checked against the parameters first.
 pub async fn ingest_encoded(
@@ -393,7 +396,7 @@ fn encode_options_json(
 /// JPEGs of the atlas's full and reduced size.
 fn new_mapping(
     m: &TextureMapping,
-) -> anyhow::Result<(NewTextureMapping, vitrine_codec::ccc::CccReport)> {
+) -> anyhow::Result<(NewTextureMapping, vitrine_colour::ccc::CccReport)> {
     let p: &CccParameters = &m.parameters;
     if p.version != 1 {
         bail!("CCC version {} is not supported (1 is)", p.version);

@@ -2,7 +2,7 @@
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
-use vitrine_codec::import::{import_bytes, MeshFormat};
+use vitrine_mesh::import::{import_bytes, MeshFormat};
 use vitrine_codec_fuzz::{check_import, import_options};
 
 fuzz_target!(|data: &[u8]| {

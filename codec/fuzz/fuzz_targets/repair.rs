@@ -5,7 +5,7 @@
 
 use arbitrary::Arbitrary;
 use libfuzzer_sys::fuzz_target;
-use vitrine_codec::repair::{check_manifold, prepare, RepairOptions};
+use vitrine_mesh::repair::{check_manifold, prepare, RepairOptions};
 use vitrine_codec::{
     encode, BaseTarget, Decoder, EncodeOptions, IndexedMesh, Limits, Quantization, StreamIndex,
 };

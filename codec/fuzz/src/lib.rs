@@ -3,8 +3,8 @@
 
 use std::sync::OnceLock;
 
-use vitrine_codec::import::ImportOptions;
-use vitrine_codec::samples::{icosphere, paint, torus};
+use vitrine_mesh::import::ImportOptions;
+use vitrine_samples::{icosphere, paint, torus};
 use vitrine_codec::{encode, Decoder, EncodeOptions, IndexedMesh, Limits};
 
 /// Small budgets, so that a hostile input that is merely big is refused

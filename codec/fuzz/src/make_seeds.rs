@@ -4,8 +4,8 @@
 
 use std::path::Path;
 
-use vitrine_codec::export::{write_glb, write_obj, write_ply};
-use vitrine_codec::samples::{icosphere, plate_with_tunnels};
+use vitrine_mesh::export::{write_glb, write_obj, write_ply};
+use vitrine_samples::{icosphere, plate_with_tunnels};
 use vitrine_codec::{encode, EncodeOptions, StreamIndex};
 use vitrine_codec_fuzz::{sample_meshes, sample_streams};
 

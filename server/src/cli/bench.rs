@@ -12,8 +12,8 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::Instant;
-use vitrine_codec::export::write_ply;
 use vitrine_codec::{breakdown, decode, encode, EncodeOptions, IndexedMesh, Limits};
+use vitrine_mesh::export::write_ply;
 
 #[derive(Args, Debug)]
 pub struct BenchArgs {
@@ -352,8 +352,8 @@ fn markdown(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use vitrine_codec::import::{import_path, ImportOptions};
-    use vitrine_codec::samples;
+    use vitrine_mesh::import::{import_path, ImportOptions};
+    use vitrine_samples as samples;
 
     /// Draco must be handed the mesh we encode, not the file: an OBJ whose
     /// seams duplicate vertices is welded by our import, so the file holds
@@ -377,7 +377,7 @@ mod tests {
         };
         let input = dir.path().join("seams.obj");
         let mut file = std::fs::File::create(&input).unwrap();
-        vitrine_codec::export::write_obj(&unwelded, &mut file).unwrap();
+        vitrine_mesh::export::write_obj(&unwelded, &mut file).unwrap();
         drop(file);
         let written = dir.path().join("seams.obj.ply");
         let result = measure(&BenchOneArgs {

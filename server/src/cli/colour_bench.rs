@@ -10,11 +10,10 @@ use std::time::Instant;
 
 use anyhow::Context;
 use clap::Args;
-use vitrine_codec::ccc::{
-    encode_coloured, vertex_colours_from_texture, CccOptions, CellComplex, ColourMode,
-};
-use vitrine_codec::quality::{stream_quality, LevelQuality, Original, QualityOptions};
 use vitrine_codec::{breakdown, EncodeOptions};
+use vitrine_colour::ccc::{CccOptions, CellComplex};
+use vitrine_colour::{encode_coloured, vertex_colours_from_texture, ColourMode};
+use vitrine_quality::{stream_quality, LevelQuality, Original, QualityOptions};
 
 #[derive(Args, Debug)]
 pub struct ColourBenchArgs {
@@ -82,9 +81,8 @@ pub fn run(args: ColourBenchArgs) -> anyhow::Result<()> {
             &mesh,
             None,
             ColourMode::None,
-            &options,
             &CccOptions::default(),
-            |_| {},
+            vitrine_codec::Encoder::new(options.clone()),
         )?;
         let plain_conn = connectivity_bpv(&plain.bytes, mesh.positions.len())?;
         let mut runs = Vec::new();
@@ -99,9 +97,8 @@ pub fn run(args: ColourBenchArgs) -> anyhow::Result<()> {
                 &mesh,
                 texture.as_ref(),
                 mode,
-                &options,
                 &CccOptions::default(),
-                |_| {},
+                vitrine_codec::Encoder::new(options.clone()),
             )?;
             let complex = mapping
                 .as_ref()

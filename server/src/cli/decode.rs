@@ -2,8 +2,8 @@ use anyhow::{bail, Context};
 use clap::Args;
 use std::io::BufWriter;
 use std::path::PathBuf;
-use vitrine_codec::export::{write_glb, write_obj, write_ply};
 use vitrine_codec::{decode, Limits};
+use vitrine_mesh::export::{write_glb, write_obj, write_ply};
 
 #[derive(Args, Debug)]
 pub struct DecodeArgs {

@@ -3,8 +3,8 @@ use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
 use std::path::PathBuf;
 use std::time::Instant;
-use vitrine_codec::ccc::{encode_coloured, ColourMode};
 use vitrine_codec::{BaseTarget, EncodeOptions};
+use vitrine_colour::{encode_coloured, ColourMode};
 
 #[derive(Args, Debug)]
 pub struct EncodeArgs {
@@ -79,12 +79,11 @@ pub fn run(args: EncodeArgs) -> anyhow::Result<()> {
         &mesh,
         texture.as_ref(),
         mode,
-        &args.options(),
         &args.ccc.options(),
-        |p| {
+        vitrine_codec::Encoder::new(args.options()).progress(|p| {
             bar.set_message(p.layer.to_string());
             bar.set_position((p.input_vertices - p.vertices) as u64);
-        },
+        }),
     )?;
     bar.finish_and_clear();
     let elapsed = start.elapsed();

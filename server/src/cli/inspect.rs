@@ -1,9 +1,10 @@
 use anyhow::Context;
 use clap::Args;
 use std::path::PathBuf;
-use vitrine_codec::ccc::{vertex_colours_from_texture, CccParameters, CellComplex};
-use vitrine_codec::quality::{stream_quality, Original, QualityOptions};
 use vitrine_codec::{breakdown, Header};
+use vitrine_colour::ccc::{CccParameters, CellComplex};
+use vitrine_colour::{vertex_colours_from_texture};
+use vitrine_quality::{stream_quality, Original, QualityOptions};
 
 #[derive(Args, Debug)]
 pub struct InspectArgs {

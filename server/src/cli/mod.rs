@@ -10,9 +10,9 @@ pub mod sample;
 
 use anyhow::Context;
 use std::path::{Path, PathBuf};
-use vitrine_codec::import::{import_path, import_path_textured, ImportOptions, TexturedSurface};
-use vitrine_codec::repair::{prepare, RepairOptions, RepairReport};
 use vitrine_codec::IndexedMesh;
+use vitrine_mesh::import::{import_path, import_path_textured, ImportOptions, TexturedSurface};
+use vitrine_mesh::repair::{prepare, RepairOptions, RepairReport};
 
 /// Reads any supported mesh file and repairs it into an encodable manifold.
 pub fn load_mesh(path: &Path) -> anyhow::Result<(IndexedMesh, RepairReport)> {

@@ -5,8 +5,8 @@ use anyhow::Context;
 use clap::{Args, ValueEnum};
 use std::io::BufWriter;
 use std::path::PathBuf;
-use vitrine_codec::samples::{add_noise, icosphere, paint, plate_with_tunnels, torus};
 use vitrine_codec::IndexedMesh;
+use vitrine_samples::{add_noise, icosphere, paint, plate_with_tunnels, torus};
 
 #[derive(Clone, Copy, Debug, ValueEnum)]
 pub enum SampleKind {
@@ -65,7 +65,7 @@ pub fn run(args: SampleArgs) -> anyhow::Result<()> {
     let mesh = generate(&args);
     let file = std::fs::File::create(&args.output)
         .with_context(|| format!("creating {}", args.output.display()))?;
-    vitrine_codec::export::write_ply(&mesh, &mut BufWriter::new(file))?;
+    vitrine_mesh::export::write_ply(&mesh, &mut BufWriter::new(file))?;
     eprintln!(
         "{}: {} vertices, {} faces",
         args.output.display(),

@@ -5,11 +5,12 @@ use crate::storage::{ConnectOptions, OnExisting};
 use anyhow::Context;
 use std::path::PathBuf;
 use std::time::Duration;
-use vitrine_codec::ccc::{CccOptions, ColourMode};
-use vitrine_codec::import::{import_path_textured, ImportOptions};
-use vitrine_codec::quality::QualityOptions;
-use vitrine_codec::repair::{prepare, RepairOptions};
 use vitrine_codec::EncodeOptions;
+use vitrine_colour::ccc::{CccOptions};
+use vitrine_colour::{ColourMode};
+use vitrine_mesh::import::{import_path_textured, ImportOptions};
+use vitrine_mesh::repair::{prepare, RepairOptions};
+use vitrine_quality::QualityOptions;
 
 #[derive(clap::Args, Clone, Debug)]
 pub struct IngestArgs {

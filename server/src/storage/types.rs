@@ -44,7 +44,7 @@ impl LevelRecord {
     }
 }
 
-/// One level's quality against the original (`vitrine_codec::quality`).
+/// One level's quality against the original (`vitrine_quality`).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct LevelMetrics {
     /// Symmetric Hausdorff distance over the bounding-box diagonal.

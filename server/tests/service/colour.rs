@@ -10,12 +10,10 @@ use std::time::Duration;
 use vitrine::ingest::{ingest_encoded, ingest_mesh, IngestOptions, ModelMeta};
 use vitrine::storage::sha256_hex;
 use vitrine::{app, AppState};
-use vitrine_codec::ccc::{
-    AtlasLayout, CccParameters, CccReport, CellComplex, CellTextureLayout, ColourMode,
-    TextureMapping,
-};
-use vitrine_codec::samples::torus;
 use vitrine_codec::{Decoder, Limits};
+use vitrine_colour::ccc::{AtlasLayout, CccParameters, CccReport, CellComplex, CellTextureLayout, TextureMapping};
+use vitrine_colour::{ColourMode};
+use vitrine_samples::torus;
 
 /// A two-cube complex with one cell and two tiles: small, but every size in
 /// it is consistent, as ingest checks.

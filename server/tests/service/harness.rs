@@ -10,8 +10,8 @@ use tokio::sync::oneshot;
 use vitrine::ingest::{ingest_mesh, IngestOptions, IngestReport, ModelMeta};
 use vitrine::storage::{connect, ConnectOptions, Storage};
 use vitrine::{app, AppState, ServeLimits, ServiceConfig};
-use vitrine_codec::samples::{paint, torus};
 use vitrine_codec::{encode, EncodeOptions, Encoded, IndexedMesh};
+use vitrine_samples::{paint, torus};
 
 use super::proxy::Proxy;
 

@@ -6,8 +6,8 @@ use super::story::get;
 use serde_json::Value;
 use vitrine::ingest::{ingest_mesh, IngestOptions, ModelMeta};
 use vitrine::{app, AppState};
-use vitrine_codec::ccc::ColourMode;
-use vitrine_codec::quality::QualityOptions;
+use vitrine_colour::ColourMode;
+use vitrine_quality::QualityOptions;
 
 /// Small enough for a debug build: the curve's shape, not its precision, is tested.
 fn quick() -> QualityOptions {
