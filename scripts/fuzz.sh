@@ -6,7 +6,7 @@
 # Needs the nightly toolchain (rustup toolchain install nightly; without it
 # the script skips, see below); installs cargo-fuzz if it is missing. Corpora grow in codec/fuzz/corpus/<target>,
 # crashes land in codec/fuzz/artifacts/<target>; both are git-ignored. Turn a
-# crash into a regression test in codec/tests/hostile.rs. Exits non-zero if
+# crash into a regression test in codec/mesh/tests/hostile.rs. Exits non-zero if
 # any target found a crash.
 set -euo pipefail
 

@@ -1,6 +1,6 @@
 // @ts-check
 /**
- * Colour through a cubic cell complex (CCC, codec/CCC.md; thesis ch. 5):
+ * Colour through a cubic cell complex (CCC, codec/colour/CCC.md; thesis ch. 5):
  * a fragment at world position p finds its colour the same way at every
  * level — grid cube → cell → central projection onto the cube's faces →
  * tile → bilinear texel — so the viewer needs no per-vertex UVs and the
@@ -9,7 +9,7 @@
  * The lookup is written twice, like the lighting in shading.js: as GLSL for
  * the fragment shader (`GLSL_CCC`) and as JavaScript (`CellComplex`), which
  * the Node tests check against hand-made complexes and the end-to-end test
- * checks the shader against. codec/src/ccc/lookup.rs is the Rust twin.
+ * checks the shader against. codec/colour/src/ccc/lookup.rs is the Rust twin.
  */
 
 /**

@@ -162,7 +162,7 @@ export class StreamDecoder {
 
 /**
  * Splits a whole stream file into its base part and batches, reading only
- * the level table (see codec/FORMAT.md).
+ * the level table (see codec/core/FORMAT.md).
  * @param {Uint8Array} stream
  */
 export function splitStream(stream) {

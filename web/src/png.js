@@ -1,7 +1,7 @@
 // @ts-check
 /**
  * A small PNG decoder for the cell texture of a CCC colour mapping
- * (codec/CCC.md). The cell texture is data, not a picture: every byte is
+ * (codec/colour/CCC.md). The cell texture is data, not a picture: every byte is
  * part of a 24-bit number, so it must reach the shader exactly. Decoding it
  * here (the browser's DecompressionStream inflates, this file undoes the row
  * filters) leaves no room for colour management, gamma or premultiplication

@@ -235,7 +235,7 @@ export class Reconstruction {
   }
 
   /**
-   * Posts the current level. Vertices are only ever appended (codec/FORMAT.md:
+   * Posts the current level. Vertices are only ever appended (codec/core/FORMAT.md:
    * each pass appends the vertices it inserts), so positions and colours
    * carry only the vertices not posted before (from `firstVertex`); normals
    * and indices change everywhere and go whole. Normals (unless the

@@ -1,7 +1,7 @@
 //! Evaluates the cubic cell complex on a mesh file: guard overhead against
 //! unguarded AD, texture sizes, ambiguity and build time, for a few cell sizes.
 //!
-//!     cargo run --release -p vitrine-codec --example ccc_eval -- MESH [CUBES_ON_LONGEST...]
+//!     cargo run --release -p vitrine-colour --example ccc_eval -- MESH [CUBES_ON_LONGEST...]
 
 use std::time::Instant;
 

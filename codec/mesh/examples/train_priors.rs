@@ -1,5 +1,5 @@
-//! Trains the connectivity priors (`codec/src/priors/table.rs`) on meshes:
-//! `cargo run --release -p vitrine-codec --example train_priors -- mesh… > table.rs`
+//! Trains the connectivity priors (`codec/core/src/priors/table.rs`) on meshes:
+//! `cargo run --release -p vitrine-mesh --example train_priors -- mesh… > table.rs`
 //! (`scripts/train-priors.sh` runs it on the Stanford dragon from npm).
 use vitrine_codec::{encode, EncodeOptions, GateStatistics};
 use vitrine_mesh::import::{import_path, ImportOptions};
@@ -8,7 +8,7 @@ use vitrine_mesh::repair::{prepare, RepairOptions};
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let paths: Vec<String> = std::env::args().skip(1).collect();
     if paths.is_empty() {
-        return Err("usage: train_priors mesh… > codec/src/priors/table.rs".into());
+        return Err("usage: train_priors mesh… > codec/core/src/priors/table.rs".into());
     }
     let mut statistics = GateStatistics::default();
     for path in &paths {

@@ -2,7 +2,7 @@
 //! written by `vitrine encode --colour ccc`) or its vertex colours, for a look
 //! by eye:
 //!
-//!     cargo run --release -p vitrine-codec --example ccc_render -- STREAM OUT_PREFIX [VIEW] [LEVEL...]
+//!     cargo run --release -p vitrine-quality --example ccc_render -- STREAM OUT_PREFIX [VIEW] [LEVEL...]
 
 use vitrine_codec::{Decoder, Limits, StreamIndex};
 use vitrine_colour::ccc::{CccParameters, CellComplex};

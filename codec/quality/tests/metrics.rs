@@ -400,7 +400,7 @@ fn rendering_clips_against_the_near_plane() {
     assert_eq!(frame.covered(), 64 * 64);
 }
 
-/// Timings quoted in the report: `cargo test --release -p vitrine-codec --test metrics -- --ignored --nocapture`.
+/// Timings quoted in the report: `cargo test --release -p vitrine-quality --test metrics -- --ignored --nocapture`.
 #[test]
 #[ignore]
 fn timing_on_100k_meshes() {

@@ -3,7 +3,7 @@ use clap::Args;
 use std::path::PathBuf;
 use vitrine_codec::{breakdown, Header};
 use vitrine_colour::ccc::{CccParameters, CellComplex};
-use vitrine_colour::{vertex_colours_from_texture};
+use vitrine_colour::vertex_colours_from_texture;
 use vitrine_quality::{stream_quality, Original, QualityOptions};
 
 #[derive(Args, Debug)]

@@ -159,7 +159,7 @@ struct ManifestCcc<'a> {
 #[derive(Serialize)]
 #[serde(tag = "mode", rename_all = "lowercase")]
 enum ManifestColour<'a> {
-    /// Colour mapping through a cubic cell complex (`codec/CCC.md`): the
+    /// Colour mapping through a cubic cell complex (`codec/colour/CCC.md`): the
     /// viewer loads the cell texture and the low-resolution colour texture
     /// after the base mesh, then the full-resolution one.
     Ccc(Box<ManifestCcc<'a>>),

@@ -72,7 +72,7 @@ pub struct TextureRef {
 #[derive(Clone, Debug, PartialEq)]
 pub struct MappingRecord {
     pub id: i64,
-    /// The complex's parameters (`codec/CCC.md`), as stored.
+    /// The complex's parameters (`codec/colour/CCC.md`), as stored.
     pub parameters: serde_json::Value,
 }
 
@@ -92,7 +92,7 @@ pub struct ModelRecord {
     pub quantization_bits: u8,
     pub has_colour: bool,
     /// Stream format version the payloads were encoded in (column
-    /// `compression.codec_version`, `codec/FORMAT.md`).
+    /// `compression.codec_version`, `codec/core/FORMAT.md`).
     pub stream_format: u8,
     /// `levels[0]` is the base mesh, `levels[k]` the mesh after batch `k`.
     pub levels: Vec<LevelRecord>,
@@ -218,7 +218,7 @@ pub struct NewTexture {
 /// The three images of a CCC colour mapping and its parameters.
 #[derive(Clone, Debug)]
 pub struct NewTextureMapping {
-    /// Parameters as JSON (`codec/CCC.md`, "Parameters").
+    /// Parameters as JSON (`codec/colour/CCC.md`, "Parameters").
     pub parameters: String,
     pub cell: NewTexture,
     pub colour: NewTexture,

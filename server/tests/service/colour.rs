@@ -11,8 +11,10 @@ use vitrine::ingest::{ingest_encoded, ingest_mesh, IngestOptions, ModelMeta};
 use vitrine::storage::sha256_hex;
 use vitrine::{app, AppState};
 use vitrine_codec::{Decoder, Limits};
-use vitrine_colour::ccc::{AtlasLayout, CccParameters, CccReport, CellComplex, CellTextureLayout, TextureMapping};
-use vitrine_colour::{ColourMode};
+use vitrine_colour::ccc::{
+    AtlasLayout, CccParameters, CccReport, CellComplex, CellTextureLayout, TextureMapping,
+};
+use vitrine_colour::ColourMode;
 use vitrine_samples::torus;
 
 /// A two-cube complex with one cell and two tiles: small, but every size in

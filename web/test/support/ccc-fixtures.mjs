@@ -1,6 +1,6 @@
 // @ts-check
 /**
- * Hand-made cubic cell complexes (codec/CCC.md) and a PNG writer, for the
+ * Hand-made cubic cell complexes (codec/colour/CCC.md) and a PNG writer, for the
  * Node tests of src/ccc.js and src/png.js and the shader test in Chromium.
  */
 import { deflateSync } from 'node:zlib';

@@ -1,6 +1,6 @@
 //! Cubic cell complex colour mapping (thesis ch. 5; Apaza-Agüero, Silva &
 //! Bellon 2011): colour lives in one texture shared by every level, reached
-//! through a grid of cubes around the surface. The layout is in `codec/CCC.md`.
+//! through a grid of cubes around the surface. The layout is in `codec/colour/CCC.md`.
 
 mod build;
 mod grid;
