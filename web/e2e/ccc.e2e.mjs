@@ -204,7 +204,7 @@ window.draw = async (atlasUrl, resolution) => {
     if (path === '/') return void response.writeHead(200, { 'content-type': 'text/html' }).end(harness);
     if (path === '/favicon.ico') return void response.writeHead(204).end();
     if (path in files) return void response.writeHead(200, { 'content-type': 'image/png' }).end(files[/** @type {keyof typeof files} */ (path)]);
-    if (/^\/src\/[a-z]+\.js$/.test(path)) {
+    if (/^\/src\/[a-z-]+\.js$/.test(path)) {
       return void response.writeHead(200, { 'content-type': 'text/javascript' }).end(readFileSync(join(root, 'web', path)));
     }
     response.writeHead(404).end();
