@@ -2,13 +2,13 @@
 /**
  * One model on screen: reads the manifest, starts a decode worker, shows each
  * level the worker sends, follows the visitor's level cap, and turns every
- * failure into a message with a retry button.
+ * failure into a message with a retry button. A model in `ccc` mode gets its
+ * colour textures from colour-loader.js once the base mesh is on screen.
  */
 
 import { OrbitCamera } from './camera.js';
-import { checkParameters } from './ccc.js';
+import { ColourLoader } from './colour-loader.js';
 import { OrbitControls } from './controls.js';
-import { decodePng } from './png.js';
 import { canTransfer, openRenderer } from './render-host.js';
 import { retryAfterSeconds, waitToRetry } from './retry.js';
 
@@ -68,11 +68,6 @@ import { retryAfterSeconds, waitToRetry } from './retry.js';
  *   when the textures were requested and when each colour texture was first drawn
  * @property {string | null} colourError why the CCC colour could not be shown (the model stays visible)
  */
-
-/** @param {unknown} error */
-function describe(error) {
-  return error instanceof Error ? error.message : String(error);
-}
 
 /** @type {Map<string, Promise<WebAssembly.Module>>} */
 const compiled = new Map();
@@ -149,8 +144,13 @@ export class Viewer {
   #wireframe = false;
   /** Bumped by stop(), so a start() still waiting for the network gives up. */
   #attempt = 0;
-  /** The cell texture URL whose mapping is loaded or loading (kept across retries). */
-  #colourSource = /** @type {string | null} */ (null);
+  /** The CCC colour textures: fetched after the first frame, kept across retries. */
+  #colour = new ColourLoader({
+    manifest: () => this.manifest,
+    renderer: () => this.renderer,
+    url: (path) => this.#apiUrl(path),
+    set: (patch) => this.#set(patch),
+  });
   /** The cap in force: from the manifest, or from a batch the server refused. */
   #cap = { level: 0, reason: /** @type {string | null} */ (null), retryAfterS: /** @type {number | null} */ (null) };
 
@@ -249,16 +249,9 @@ export class Viewer {
     this.#cap = { level: manifest.cap.level, reason: manifest.cap.reason, retryAfterS: manifest.cap.retry_after_s };
     const target = this.#target(manifest.cap.level);
     this.#set({ status: 'refining', lastLevel: manifest.last_level, targetLevel: target });
-    const mode = manifest.colour?.mode ?? (manifest.has_colour ? 'vertex' : 'none');
-    if (mode !== 'ccc') {
-      this.#colourSource = null;
-      this.renderer?.setColourMapping(null);
-      this.#set({ colour: mode, colourError: null });
-    } else if (this.#colourSource !== /** @type {any} */ (manifest.colour).cell_texture.url) {
-      this.#set({ colour: 'loading', colourError: null });
-    }
+    this.#colour.begin(manifest);
     // A drawn frame may already be on screen (a retry): then load now.
-    if (this.state.firstFrameMs !== null) this.#loadColour();
+    if (this.state.firstFrameMs !== null) void this.#colour.load();
     const url = (/** @type {string} */ path) => this.#apiUrl(path);
     /** @type {import('./reconstruction.js').LoadRequest} */
     const request = {
@@ -371,87 +364,10 @@ export class Viewer {
     const first = this.state.firstFrameMs === null;
     this.state.firstFrameMs ??= now;
     // The colour textures wait for the first frame of the base mesh.
-    if (first) this.#loadColour();
+    if (first) void this.#colour.load();
     // The page's listeners run in a task of their own, after this one: the
     // render worker's report stays a small task however much they do.
     setTimeout(() => this.ui.root.dispatchEvent(new CustomEvent('vitrine-level', { detail: { level }, bubbles: true, composed: true })));
-  }
-
-  /**
-   * Progressive colour (thesis §5): the cell texture and the low-resolution
-   * colour texture in parallel, then the full-resolution colour texture,
-   * which replaces the low one when it arrives. Runs after the base mesh's
-   * first frame; a failure leaves the model in per-vertex colour or clay
-   * with a notice, never an error overlay.
-   */
-  async #loadColour() {
-    const colour = this.manifest?.colour;
-    const renderer = this.renderer;
-    if (!colour || colour.mode !== 'ccc' || !renderer) return;
-    if (this.#colourSource === colour.cell_texture.url) return;
-    this.#colourSource = colour.cell_texture.url;
-    const source = this.#colourSource;
-    const current = () => this.#colourSource === source;
-    this.state.colourAtMs = { requested: performance.now() };
-    this.#set({ colour: 'loading', colourError: null });
-    try {
-      const [cells, low] = await Promise.all([
-        this.#fetchBytes(colour.cell_texture.url).then(decodePng),
-        this.#fetchImage(colour.colour_texture_low.url),
-      ]);
-      if (!current()) return;
-      checkParameters(colour.parameters, cells);
-      const max = renderer.maxTextureSize;
-      if (Math.max(cells.width, cells.height, low.width, low.height) > max) {
-        throw new Error(`the colour textures are larger than this GPU's limit (${max} texels)`);
-      }
-      renderer.setColourMapping({ parameters: colour.parameters, cells });
-      renderer.setColourAtlas(low, 'low');
-      this.#set({ colour: 'low' });
-    } catch (error) {
-      if (!current()) return;
-      this.#colourSource = null;
-      const mode = this.manifest?.has_colour ? 'vertex' : 'none';
-      this.#set({ colour: mode, colourError: `the colour texture could not be loaded: ${describe(error)}` });
-      return;
-    }
-    try {
-      const full = await this.#fetchImage(colour.colour_texture.url);
-      if (!current()) return;
-      if (Math.max(full.width, full.height) > renderer.maxTextureSize) {
-        throw new Error(`the full-resolution colour texture is larger than this GPU's limit (${renderer.maxTextureSize} texels)`);
-      }
-      renderer.setColourAtlas(full, 'full');
-      this.#set({ colour: 'full' });
-    } catch (error) {
-      if (current()) this.#set({ colourError: `showing low-resolution colour: ${describe(error)}` });
-    }
-  }
-
-  /** @param {string} path */
-  async #fetchBytes(path) {
-    let response;
-    try {
-      response = await fetch(this.#apiUrl(path));
-    } catch (error) {
-      throw new Error(`could not reach the server (${describe(error)})`);
-    }
-    if (!response.ok) throw new Error(`the server answered ${response.status}`);
-    return new Uint8Array(await response.arrayBuffer());
-  }
-
-  /**
-   * A colour texture decoded off the main thread, bytes as stored (no
-   * colour-space conversion).
-   * @param {string} path
-   */
-  async #fetchImage(path) {
-    const bytes = await this.#fetchBytes(path);
-    return createImageBitmap(new Blob([bytes], { type: 'image/jpeg' }), {
-      colorSpaceConversion: 'none',
-      premultiplyAlpha: 'none',
-      imageOrientation: 'from-image',
-    });
   }
 
   /**
