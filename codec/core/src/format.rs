@@ -217,6 +217,38 @@ impl ChunkHeader {
     }
 }
 
+/// One refinement batch's chunk (FORMAT.md, "Chunks"), split into its
+/// header and payload: for tools that build batches piece by piece, such as
+/// the fuzz target that wraps fuzzed payloads in a real batch's header.
+#[derive(Clone, Copy, Debug)]
+pub struct BatchChunk<'a> {
+    header: ChunkHeader,
+    pub payload: &'a [u8],
+}
+
+impl<'a> BatchChunk<'a> {
+    /// Parses a batch chunk, as [`StreamIndex::batches`] delimits one.
+    pub fn parse(chunk: &'a [u8]) -> Result<Self> {
+        let (header, payload) = ChunkHeader::parse(chunk, BATCH_TAG)?;
+        Ok(BatchChunk { header, payload })
+    }
+
+    /// The same chunk (level and counts) around another payload, written by
+    /// the encoder's own chunk writer.
+    pub fn with_payload(&self, payload: &[u8]) -> Result<Vec<u8>> {
+        let payload_len = u32::try_from(payload.len())
+            .map_err(|_| Error::Limit("a payload over 4 GiB".into()))?;
+        let mut out = Vec::with_capacity(payload.len() + 24);
+        ChunkHeader {
+            payload_len,
+            ..self.header
+        }
+        .write(&mut out);
+        out.extend_from_slice(payload);
+        Ok(out)
+    }
+}
+
 /// A bounds-checked little-endian cursor: every read past the end is an error.
 pub(crate) struct Reader<'a> {
     bytes: &'a [u8],

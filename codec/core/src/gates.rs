@@ -23,7 +23,11 @@ use std::collections::VecDeque;
 use crate::entropy::{BitModel, FrequencyModel};
 use crate::halfedge::{face, next, prev, Connectivity, NONE};
 use crate::patch::{growth, pattern, Pattern, Tag, MAX_VALENCE, MIN_VALENCE};
-use crate::predict::{gate_context, GATE_CONTEXTS};
+use crate::contexts::{
+    CLEANING_CONTEXTS, DECIMATION_CONTEXTS, DECIMATION_SYMBOLS, FIT_CLASSES, FRONT_VALENCES,
+    VALENCE_CLASSES,
+};
+use crate::predict::gate_context;
 use crate::priors;
 use crate::{Error, Result};
 
@@ -35,14 +39,6 @@ pub(crate) enum PassKind {
     Cleaning,
 }
 
-/// Decimation symbols: 0 = null patch, `valence − 2` otherwise (1..=4).
-pub(crate) const DECIMATION_SYMBOLS: usize = MAX_VALENCE - 1;
-/// Coarse valence classes by faces around a vertex: ≤ 4, 5–6, ≥ 7.
-const VALENCE_CLASSES: usize = 3;
-/// The front vertex's coarse valence itself, ≤ 2 … ≥ 9.
-const FRONT_VALENCES: usize = 8;
-/// How many patch valences fit around a gate: 1 (only 3) ..= 4 (3 to 6).
-const FIT_CLASSES: usize = MAX_VALENCE - MIN_VALENCE + 1;
 
 /// Where a gate's code comes from: the stream (decoder) or the encoder's
 /// recorded decisions, coded as they are replayed.
@@ -101,12 +97,6 @@ pub(crate) struct Border {
     pub polygon: [u32; MAX_VALENCE],
 }
 
-/// Decimating contexts: gate tags × front valence × valence classes of the
-/// gate's origin and target × widest fit.
-pub(crate) const DECIMATION_CONTEXTS: usize =
-    GATE_CONTEXTS * FRONT_VALENCES * VALENCE_CLASSES * VALENCE_CLASSES * FIT_CLASSES;
-/// Cleaning contexts: gate tags × valence classes of front, origin, target.
-pub(crate) const CLEANING_CONTEXTS: usize = GATE_CONTEXTS * VALENCE_CLASSES.pow(3);
 
 /// Adaptive models of the connectivity codes of one pass, each starting
 /// from its trained prior ([`crate::priors`]).

@@ -15,6 +15,7 @@
 #![forbid(unsafe_code)]
 
 mod base_mesh;
+mod contexts;
 mod decoder;
 pub mod edges;
 mod encoder;
@@ -30,13 +31,14 @@ mod patch;
 mod predict;
 mod priors;
 mod quantize;
+mod training;
 
 pub use decoder::{decode, Decoder, Limits};
 pub use encoder::{
     encode, BaseTarget, CandidatePatch, EncodeOptions, EncodeProgress, Encoded, Encoder, PatchGuard,
 };
 pub use error::{Error, Result};
-pub use format::{Header, LevelInfo, StreamIndex, MAGIC, VERSION};
+pub use format::{BatchChunk, Header, LevelInfo, StreamIndex, MAGIC, VERSION};
 pub use gates::GateStatistics;
 pub use inspect::{breakdown, LevelBreakdown};
 pub use mesh::IndexedMesh;

@@ -165,3 +165,27 @@ fn shared_meshes_round_trip() {
     }
     assert!(tested >= 10, "expected the shared meshes, found {tested}");
 }
+
+/// A batch's payload re-wrapped by the public chunk writer is the same chunk,
+/// byte for byte, and decodes (the batch fuzz target relies on it); a
+/// different payload length is written into the header.
+#[test]
+fn batch_chunks_rewrap_to_the_same_bytes() {
+    let mesh = torus(40, 16, 1.0, 0.3);
+    let stream = encode(&mesh, &EncodeOptions::default()).unwrap().bytes;
+    let index = StreamIndex::parse(&stream).unwrap();
+    let mut d = vitrine_codec::Decoder::new(&stream[index.base.clone()], Limits::default()).unwrap();
+    for range in &index.batches {
+        let real = &stream[range.clone()];
+        let chunk = vitrine_codec::BatchChunk::parse(real).unwrap();
+        let wrapped = chunk.with_payload(chunk.payload).unwrap();
+        assert_eq!(wrapped, real);
+        d.apply_batch(&wrapped).unwrap();
+    }
+    assert_eq!(d.vertex_count(), mesh.positions.len());
+    let first = vitrine_codec::BatchChunk::parse(&stream[index.batches[0].clone()]).unwrap();
+    let longer = first.with_payload(&[0; 300]).unwrap();
+    let parsed = vitrine_codec::BatchChunk::parse(&longer).unwrap();
+    assert_eq!(parsed.payload, &[0; 300][..]);
+    assert!(vitrine_codec::BatchChunk::parse(&longer[..longer.len() - 1]).is_err());
+}

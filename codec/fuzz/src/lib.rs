@@ -5,7 +5,7 @@ use std::sync::OnceLock;
 
 use vitrine_mesh::import::ImportOptions;
 use vitrine_samples::{icosphere, paint, torus};
-use vitrine_codec::{encode, Decoder, EncodeOptions, IndexedMesh, Limits};
+use vitrine_codec::{encode, BatchChunk, Decoder, EncodeOptions, IndexedMesh, Limits, StreamIndex};
 
 /// Small budgets, so that a hostile input that is merely big is refused
 /// quickly and the fuzzer spends its time on malformed ones.
@@ -44,6 +44,25 @@ pub fn sample_streams() -> &'static [Vec<u8>] {
             })
             .collect()
     })
+}
+
+/// Panics unless batch 1 of every sample stream, its payload re-wrapped by
+/// [`BatchChunk::with_payload`], is the same chunk and decodes: the
+/// structured batch target would otherwise fuzz only the header parser.
+/// Checked once per process.
+pub fn wrapped_batches_decode() {
+    static CHECKED: OnceLock<()> = OnceLock::new();
+    CHECKED.get_or_init(|| {
+        for stream in sample_streams() {
+            let index = StreamIndex::parse(stream).expect("sample stream");
+            let real = &stream[index.batches[0].clone()];
+            let chunk = BatchChunk::parse(real).expect("sample batch");
+            let wrapped = chunk.with_payload(chunk.payload).expect("small payload");
+            assert_eq!(wrapped, real, "the chunk writer rebuilds the real chunk");
+            let mut d = Decoder::new(&stream[index.base.clone()], LIMITS).expect("sample base");
+            d.apply_batch(&wrapped).expect("an unmodified wrapped payload decodes");
+        }
+    });
 }
 
 /// What holds for any decoder that returned `Ok`, whatever its input.

@@ -4,7 +4,8 @@
 
 use super::Level;
 use crate::entropy::{BitModel, FrequencyModel, RangeDecoder};
-use crate::gates::{Border, GateCodes, PassKind, PatchSink, Region, Traversal, DECIMATION_SYMBOLS};
+use crate::contexts::DECIMATION_SYMBOLS;
+use crate::gates::{Border, GateCodes, PassKind, PatchSink, Region, Traversal};
 use crate::halfedge::{face, Connectivity, NONE};
 use crate::patch::MAX_VALENCE;
 use crate::predict::{
