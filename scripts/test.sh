@@ -7,6 +7,7 @@ cd "$(dirname "$0")/.."
 bash scripts/setup.sh
 cargo fmt --all -- --check
 cargo clippy --workspace --all-targets -- -D warnings
+bash scripts/check-layout.sh # wasm32 core, crate and module DAGs, priors
 bash scripts/build.sh
 cargo test --workspace
 (cd web && npm run --silent typecheck && npm test && npm run test:e2e)

@@ -1,0 +1,17 @@
+#!/usr/bin/env bash
+# The workspace's shape (README, "Layout"): the codec core builds for
+# wasm32-unknown-unknown with its default features and pulls in none of the
+# crates that belong around it; no crate's modules import in a cycle; the
+# trained priors are what training on the pinned scan gives.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+cargo build -q -p vitrine-codec --target wasm32-unknown-unknown
+forbidden=$(cargo tree -q -p vitrine-codec --target wasm32-unknown-unknown -e normal --prefix none |
+    awk '{print $1}' | sort -u | grep -xE 'image|gltf|rayon|serde|serde_json|tokio|sqlx|vitrine-mesh|vitrine-samples' || true)
+if [ -n "$forbidden" ]; then
+    echo "vitrine-codec's wasm32 build depends on: $forbidden" >&2
+    exit 1
+fi
+echo "vitrine-codec builds for wasm32 with: $(cargo tree -q -p vitrine-codec --target wasm32-unknown-unknown -e normal --depth 1 --prefix none | tail -n +2 | awk '{print $1}' | sort -u | tr '\n' ' ')"
+python3 scripts/module-cycles.py
+bash scripts/train-priors.sh --check
