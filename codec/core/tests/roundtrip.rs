@@ -174,7 +174,8 @@ fn batch_chunks_rewrap_to_the_same_bytes() {
     let mesh = torus(40, 16, 1.0, 0.3);
     let stream = encode(&mesh, &EncodeOptions::default()).unwrap().bytes;
     let index = StreamIndex::parse(&stream).unwrap();
-    let mut d = vitrine_codec::Decoder::new(&stream[index.base.clone()], Limits::default()).unwrap();
+    let mut d =
+        vitrine_codec::Decoder::new(&stream[index.base.clone()], Limits::default()).unwrap();
     for range in &index.batches {
         let real = &stream[range.clone()];
         let chunk = vitrine_codec::BatchChunk::parse(real).unwrap();
@@ -188,4 +189,48 @@ fn batch_chunks_rewrap_to_the_same_bytes() {
     let parsed = vitrine_codec::BatchChunk::parse(&longer).unwrap();
     assert_eq!(parsed.payload, &[0; 300][..]);
     assert!(vitrine_codec::BatchChunk::parse(&longer[..longer.len() - 1]).is_err());
+}
+
+/// Guards compose: a patch is decimated only when every guard allows it, so
+/// two guards give the bytes one guard testing both would give, and a guard
+/// that allows everything changes nothing.
+#[test]
+fn guards_compose_as_a_conjunction() {
+    use vitrine_codec::{CandidatePatch, Encoder, PatchGuard};
+    /// Refuses the patches centred in one slab of x (quantized, 0–4095).
+    struct Slab(i32, i32);
+    impl PatchGuard for Slab {
+        fn allows(&self, p: &CandidatePatch<'_>) -> bool {
+            !(self.0..self.1).contains(&p.centre[0])
+        }
+    }
+    struct Both;
+    impl PatchGuard for Both {
+        fn allows(&self, p: &CandidatePatch<'_>) -> bool {
+            Slab(0, 1000).allows(p) && Slab(3000, 4096).allows(p)
+        }
+    }
+    struct Anything;
+    impl PatchGuard for Anything {
+        fn allows(&self, _: &CandidatePatch<'_>) -> bool {
+            true
+        }
+    }
+    let mut mesh = torus(48, 16, 1.0, 0.3);
+    add_noise(&mut mesh, 0.003, 5);
+    let options = EncodeOptions::default();
+    let bytes = |guards: &[&dyn PatchGuard]| {
+        let mut encoder = Encoder::new(options.clone());
+        for g in guards {
+            encoder = encoder.guard(*g);
+        }
+        encoder.encode(&mesh).unwrap().bytes
+    };
+    let composed = bytes(&[&Slab(0, 1000), &Slab(3000, 4096)]);
+    assert_eq!(composed, bytes(&[&Both]));
+    assert_ne!(composed, bytes(&[&Slab(0, 1000)]), "the second guard refuses patches");
+    assert_ne!(composed, bytes(&[&Slab(3000, 4096)]), "the first guard refuses patches");
+    assert_eq!(bytes(&[&Anything, &Anything]), encode(&mesh, &options).unwrap().bytes);
+    let d = decode(&composed, None, Limits::default()).unwrap();
+    assert_eq!(d.vertex_count(), mesh.positions.len());
 }
