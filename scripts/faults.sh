@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Fault injection against the release `vitrine` binary (issue #6): each case
+# Fault injection against the release `vitrine` binary: each case
 # prints PASS/FAIL/SKIP and a detail line; the script exits non-zero if any
 # case FAILs. Results also land in $WORK/faults.md (RELIABILITY.md quotes them).
 #

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Crowd load test (issue #6): simulated viewer visitors against the release
+# Crowd load test: simulated viewer visitors against the release
 # `vitrine serve`, load caps off and on. See tests/README.md.
 #
 #   scripts/load.sh            the full run for BENCHMARKS.md: the 2.15 M-vertex

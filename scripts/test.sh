@@ -11,7 +11,7 @@ bash scripts/check-layout.sh # wasm32 core, crate and module DAGs, priors
 bash scripts/build.sh
 cargo test --workspace
 (cd web && npm run --silent typecheck && npm test && npm run test:e2e)
-bash scripts/load.sh --short && bash scripts/faults.sh --short # crowd, faults, hostile HTTP (issue #6, ~3 min)
+bash scripts/load.sh --short && bash scripts/faults.sh --short # crowd, faults, hostile HTTP (~3 min)
 if [ -x scripts/fuzz.sh ] || [ -f scripts/fuzz.sh ]; then
     bash scripts/fuzz.sh "${FUZZ_SECONDS:-20}"
 fi

@@ -16,17 +16,17 @@
 //! Every pass's models start from priors trained on a scan
 //! ([`crate::priors`]), which is what makes this many contexts pay. On the
 //! shared scans this takes connectivity from 4.5 (AD01's tags alone) to
-//! 3.7 bits/vertex at no cost in geometry (BENCHMARKS.md).
+//! 3.7 bits/vertex at no cost in geometry (docs/bench-log/).
 
 use std::collections::VecDeque;
 
-use crate::entropy::{BitModel, FrequencyModel};
-use crate::halfedge::{face, next, prev, Connectivity, NONE};
-use crate::patch::{growth, pattern, Pattern, Tag, MAX_VALENCE, MIN_VALENCE};
 use crate::contexts::{
     CLEANING_CONTEXTS, DECIMATION_CONTEXTS, DECIMATION_SYMBOLS, FIT_CLASSES, FRONT_VALENCES,
     VALENCE_CLASSES,
 };
+use crate::entropy::{BitModel, FrequencyModel};
+use crate::halfedge::{face, next, prev, Connectivity, NONE};
+use crate::patch::{growth, pattern, Pattern, Tag, MAX_VALENCE, MIN_VALENCE};
 use crate::predict::gate_context;
 use crate::priors;
 use crate::{Error, Result};
@@ -38,7 +38,6 @@ pub(crate) enum PassKind {
     /// Removes the valence-3 vertices decimation leaves behind.
     Cleaning,
 }
-
 
 /// Where a gate's code comes from: the stream (decoder) or the encoder's
 /// recorded decisions, coded as they are replayed.
@@ -96,7 +95,6 @@ pub(crate) struct Border {
     pub valence: usize,
     pub polygon: [u32; MAX_VALENCE],
 }
-
 
 /// Adaptive models of the connectivity codes of one pass, each starting
 /// from its trained prior ([`crate::priors`]).

@@ -1,4 +1,4 @@
-//! Quality metrics (issue #5): Hausdorff, Roy colour RMSE, the CPU rasterizer
+//! Quality metrics: Hausdorff, Roy colour RMSE, the CPU rasterizer
 //! and the Lindstrom–Turk image RMSE.
 
 use glam::Vec3;

@@ -84,7 +84,7 @@ impl ColourSurface<'_> {
 fn default_cell_size(extent: DVec3, vertices: usize) -> f64 {
     let longest = extent.max_element().max(f64::MIN_POSITIVE);
     // A few base-mesh edges (1 % of the vertices) per cube: the guard then
-    // rarely fires, and tiles stay large next to their gutters (BENCHMARKS.md).
+    // rarely fires, and tiles stay large next to their gutters (docs/bench-log/).
     let cubes = (0.08 * (vertices as f64).sqrt()).clamp(12.0, 200.0);
     longest / cubes
 }

@@ -3,8 +3,8 @@
 //! removed vertices' positions and colours, then their re-insertion.
 
 use super::Level;
-use crate::entropy::{BitModel, FrequencyModel, RangeDecoder};
 use crate::contexts::DECIMATION_SYMBOLS;
+use crate::entropy::{BitModel, FrequencyModel, RangeDecoder};
 use crate::gates::{Border, GateCodes, PassKind, PatchSink, Region, Traversal};
 use crate::halfedge::{face, Connectivity, NONE};
 use crate::patch::MAX_VALENCE;

@@ -7,8 +7,8 @@
 use std::sync::mpsc::{sync_channel, SyncSender};
 use std::thread::{Scope, ScopedJoinHandle};
 
-use crate::entropy::{BitModel, FrequencyModel, RangeEncoder};
 use crate::contexts::DECIMATION_SYMBOLS;
+use crate::entropy::{BitModel, FrequencyModel, RangeEncoder};
 use crate::gates::{GateCodes, PassKind, Traversal, Walked};
 use crate::halfedge::Connectivity;
 use crate::patch::MAX_VALENCE;

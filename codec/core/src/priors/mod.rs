@@ -6,7 +6,7 @@
 //! bits learning. Starting from code statistics of a real scan instead of
 //! flat models saves 0.12 bit/vertex with version 2's 324 decimating
 //! contexts, and lets the richer contexts save 0.08 more, on the shared
-//! scans, none of which was trained on (BENCHMARKS.md).
+//! scans, none of which was trained on (docs/bench-log/, session 4).
 //!
 //! The tables in `table.rs` are part of the stream format (since version 3).
 //! They were trained on the Stanford dragon, 100 k-vertex VRIP

@@ -1,4 +1,4 @@
-//! Quality metrics for a level against the original (issue #5; REFERENCE.md §6).
+//! Quality metrics for a level against the original.
 //!
 //! - [`hausdorff`]: the symmetric Hausdorff distance between two surfaces,
 //!   estimated Metro-style by dense area-uniform surface sampling (Cignoni,
