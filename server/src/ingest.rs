@@ -4,6 +4,7 @@
 //! [`IngestOptions::quality`], every level is measured against the original
 //! first (outside the transaction) and the curve is stored in the level rows.
 
+use crate::source::{default_colour_mode, read_back, QualityReference};
 use crate::storage::{
     valid_slug, LevelMetrics, NewCompression, NewLevel, NewModel, NewTexture, NewTextureMapping,
     OnExisting, Storage, StoredModel,
@@ -12,10 +13,10 @@ use anyhow::{bail, Context};
 use serde_json::json;
 use std::time::{Duration, Instant};
 use vitrine_codec::{BaseTarget, EncodeOptions, Encoded, IndexedMesh, StreamIndex};
-use vitrine_colour::ccc::{CccOptions, CccParameters, CccReport, CellComplex, TextureMapping};
-use vitrine_colour::{encode_coloured, vertex_colours_from_texture, ColourMode};
+use vitrine_colour::ccc::{CccOptions, CccParameters, CccReport, TextureMapping};
+use vitrine_colour::{encode_coloured, ColourMode};
 use vitrine_mesh::import::TexturedSurface;
-use vitrine_quality::{stream_quality, LevelQuality, Original, QualityOptions};
+use vitrine_quality::{LevelQuality, QualityOptions};
 
 /// What a model is called and who may see it.
 #[derive(Clone, Debug)]
@@ -126,11 +127,7 @@ pub async fn ingest_coloured(
     let source = source_info(&meta, &mesh);
     let mode = options
         .colour
-        .unwrap_or(if mesh.colors.is_some() || texture.is_some() {
-            ColourMode::Vertex
-        } else {
-            ColourMode::None
-        });
+        .unwrap_or_else(|| default_colour_mode(&mesh, texture.as_ref()));
     let (encode_options, ccc) = (options.encode.clone(), options.ccc.clone());
     let quality_options = options.quality;
     let (encoded, mapping, encode_time, quality) =
@@ -178,23 +175,17 @@ pub async fn ingest_coloured(
 fn measure_quality(
     stream: &[u8],
     mapping: Option<&TextureMapping>,
-    mut mesh: IndexedMesh,
+    mesh: IndexedMesh,
     texture: Option<TexturedSurface>,
     options: &QualityOptions,
 ) -> anyhow::Result<MeasuredQuality> {
     let started = Instant::now();
     let complex = mapping
-        .map(|m| CellComplex::from_images(&m.parameters, &m.cell_png, &m.colour_jpeg))
+        .map(read_back)
         .transpose()
         .context("reading back the cell complex")?;
-    if let Some(t) = &texture {
-        mesh.colors = Some(vertex_colours_from_texture(&mesh, t));
-    }
-    let original = Original {
-        mesh: &mesh,
-        texture: texture.as_ref(),
-    };
-    let levels = stream_quality(stream, complex.as_ref(), &original, options)?;
+    let reference = QualityReference::new(mesh, texture);
+    let levels = reference.measure(stream, complex.as_ref(), options)?;
     Ok(MeasuredQuality {
         levels,
         options: *options,

@@ -1,8 +1,12 @@
-//! Vitrine's storage and HTTP service.
+//! Vitrine's storage, HTTP service and command line.
 //!
 //! Models are ingested into a database ([`storage`]: SQLite or PostgreSQL,
 //! one trait) as a base mesh plus one refinement batch per level, and served
 //! by an axum [`app`] that caps how many levels each visitor may fetch.
+//! The command line lives here too ([`commands`], one module per
+//! subcommand): the `vitrine` binary and, with the `dev-tools` feature,
+//! `vitrine-dev` only parse their arguments and run a [`Command`] or a
+//! `DevCommand`.
 //!
 //! ```no_run
 //! # async fn demo() -> anyhow::Result<()> {
@@ -17,14 +21,21 @@
 //! ```
 #![forbid(unsafe_code)]
 
-mod commands;
+mod ccc_files;
+pub mod commands;
+mod connections;
+mod database;
 pub mod ingest;
-mod serve;
 pub mod service;
+mod source;
 pub mod storage;
 
-pub use commands::{init_tracing, new_token, open_storage, run_ingest, run_serve, run_token};
-pub use commands::{models_table, run_models, ModelsArgs};
-pub use commands::{CccArgs, IngestArgs, ServeArgs, TokenArgs};
-pub use serve::{serve, shutdown_signal, ServeLimits};
+pub use commands::ingest::{run as run_ingest, IngestArgs};
+pub use commands::models::models_table;
+pub use commands::token::new_token;
+pub use commands::Command;
+#[cfg(feature = "dev-tools")]
+pub use commands::DevCommand;
+pub use connections::{serve, shutdown_signal, ServeLimits};
+pub use database::open_storage;
 pub use service::{app, ops_app, AppState, ServiceConfig};

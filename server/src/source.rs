@@ -1,63 +1,71 @@
-//! The codec commands: encode, decode, inspect, bench.
-
-pub mod bench;
-pub mod colour_bench;
-pub mod decode;
-pub mod dump;
-pub mod encode;
-pub mod inspect;
-pub mod sample;
+//! The mesh a command starts from: a file read with its colour texture and
+//! repaired into an encodable manifold ([`load_coloured_mesh`]), and the
+//! original that a stream's levels are measured against
+//! ([`QualityReference`]).
 
 use anyhow::Context;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use vitrine_codec::IndexedMesh;
-use vitrine_mesh::import::{import_path, import_path_textured, ImportOptions, TexturedSurface};
+use vitrine_colour::ccc::{CellComplex, TextureMapping};
+use vitrine_colour::{vertex_colours_from_texture, ColourMode};
+use vitrine_mesh::import::{import_path_textured, ImportOptions, TexturedSurface};
 use vitrine_mesh::repair::{prepare, RepairOptions, RepairReport};
+use vitrine_quality::{stream_quality, LevelQuality, Original, QualityOptions};
 
-/// Reads any supported mesh file and repairs it into an encodable manifold.
-pub fn load_mesh(path: &Path) -> anyhow::Result<(IndexedMesh, RepairReport)> {
-    let mesh = import_path(path, &ImportOptions::default())
-        .with_context(|| format!("reading {}", path.display()))?;
-    prepare(mesh, &RepairOptions::default())
-        .with_context(|| format!("repairing {}", path.display()))
+/// A mesh file as read and repaired.
+pub struct SourceMesh {
+    /// Repaired: what the encoder is given.
+    pub mesh: IndexedMesh,
+    /// The file's colour texture (OBJ+MTL, glTF), when it has one.
+    pub texture: Option<TexturedSurface>,
+    pub repair: RepairReport,
+    /// Vertices and faces as imported, before repair.
+    pub imported_vertices: usize,
+    pub imported_faces: usize,
 }
 
-/// Reads a mesh file with its colour texture when it has one (OBJ+MTL,
-/// glTF), repaired; texture problems are warnings, not errors.
-pub fn load_coloured_mesh(
-    path: &Path,
-) -> anyhow::Result<(IndexedMesh, Option<TexturedSurface>, RepairReport)> {
+/// Reads a mesh file (PLY, OBJ, OFF, glTF, GLB) with its colour texture when
+/// it has one, and repairs it. Texture problems are warnings on stderr, not
+/// errors: the mesh is still encodable without its texture.
+pub fn load_coloured_mesh(path: &Path) -> anyhow::Result<SourceMesh> {
     let imported = import_path_textured(path, &ImportOptions::default())
         .with_context(|| format!("reading {}", path.display()))?;
     for w in &imported.warnings {
         eprintln!("warning: {}: {w}", path.display());
     }
-    let (mesh, report) = prepare(imported.mesh, &RepairOptions::default())
-        .with_context(|| format!("repairing {}", path.display()))?;
-    Ok((mesh, imported.texture, report))
+    let imported_vertices = imported.mesh.vertex_count();
+    let imported_faces = imported.mesh.face_count();
+    let (mesh, repair) = repaired(imported.mesh, path)?;
+    Ok(SourceMesh {
+        mesh,
+        texture: imported.texture,
+        repair,
+        imported_vertices,
+        imported_faces,
+    })
 }
 
-/// Where `vitrine encode --colour ccc` puts the complex beside a stream.
-pub struct CccFiles {
-    pub parameters: PathBuf,
-    pub cell: PathBuf,
-    pub colour: PathBuf,
-    pub colour_low: PathBuf,
+/// Reads a mesh file's geometry and per-vertex colour only, never its
+/// texture (which `bench` would count in the peak memory), and repairs it.
+#[cfg(feature = "dev-tools")]
+pub fn load_mesh(path: &Path) -> anyhow::Result<(IndexedMesh, RepairReport)> {
+    let mesh = vitrine_mesh::import::import_path(path, &ImportOptions::default())
+        .with_context(|| format!("reading {}", path.display()))?;
+    repaired(mesh, path)
 }
 
-impl CccFiles {
-    pub fn beside(stream: &Path) -> CccFiles {
-        let with = |suffix: &str| {
-            let mut name = stream.as_os_str().to_owned();
-            name.push(suffix);
-            PathBuf::from(name)
-        };
-        CccFiles {
-            parameters: with(".ccc.json"),
-            cell: with(".cell.png"),
-            colour: with(".colour.jpg"),
-            colour_low: with(".colour-low.jpg"),
-        }
+fn repaired(mesh: IndexedMesh, path: &Path) -> anyhow::Result<(IndexedMesh, RepairReport)> {
+    prepare(mesh, &RepairOptions::default())
+        .with_context(|| format!("repairing {}", path.display()))
+}
+
+/// How colour travels when not asked: per vertex when the mesh has colour
+/// or a texture, else not at all.
+pub fn default_colour_mode(mesh: &IndexedMesh, texture: Option<&TexturedSurface>) -> ColourMode {
+    if mesh.colors.is_some() || texture.is_some() {
+        ColourMode::Vertex
+    } else {
+        ColourMode::None
     }
 }
 
@@ -77,4 +85,49 @@ pub fn describe_repair(r: &RepairReport) -> Option<String> {
     .map(|(n, what)| format!("{n} {what}"))
     .collect();
     (!parts.is_empty()).then(|| parts.join(", "))
+}
+
+/// The original a stream's levels are measured against: the repaired mesh
+/// with per-vertex colour, sampled from the texture for a textured scan, and
+/// the texture itself for the image metric.
+pub struct QualityReference {
+    pub mesh: IndexedMesh,
+    pub texture: Option<TexturedSurface>,
+}
+
+impl QualityReference {
+    pub fn new(mut mesh: IndexedMesh, texture: Option<TexturedSurface>) -> QualityReference {
+        if let Some(t) = &texture {
+            mesh.colors = Some(vertex_colours_from_texture(&mesh, t));
+        }
+        QualityReference { mesh, texture }
+    }
+
+    pub fn original(&self) -> Original<'_> {
+        Original {
+            mesh: &self.mesh,
+            texture: self.texture.as_ref(),
+        }
+    }
+
+    /// Every level of `stream` against the original; colour at a level is
+    /// the complex's lookup when there is one, else the stream's own.
+    pub fn measure(
+        &self,
+        stream: &[u8],
+        complex: Option<&CellComplex>,
+        options: &QualityOptions,
+    ) -> anyhow::Result<Vec<LevelQuality>> {
+        Ok(stream_quality(stream, complex, &self.original(), options)?)
+    }
+}
+
+/// The complex a mapping describes, read back from its images as the viewer
+/// reads them (the full-resolution atlas).
+pub fn read_back(mapping: &TextureMapping) -> anyhow::Result<CellComplex> {
+    Ok(CellComplex::from_images(
+        &mapping.parameters,
+        &mapping.cell_png,
+        &mapping.colour_jpeg,
+    )?)
 }

@@ -1,7 +1,7 @@
-//! `vitrine bench`: bits per vertex, speed and peak memory on a set of meshes,
+//! `vitrine-dev bench`: bits per vertex, speed and peak memory on a set of meshes,
 //! optionally beside Google Draco, as a markdown table for BENCHMARKS.md.
 //!
-//! Each mesh runs in a child process (`vitrine bench-one`) so its peak
+//! Each mesh runs in a child process (`vitrine-dev bench-one`) so its peak
 //! resident memory is its own.
 
 use anyhow::{bail, Context};
@@ -65,6 +65,32 @@ pub struct BenchResult {
     pub peak_rss_mib: f64,
 }
 
+/// Runs `f` `runs` times (at least once): the median time in milliseconds,
+/// and the last result (dropped outside the timing).
+fn timed<T>(runs: usize, mut f: impl FnMut() -> anyhow::Result<T>) -> anyhow::Result<(f64, T)> {
+    let mut ms = Vec::new();
+    let mut last = None;
+    for _ in 0..runs.max(1) {
+        let t = Instant::now();
+        let value = f()?;
+        ms.push(t.elapsed().as_secs_f64() * 1e3);
+        last = Some(value);
+    }
+    Ok((median(ms), last.expect("at least one run")))
+}
+
+/// The mesh as encoded, without its colour, as a binary PLY for the peer coder.
+fn write_geometry(mesh: &IndexedMesh, path: &Path) -> anyhow::Result<()> {
+    let geometry = IndexedMesh {
+        colors: None,
+        ..mesh.clone()
+    };
+    let mut file = std::io::BufWriter::new(std::fs::File::create(path)?);
+    write_ply(&geometry, &mut file)?;
+    file.flush()?;
+    Ok(())
+}
+
 fn median(mut v: Vec<f64>) -> f64 {
     v.sort_by(f64::total_cmp);
     v[v.len() / 2]
@@ -90,15 +116,9 @@ pub fn run_one(args: BenchOneArgs) -> anyhow::Result<()> {
 /// Encodes and decodes one mesh `args.runs` times; sizes, median speeds and
 /// this process's peak memory.
 fn measure(args: &BenchOneArgs) -> anyhow::Result<BenchResult> {
-    let (mesh, _) = super::load_mesh(&args.input)?;
+    let (mesh, _) = crate::source::load_mesh(&args.input)?;
     if let Some(path) = &args.write_mesh {
-        let geometry = IndexedMesh {
-            colors: None,
-            ..mesh.clone()
-        };
-        let mut file = std::io::BufWriter::new(std::fs::File::create(path)?);
-        write_ply(&geometry, &mut file)?;
-        file.flush()?;
+        write_geometry(&mesh, path)?;
     }
     let options = EncodeOptions {
         quantization_bits: args.bits,
@@ -106,21 +126,12 @@ fn measure(args: &BenchOneArgs) -> anyhow::Result<BenchResult> {
         pipelined: false,
         ..EncodeOptions::default()
     };
-    let mut encode_ms = Vec::new();
-    let mut encoded = None;
-    for _ in 0..args.runs.max(1) {
-        let t = Instant::now();
-        encoded = Some(encode(&mesh, &options)?);
-        encode_ms.push(t.elapsed().as_secs_f64() * 1e3);
-    }
-    let encoded = encoded.expect("at least one run");
-    let mut decode_ms = Vec::new();
-    for _ in 0..args.runs.max(1) {
-        let t = Instant::now();
+    let (encode_ms, encoded) = timed(args.runs, || Ok(encode(&mesh, &options)?))?;
+    let (decode_ms, _) = timed(args.runs, || {
         let d = decode(&encoded.bytes, None, Limits::default())?;
-        decode_ms.push(t.elapsed().as_secs_f64() * 1e3);
         std::hint::black_box(d.indices().len());
-    }
+        Ok(d)
+    })?;
     let levels = breakdown(&encoded.bytes)?;
     let n = mesh.positions.len() as f64;
     let per_vertex = |f: fn(&vitrine_codec::LevelBreakdown) -> u32| {
@@ -143,8 +154,8 @@ fn measure(args: &BenchOneArgs) -> anyhow::Result<BenchResult> {
         colour_bpv: per_vertex(|l| l.colour),
         base_bpv: (levels[0].bytes as usize + encoded.header.byte_len()) as f64 * 8.0 / n,
         total_bpv: encoded.bytes.len() as f64 * 8.0 / n,
-        encode_ms: median(encode_ms),
-        decode_ms: median(decode_ms),
+        encode_ms,
+        decode_ms,
         peak_rss_mib: peak_rss_mib(),
     };
     Ok(result)
@@ -184,11 +195,7 @@ fn mesh_files(inputs: &[PathBuf]) -> anyhow::Result<Vec<PathBuf>> {
 /// Draco's bits per vertex and decode speed per mesh, keyed by the name of
 /// the file `files` holds (each written by `bench-one --write-mesh` as
 /// `<mesh file name>.ply`, so the key is the original name).
-fn run_draco(
-    script: &Path,
-    files: &[PathBuf],
-    bits: u8,
-) -> anyhow::Result<HashMap<String, (f64, f64)>> {
+fn run_draco(script: &Path, files: &[PathBuf], bits: u8) -> anyhow::Result<DracoRows> {
     let out = Command::new("python3")
         .arg(script)
         .arg("--bits")
@@ -206,7 +213,7 @@ fn run_draco(
 }
 
 /// Parses `peer_draco.py`'s tab-separated rows (after its header line).
-fn draco_rows(table: &str) -> HashMap<String, (f64, f64)> {
+fn draco_rows(table: &str) -> DracoRows {
     let mut map = HashMap::new();
     for line in table.lines().skip(1) {
         let cols: Vec<&str> = line.split('\t').collect();
@@ -275,65 +282,17 @@ pub fn run(args: BenchArgs) -> anyhow::Result<()> {
     Ok(())
 }
 
-fn markdown(
-    results: &[BenchResult],
-    draco: Option<&HashMap<String, (f64, f64)>>,
-    bits: u8,
-    runs: usize,
-) -> String {
+/// Draco's bits per vertex and decode speed, by mesh file name.
+type DracoRows = HashMap<String, (f64, f64)>;
+
+fn markdown(results: &[BenchResult], draco: Option<&DracoRows>, bits: u8, runs: usize) -> String {
     let mut s = format!(
         "{bits}-bit quantization; speeds are the median of {runs} runs on one core; bits per vertex (b/v) over the final vertex count.\n\n"
     );
-    s += "| mesh | vertices | levels | base v | conn b/v | geom b/v | colour b/v | base b/v | total b/v |";
-    if draco.is_some() {
-        s += " Draco b/v | ours / Draco (no colour) |";
-    }
-    s += " encode Mv/s | decode Mv/s |";
-    if draco.is_some() {
-        s += " Draco decode Mv/s |";
-    }
-    s += " peak MiB |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|";
-    if draco.is_some() {
-        s += "---:|---:|";
-    }
-    s += "---:|---:|";
-    if draco.is_some() {
-        s += "---:|";
-    }
-    s += "---:|\n";
+    s += &table_header(draco.is_some());
     let mut sums = [0.0; 3];
     for r in results {
-        let mv = |ms: f64| r.vertices as f64 / ms / 1e3;
-        s += &format!(
-            "| {} | {} | {} | {} | {:.2} | {:.2} | {:.2} | {:.2} | {:.2} |",
-            r.name,
-            r.vertices,
-            r.levels,
-            r.base_vertices,
-            r.connectivity_bpv,
-            r.geometry_bpv,
-            r.colour_bpv,
-            r.base_bpv,
-            r.total_bpv
-        );
-        let peer = draco.and_then(|d| d.get(&r.name));
-        if draco.is_some() {
-            match peer {
-                // Draco codes positions only: compare without our colour bits.
-                Some((bpv, _)) => {
-                    s += &format!(" {bpv:.2} | {:.3} |", (r.total_bpv - r.colour_bpv) / bpv)
-                }
-                None => s += " – | – |",
-            }
-        }
-        s += &format!(" {:.2} | {:.2} |", mv(r.encode_ms), mv(r.decode_ms));
-        if draco.is_some() {
-            match peer {
-                Some((_, speed)) => s += &format!(" {speed:.2} |"),
-                None => s += " – |",
-            }
-        }
-        s += &format!(" {:.0} |\n", r.peak_rss_mib);
+        s += &table_row(r, draco);
         sums[0] += r.connectivity_bpv;
         sums[1] += r.total_bpv;
         sums[2] += 1.0;
@@ -346,6 +305,64 @@ fn markdown(
             sums[2]
         );
     }
+    s
+}
+
+fn table_header(with_draco: bool) -> String {
+    let mut s = String::from(
+        "| mesh | vertices | levels | base v | conn b/v | geom b/v | colour b/v | base b/v | total b/v |",
+    );
+    if with_draco {
+        s += " Draco b/v | ours / Draco (no colour) |";
+    }
+    s += " encode Mv/s | decode Mv/s |";
+    if with_draco {
+        s += " Draco decode Mv/s |";
+    }
+    s += " peak MiB |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|";
+    if with_draco {
+        s += "---:|---:|";
+    }
+    s += "---:|---:|";
+    if with_draco {
+        s += "---:|";
+    }
+    s += "---:|\n";
+    s
+}
+
+fn table_row(r: &BenchResult, draco: Option<&DracoRows>) -> String {
+    let mv = |ms: f64| r.vertices as f64 / ms / 1e3;
+    let mut s = format!(
+        "| {} | {} | {} | {} | {:.2} | {:.2} | {:.2} | {:.2} | {:.2} |",
+        r.name,
+        r.vertices,
+        r.levels,
+        r.base_vertices,
+        r.connectivity_bpv,
+        r.geometry_bpv,
+        r.colour_bpv,
+        r.base_bpv,
+        r.total_bpv
+    );
+    let peer = draco.and_then(|d| d.get(&r.name));
+    if draco.is_some() {
+        match peer {
+            // Draco codes positions only: compare without our colour bits.
+            Some((bpv, _)) => {
+                s += &format!(" {bpv:.2} | {:.3} |", (r.total_bpv - r.colour_bpv) / bpv)
+            }
+            None => s += " – | – |",
+        }
+    }
+    s += &format!(" {:.2} | {:.2} |", mv(r.encode_ms), mv(r.decode_ms));
+    if draco.is_some() {
+        match peer {
+            Some((_, speed)) => s += &format!(" {speed:.2} |"),
+            None => s += " – |",
+        }
+    }
+    s += &format!(" {:.0} |\n", r.peak_rss_mib);
     s
 }
 
@@ -388,7 +405,7 @@ mod tests {
         })
         .unwrap();
         let peer = import_path(&written, &ImportOptions::default()).unwrap();
-        let (encoded, _) = super::super::load_mesh(&input).unwrap();
+        let (encoded, _) = crate::source::load_mesh(&input).unwrap();
         assert_eq!(result.vertices, torus.positions.len());
         assert_eq!(peer.positions.len(), result.vertices);
         assert_eq!(peer.triangles.len(), result.faces);

@@ -1,3 +1,5 @@
+//! `vitrine decode`: a stream file, up to a level, as a PLY, OBJ or GLB mesh.
+
 use anyhow::{bail, Context};
 use clap::Args;
 use std::io::BufWriter;

@@ -1,4 +1,4 @@
-//! `vitrine dump-levels`: the native decoder's buffers at every level, as raw
+//! `vitrine-dev dump-levels`: the native decoder's buffers at every level, as raw
 //! little-endian files, so other decoders (WebAssembly) can be compared byte
 //! for byte: `level-K.positions` (f32), `level-K.colours` (u8), `level-K.indices` (u32).
 

@@ -1,9 +1,16 @@
+//! `vitrine encode`: a mesh file into a progressive stream file, with the
+//! cell complex written beside it in `ccc` mode.
+
+use super::ingest::CccArgs;
+use crate::ccc_files::CccFiles;
+use crate::source::{default_colour_mode, describe_repair, load_coloured_mesh, SourceMesh};
 use anyhow::Context;
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
 use std::path::PathBuf;
 use std::time::Instant;
-use vitrine_codec::{BaseTarget, EncodeOptions};
+use vitrine_codec::{BaseTarget, EncodeOptions, Encoded};
+use vitrine_colour::ccc::TextureMapping;
 use vitrine_colour::{encode_coloured, ColourMode};
 
 #[derive(Args, Debug)]
@@ -32,7 +39,7 @@ pub struct EncodeArgs {
     #[arg(long)]
     pub colour: Option<ColourMode>,
     #[command(flatten)]
-    pub ccc: vitrine::CccArgs,
+    pub ccc: CccArgs,
 }
 
 impl EncodeArgs {
@@ -54,19 +61,45 @@ pub fn run(args: EncodeArgs) -> anyhow::Result<()> {
         .output
         .clone()
         .unwrap_or_else(|| args.input.with_extension("vtr"));
-    let (mesh, texture, report) = super::load_coloured_mesh(&args.input)?;
-    let mode = args
-        .colour
-        .unwrap_or(if mesh.colors.is_some() || texture.is_some() {
-            ColourMode::Vertex
-        } else {
-            ColourMode::None
-        });
-    if let Some(text) = super::describe_repair(&report) {
+    let source = load_coloured_mesh(&args.input)?;
+    if let Some(text) = describe_repair(&source.repair) {
         eprintln!("repair: {text}");
     }
-    let n = mesh.positions.len() as u64;
-    let bar = ProgressBar::new(n);
+    let start = Instant::now();
+    let (encoded, mapping) = encode_with_progress(&source, &args)?;
+    let elapsed = start.elapsed();
+    std::fs::write(&output, &encoded.bytes)
+        .with_context(|| format!("writing {}", output.display()))?;
+    if let Some(m) = &mapping {
+        CccFiles::beside(&output).write(m)?;
+        print_complex(m);
+    }
+    let (n, h) = (source.mesh.positions.len(), &encoded.header);
+    eprintln!(
+        "{}: {} vertices, {} faces → {} bytes ({:.2} bits/vertex), {} levels, base {} vertices, {:.2} s",
+        output.display(),
+        n,
+        source.mesh.triangles.len(),
+        encoded.bytes.len(),
+        encoded.bytes.len() as f64 * 8.0 / n as f64,
+        h.batch_count(),
+        h.levels[0].vertices,
+        elapsed.as_secs_f64()
+    );
+    Ok(())
+}
+
+/// Encodes in the colour mode asked for (by default the one the mesh's
+/// colour calls for), with a progress bar of the vertices removed so far.
+fn encode_with_progress(
+    source: &SourceMesh,
+    args: &EncodeArgs,
+) -> anyhow::Result<(Encoded, Option<TextureMapping>)> {
+    let (mesh, texture) = (&source.mesh, source.texture.as_ref());
+    let mode = args
+        .colour
+        .unwrap_or_else(|| default_colour_mode(mesh, texture));
+    let bar = ProgressBar::new(mesh.positions.len() as u64);
     bar.set_style(
         ProgressStyle::with_template(
             "{spinner} layer {msg} [{bar:40}] {pos}/{len} vertices removed",
@@ -74,10 +107,9 @@ pub fn run(args: EncodeArgs) -> anyhow::Result<()> {
         .expect("valid template")
         .progress_chars("=> "),
     );
-    let start = Instant::now();
-    let (encoded, mapping) = encode_coloured(
-        &mesh,
-        texture.as_ref(),
+    let encoded = encode_coloured(
+        mesh,
+        texture,
         mode,
         &args.ccc.options(),
         vitrine_codec::Encoder::new(args.options()).progress(|p| {
@@ -86,44 +118,19 @@ pub fn run(args: EncodeArgs) -> anyhow::Result<()> {
         }),
     )?;
     bar.finish_and_clear();
-    let elapsed = start.elapsed();
-    std::fs::write(&output, &encoded.bytes)
-        .with_context(|| format!("writing {}", output.display()))?;
-    if let Some(m) = &mapping {
-        let files = super::CccFiles::beside(&output);
-        let write = |path: &std::path::Path, bytes: &[u8]| {
-            std::fs::write(path, bytes).with_context(|| format!("writing {}", path.display()))
-        };
-        write(
-            &files.parameters,
-            &serde_json::to_vec_pretty(&m.parameters)?,
-        )?;
-        write(&files.cell, &m.cell_png)?;
-        write(&files.colour, &m.colour_jpeg)?;
-        write(&files.colour_low, &m.colour_low_jpeg)?;
-        let r = &m.report;
-        eprintln!(
-            "cell complex: {} cells, {} tiles of {}², cell texture {} B, colour {} B (low {} B), ambiguous texels {:.2} %",
-            r.cells,
-            r.tiles,
-            m.parameters.tile_size,
-            r.cell_texture_bytes,
-            r.colour_texture_bytes,
-            r.colour_texture_low_bytes,
-            r.ambiguous_texels as f64 * 100.0 / r.covered_texels.max(1) as f64
-        );
-    }
-    let h = &encoded.header;
+    Ok(encoded)
+}
+
+fn print_complex(m: &TextureMapping) {
+    let r = &m.report;
     eprintln!(
-        "{}: {} vertices, {} faces → {} bytes ({:.2} bits/vertex), {} levels, base {} vertices, {:.2} s",
-        output.display(),
-        n,
-        mesh.triangles.len(),
-        encoded.bytes.len(),
-        encoded.bytes.len() as f64 * 8.0 / n as f64,
-        h.batch_count(),
-        h.levels[0].vertices,
-        elapsed.as_secs_f64()
+        "cell complex: {} cells, {} tiles of {}², cell texture {} B, colour {} B (low {} B), ambiguous texels {:.2} %",
+        r.cells,
+        r.tiles,
+        m.parameters.tile_size,
+        r.cell_texture_bytes,
+        r.colour_texture_bytes,
+        r.colour_texture_low_bytes,
+        r.ambiguous_texels as f64 * 100.0 / r.covered_texels.max(1) as f64
     );
-    Ok(())
 }

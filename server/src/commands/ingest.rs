@@ -1,15 +1,16 @@
 //! `vitrine ingest <mesh> --db … --slug … --title …`
 
-use crate::ingest::{ingest_coloured, IngestOptions, ModelMeta, SourceInfo};
+use crate::database::open_storage;
+use crate::ingest::{
+    ingest_coloured, IngestOptions, IngestReport, MeasuredQuality, ModelMeta, SourceInfo,
+};
+use crate::source::load_coloured_mesh;
 use crate::storage::{ConnectOptions, OnExisting};
-use anyhow::Context;
 use std::path::PathBuf;
 use std::time::Duration;
 use vitrine_codec::EncodeOptions;
 use vitrine_colour::ccc::CccOptions;
 use vitrine_colour::ColourMode;
-use vitrine_mesh::import::{import_path_textured, ImportOptions};
-use vitrine_mesh::repair::{prepare, RepairOptions};
 use vitrine_quality::QualityOptions;
 
 #[derive(clap::Args, Clone, Debug)]
@@ -94,65 +95,66 @@ impl CccArgs {
     }
 }
 
-pub async fn run_ingest(args: IngestArgs) -> anyhow::Result<()> {
+pub async fn run(args: IngestArgs) -> anyhow::Result<()> {
     super::init_tracing();
     let path = args.mesh.clone();
-    let (mesh, texture, source) = tokio::task::spawn_blocking(move || -> anyhow::Result<_> {
-        // The colour texture, when the file has one, is the colour source.
-        let imported = import_path_textured(&path, &ImportOptions::default())
-            .with_context(|| format!("reading {}", path.display()))?;
-        for warning in &imported.warnings {
-            eprintln!("vitrine: {}: {warning}", path.display());
-        }
-        let (mesh, texture) = (imported.mesh, imported.texture);
-        let (vertices, faces) = (mesh.vertex_count() as u64, mesh.face_count() as u64);
-        let (mesh, report) =
-            prepare(mesh, &RepairOptions::default()).context("repairing the mesh")?;
-        let name = path
-            .file_name()
-            .map(|n| n.to_string_lossy().into_owned())
-            .unwrap_or_default();
-        Ok((
-            mesh,
-            texture,
-            SourceInfo {
-                name,
-                vertices,
-                faces,
-                repair: Some(report.to_string()),
-            },
-        ))
+    let (source, info) = tokio::task::spawn_blocking(move || -> anyhow::Result<_> {
+        let source = load_coloured_mesh(&path)?;
+        let info = SourceInfo {
+            name: path
+                .file_name()
+                .map(|n| n.to_string_lossy().into_owned())
+                .unwrap_or_default(),
+            vertices: source.imported_vertices as u64,
+            faces: source.imported_faces as u64,
+            repair: Some(source.repair.to_string()),
+        };
+        Ok((source, info))
     })
     .await??;
-    let storage = super::open_storage(&args.db, &ConnectOptions::default(), false).await?;
-    let meta = ModelMeta {
-        slug: args.slug,
-        title: args.title,
-        description: args.description,
-        policy: args.policy,
-        good_enough_level: args.good_enough_level,
-        on_existing: if args.new_version {
-            OnExisting::NewVersion
-        } else {
-            OnExisting::Refuse
-        },
-        source: Some(source),
-    };
-    let options = IngestOptions {
-        encode: EncodeOptions {
-            quantization_bits: args.quantization_bits,
-            ..EncodeOptions::default()
-        },
-        colour: args.colour,
-        ccc: args.ccc.options(),
-        quality: args.quality.then(|| QualityOptions {
-            image_size: args.quality_image_size,
-            ..QualityOptions::default()
-        }),
-        pause_before_commit: args.pause_before_commit_ms.map(Duration::from_millis),
-    };
+    let storage = open_storage(&args.db, &ConnectOptions::default(), false).await?;
+    let (meta, options) = (args.meta(info), args.options());
     let slug = meta.slug.clone();
-    let report = ingest_coloured(&*storage, mesh, texture, meta, &options).await?;
+    let report = ingest_coloured(&*storage, source.mesh, source.texture, meta, &options).await?;
+    print_report(&slug, &report);
+    Ok(())
+}
+
+impl IngestArgs {
+    fn meta(&self, source: SourceInfo) -> ModelMeta {
+        ModelMeta {
+            slug: self.slug.clone(),
+            title: self.title.clone(),
+            description: self.description.clone(),
+            policy: self.policy.clone(),
+            good_enough_level: self.good_enough_level,
+            on_existing: if self.new_version {
+                OnExisting::NewVersion
+            } else {
+                OnExisting::Refuse
+            },
+            source: Some(source),
+        }
+    }
+
+    fn options(&self) -> IngestOptions {
+        IngestOptions {
+            encode: EncodeOptions {
+                quantization_bits: self.quantization_bits,
+                ..EncodeOptions::default()
+            },
+            colour: self.colour,
+            ccc: self.ccc.options(),
+            quality: self.quality.then(|| QualityOptions {
+                image_size: self.quality_image_size,
+                ..QualityOptions::default()
+            }),
+            pause_before_commit: self.pause_before_commit_ms.map(Duration::from_millis),
+        }
+    }
+}
+
+fn print_report(slug: &str, report: &IngestReport) {
     println!(
         "ingested {slug} version {} (compression {}): {} levels, {} → {} vertices, {} bytes, encoded in {:.1} s",
         report.stored.version,
@@ -175,20 +177,23 @@ pub async fn run_ingest(args: IngestArgs) -> anyhow::Result<()> {
         );
     }
     if let Some(q) = &report.quality {
-        let (first, last) = (&q.levels[0], &q.levels[q.levels.len() - 1]);
-        let roy = |r: Option<f64>| r.map_or_else(|| "—".to_string(), |r| format!("{r:.2}"));
-        println!(
-            "quality of {} levels measured in {:.1} s ({} px views): image RMSE {:.2} → {:.2}, Roy colour RMSE {} → {}, Hausdorff/diagonal {:.6} → {:.6}",
-            q.levels.len(),
-            q.time.as_secs_f64(),
-            q.options.image_size,
-            first.image_rmse,
-            last.image_rmse,
-            roy(first.roy_rmse),
-            roy(last.roy_rmse),
-            first.hausdorff,
-            last.hausdorff,
-        );
+        print_quality(q);
     }
-    Ok(())
+}
+
+fn print_quality(q: &MeasuredQuality) {
+    let (first, last) = (&q.levels[0], &q.levels[q.levels.len() - 1]);
+    let roy = |r: Option<f64>| r.map_or_else(|| "—".to_string(), |r| format!("{r:.2}"));
+    println!(
+        "quality of {} levels measured in {:.1} s ({} px views): image RMSE {:.2} → {:.2}, Roy colour RMSE {} → {}, Hausdorff/diagonal {:.6} → {:.6}",
+        q.levels.len(),
+        q.time.as_secs_f64(),
+        q.options.image_size,
+        first.image_rmse,
+        last.image_rmse,
+        roy(first.roy_rmse),
+        roy(last.roy_rmse),
+        first.hausdorff,
+        last.hausdorff,
+    );
 }

@@ -1,10 +1,13 @@
+//! `vitrine inspect`: what each level of a stream costs and, given the
+//! original mesh, how close each level comes to it.
+
+use crate::ccc_files::CccFiles;
+use crate::source::{load_coloured_mesh, QualityReference};
 use anyhow::Context;
 use clap::Args;
-use std::path::PathBuf;
-use vitrine_codec::{breakdown, Header};
-use vitrine_colour::ccc::{CccParameters, CellComplex};
-use vitrine_colour::vertex_colours_from_texture;
-use vitrine_quality::{stream_quality, Original, QualityOptions};
+use std::path::{Path, PathBuf};
+use vitrine_codec::{breakdown, Header, LevelBreakdown};
+use vitrine_quality::QualityOptions;
 
 #[derive(Args, Debug)]
 pub struct InspectArgs {
@@ -39,6 +42,15 @@ pub fn run(args: InspectArgs) -> anyhow::Result<()> {
         },
         header.batch_count()
     );
+    print_levels(&bytes, &levels, header.final_level().vertices);
+    if let Some(original) = &args.original {
+        print_quality(&bytes, &args, original)?;
+    }
+    Ok(())
+}
+
+/// Per level, and summed over the stream, bits per vertex by what they code.
+fn print_levels(bytes: &[u8], levels: &[LevelBreakdown], final_vertices: u32) {
     println!("level  vertices     faces      bytes   conn b/v   geom b/v  colour b/v  total b/v");
     for (k, l) in levels.iter().enumerate() {
         // Bits per vertex *added* by this level, the figure AD01 reports per layer.
@@ -59,10 +71,9 @@ pub fn run(args: InspectArgs) -> anyhow::Result<()> {
             bpv(l.bytes)
         );
     }
-    let n = header.final_level().vertices as f64;
-    let sum = |f: fn(&vitrine_codec::LevelBreakdown) -> u32| {
-        levels[1..].iter().map(f).sum::<u32>() as f64 * 8.0 / n
-    };
+    let n = final_vertices as f64;
+    let sum =
+        |f: fn(&LevelBreakdown) -> u32| levels[1..].iter().map(f).sum::<u32>() as f64 * 8.0 / n;
     println!(
         "whole stream per final vertex: connectivity {:.2}, geometry {:.2}, colour {:.2}, base mesh {:.2}, total {:.2} bits",
         sum(|l| l.connectivity + l.overhead),
@@ -71,42 +82,15 @@ pub fn run(args: InspectArgs) -> anyhow::Result<()> {
         levels[0].bytes as f64 * 8.0 / n,
         bytes.len() as f64 * 8.0 / n
     );
-    if let Some(original) = &args.original {
-        print_quality(&bytes, &args, original)?;
-    }
-    Ok(())
 }
 
-fn print_quality(
-    bytes: &[u8],
-    args: &InspectArgs,
-    original: &std::path::Path,
-) -> anyhow::Result<()> {
-    let (mut mesh, texture, _) = super::load_coloured_mesh(original)?;
-    if let Some(t) = &texture {
-        mesh.colors = Some(vertex_colours_from_texture(&mesh, t));
-    }
-    let files = super::CccFiles::beside(&args.input);
-    let complex = if files.parameters.exists() {
-        let read = |p: &std::path::Path| {
-            std::fs::read(p).with_context(|| format!("reading {}", p.display()))
-        };
-        let parameters: CccParameters = serde_json::from_slice(&read(&files.parameters)?)?;
-        Some(CellComplex::from_images(
-            &parameters,
-            &read(&files.cell)?,
-            &read(&files.colour)?,
-        )?)
-    } else {
-        None
-    };
-    let quality = stream_quality(
+fn print_quality(bytes: &[u8], args: &InspectArgs, original: &Path) -> anyhow::Result<()> {
+    let source = load_coloured_mesh(original)?;
+    let reference = QualityReference::new(source.mesh, source.texture);
+    let complex = CccFiles::beside(&args.input).read_complex()?;
+    let quality = reference.measure(
         bytes,
         complex.as_ref(),
-        &Original {
-            mesh: &mesh,
-            texture: texture.as_ref(),
-        },
         &QualityOptions {
             image_size: args.image_size,
             ..QualityOptions::default()

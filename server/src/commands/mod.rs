@@ -1,18 +1,95 @@
-//! The `ingest`, `serve`, `token` and `models` subcommands, for `main.rs` to wire in.
+//! The subcommands, one module each, holding its clap arguments and its
+//! `run`: [`Command`] is `vitrine`'s, [`DevCommand`] (feature `dev-tools`)
+//! the developer tools of `vitrine-dev`. The binaries only parse and call
+//! [`Command::run`].
 
-mod ingest;
-mod models;
-mod serve;
-mod token;
+pub mod decode;
+pub mod encode;
+pub mod ingest;
+pub mod inspect;
+pub mod models;
+pub mod sample;
+pub mod serve;
+pub mod token;
 
-pub use ingest::{run_ingest, CccArgs, IngestArgs};
-pub use models::{models_table, run_models, ModelsArgs};
-pub use serve::{run_serve, ServeArgs};
-pub use token::{new_token, run_token, TokenArgs};
+#[cfg(feature = "dev-tools")]
+pub mod bench;
+#[cfg(feature = "dev-tools")]
+pub mod colour_bench;
+#[cfg(feature = "dev-tools")]
+pub mod dump_levels;
 
-use crate::storage::{self, ConnectOptions, Storage};
-use std::sync::Arc;
-use std::time::Duration;
+use clap::Subcommand;
+use std::future::Future;
+
+#[derive(Subcommand)]
+pub enum Command {
+    /// Encode a mesh and store it in the database (one transaction).
+    Ingest(ingest::IngestArgs),
+    /// Serve models, refinement batches and the viewer over HTTP.
+    Serve(serve::ServeArgs),
+    /// Create an access token for researcher-level audiences.
+    Token(token::TokenArgs),
+    /// List the stored models and whether this build serves their stream format.
+    Models(models::ModelsArgs),
+    /// Encode a mesh (PLY, OBJ, OFF, glTF/GLB) into a progressive stream file.
+    Encode(encode::EncodeArgs),
+    /// Decode a stream file up to a level and write PLY, OBJ or GLB.
+    Decode(decode::DecodeArgs),
+    /// Per-level table of a stream: vertices, faces, bytes, bits per vertex.
+    Inspect(inspect::InspectArgs),
+    /// Write a generated sample mesh (torus, sphere, plate) as PLY.
+    Sample(sample::SampleArgs),
+}
+
+impl Command {
+    pub fn run(self) -> anyhow::Result<()> {
+        match self {
+            Command::Ingest(args) => block_on(ingest::run(args)),
+            Command::Serve(args) => block_on(serve::run(args)),
+            Command::Token(args) => block_on(token::run(args)),
+            Command::Models(args) => block_on(models::run(args)),
+            Command::Encode(args) => encode::run(args),
+            Command::Decode(args) => decode::run(args),
+            Command::Inspect(args) => inspect::run(args),
+            Command::Sample(args) => sample::run(args),
+        }
+    }
+}
+
+#[cfg(feature = "dev-tools")]
+#[derive(Subcommand)]
+pub enum DevCommand {
+    /// Benchmark the codec on a folder of meshes and print a markdown table.
+    Bench(bench::BenchArgs),
+    /// Compare the colour modes (ccc, vertex, vertex-metric) on coloured meshes: sizes and quality per level.
+    ColourBench(colour_bench::ColourBenchArgs),
+    /// Write the native decoder's buffers at every level (for cross-checks).
+    DumpLevels(dump_levels::DumpArgs),
+    /// One mesh of `bench`, in its own process so peak memory is its own.
+    #[command(hide = true)]
+    BenchOne(bench::BenchOneArgs),
+}
+
+#[cfg(feature = "dev-tools")]
+impl DevCommand {
+    pub fn run(self) -> anyhow::Result<()> {
+        match self {
+            DevCommand::Bench(args) => bench::run(args),
+            DevCommand::ColourBench(args) => colour_bench::run(args),
+            DevCommand::DumpLevels(args) => dump_levels::run(args),
+            DevCommand::BenchOne(args) => bench::run_one(args),
+        }
+    }
+}
+
+/// Runs an async command on a multi-threaded runtime of its own.
+fn block_on(command: impl Future<Output = anyhow::Result<()>>) -> anyhow::Result<()> {
+    tokio::runtime::Builder::new_multi_thread()
+        .enable_all()
+        .build()?
+        .block_on(command)
+}
 
 /// Logs to stderr, filtered by `RUST_LOG` (default `info`). Safe to call twice.
 pub fn init_tracing() {
@@ -22,53 +99,4 @@ pub fn init_tracing() {
         .with_env_filter(filter)
         .with_writer(std::io::stderr)
         .try_init();
-}
-
-/// Opens the database and applies migrations. With `wait`, an unreachable
-/// database is retried with backoff until it answers instead of failing.
-pub async fn open_storage(
-    url: &str,
-    options: &ConnectOptions,
-    wait: bool,
-) -> anyhow::Result<Arc<dyn Storage>> {
-    let storage = storage::connect(url, options)?;
-    let mut backoff = Duration::from_millis(250);
-    loop {
-        match storage.migrate().await {
-            Ok(()) => return Ok(storage),
-            Err(e) if wait && e.is_unavailable() => {
-                tracing::warn!(error = %e, retry_in = ?backoff, "database unavailable; retrying");
-                tokio::time::sleep(backoff).await;
-                backoff = (backoff * 2).min(Duration::from_secs(15));
-            }
-            Err(e) => return Err(anyhow::Error::new(e).context(format!("opening {}", redact(url)))),
-        }
-    }
-}
-
-/// The URL without its password, for messages.
-pub fn redact(url: &str) -> String {
-    match (url.find("://"), url.rfind('@')) {
-        (Some(scheme), Some(at)) if at > scheme => {
-            let userinfo = &url[scheme + 3..at];
-            match userinfo.split_once(':') {
-                Some((user, _)) => format!("{}{user}:***{}", &url[..scheme + 3], &url[at..]),
-                None => url.to_owned(),
-            }
-        }
-        _ => url.to_owned(),
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    #[test]
-    fn passwords_are_redacted() {
-        assert_eq!(
-            super::redact("postgres://u:secret@h/db"),
-            "postgres://u:***@h/db"
-        );
-        assert_eq!(super::redact("postgres://u@h/db"), "postgres://u@h/db");
-        assert_eq!(super::redact("sqlite:x.db"), "sqlite:x.db");
-    }
 }

@@ -1,6 +1,7 @@
 //! `vitrine models`: what a database holds, and whether this build serves
 //! it — the check to run after upgrading Vitrine, before `serve`.
 
+use crate::database::open_storage;
 use crate::storage::{ConnectOptions, ModelSummary};
 use std::fmt::Write as _;
 
@@ -56,9 +57,9 @@ pub fn models_table(models: &[ModelSummary]) -> (String, usize) {
     (out, stale)
 }
 
-pub async fn run_models(args: ModelsArgs) -> anyhow::Result<()> {
+pub async fn run(args: ModelsArgs) -> anyhow::Result<()> {
     super::init_tracing();
-    let storage = super::open_storage(&args.db, &ConnectOptions::default(), false).await?;
+    let storage = open_storage(&args.db, &ConnectOptions::default(), false).await?;
     let (table, stale) = models_table(&storage.list_models().await?);
     println!("{table}");
     if args.check && stale > 0 {

@@ -2,7 +2,8 @@
 //! variable; the defaults are those of [`ServiceConfig::default`] and
 //! [`ServeLimits::default`] (a test keeps them equal).
 
-use crate::serve::{serve, shutdown_signal, ServeLimits};
+use crate::connections::{serve, shutdown_signal, ServeLimits};
+use crate::database::{open_storage, redact};
 use crate::service::admission::AdmissionConfig;
 use crate::service::cap::CapRules;
 use crate::service::load::LoadConfig;
@@ -186,16 +187,16 @@ async fn warn_stale_models(storage: &dyn crate::storage::Storage) {
 
 /// Runs until Ctrl-C or SIGTERM. A database that is down at start-up is
 /// waited for; one that goes away later gives 503s until it is back.
-pub async fn run_serve(args: ServeArgs) -> anyhow::Result<()> {
+pub async fn run(args: ServeArgs) -> anyhow::Result<()> {
     super::init_tracing();
-    let storage = super::open_storage(&args.db, &args.connect_options(), true).await?;
+    let storage = open_storage(&args.db, &args.connect_options(), true).await?;
     warn_stale_models(storage.as_ref()).await;
     let state = AppState::new(storage, args.service_config());
     let _sampler = state.spawn_load_sampler();
     let listener = listen(args.listen)?;
     tracing::info!(
         addr = %listener.local_addr()?,
-        db = %super::redact(&args.db),
+        db = %redact(&args.db),
         backend = state.storage().backend(),
         "serving"
     );

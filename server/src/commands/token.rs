@@ -1,5 +1,6 @@
 //! `vitrine token --label … [--model slug]`: a researcher token.
 
+use crate::database::open_storage;
 use crate::storage::{now_ms, sha256_hex, ConnectOptions, NewToken};
 
 #[derive(clap::Args, Clone, Debug)]
@@ -22,9 +23,9 @@ pub fn new_token() -> String {
 }
 
 /// Creates a token and prints it once; only its digest is stored.
-pub async fn run_token(args: TokenArgs) -> anyhow::Result<()> {
+pub async fn run(args: TokenArgs) -> anyhow::Result<()> {
     super::init_tracing();
-    let storage = super::open_storage(&args.db, &ConnectOptions::default(), false).await?;
+    let storage = open_storage(&args.db, &ConnectOptions::default(), false).await?;
     let token = new_token();
     let expires_at_ms = args
         .expires_in_days
