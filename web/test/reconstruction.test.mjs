@@ -1,15 +1,16 @@
 // @ts-check
-// The decode worker's reconstruction loop, in Node, on streams written by the
-// Rust encoder, with a fake `fetch` that serves the stream split as the
-// service serves it (base, then batch k at /batches/k).
+// The decode worker's reconstruction loop, in Node, on a stream written by the
+// Rust encoder (the committed painted torus, test/fixtures), with a fake
+// `fetch` that serves the stream split as the service serves it (base, then
+// batch k at /batches/k).
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
 import { readFileSync } from 'node:fs';
 import { VitrineCodec, splitStream } from '../src/codec.js';
 import { Reconstruction } from '../src/reconstruction.js';
-import { encodedSample, wasmPath } from './support/fixtures.mjs';
+import { fixture, wasmPath } from './support/fixtures.mjs';
 
-const sample = encodedSample('torus', ['--kilo-vertices', '8', '--colour']);
+const sample = fixture('painted-torus');
 const parts = splitStream(sample.stream);
 const last = parts.batches.length;
 const module = new WebAssembly.Module(readFileSync(wasmPath));

@@ -1,71 +1,72 @@
 // @ts-check
-// Node tests of the WebAssembly decoder against streams written by the Rust
-// encoder: every level's buffers must equal the native decoder's, byte for byte.
+// Node tests of the WebAssembly decoder on the committed streams in
+// test/fixtures, written by the Rust encoder from generated samples: every
+// level's buffers must be what the native decoder made of the same bytes
+// when they were blessed (SHA-256 of each buffer, in NAME.json), so any
+// change to the decoder's output fails here. If the change is meant,
+// re-record them with `bash scripts/bless-fixtures.sh`. No CLI is run: only
+// the wasm module must be built.
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
-import { execFileSync } from 'node:child_process';
-import { mkdtempSync, readFileSync, existsSync } from 'node:fs';
-import { tmpdir } from 'node:os';
-import { join, dirname } from 'node:path';
-import { fileURLToPath } from 'node:url';
+import { existsSync, readFileSync } from 'node:fs';
 import { VitrineCodec, splitStream, DecodeError } from '../src/codec.js';
-
-const root = join(dirname(fileURLToPath(import.meta.url)), '..', '..');
-const vitrine = process.env.VITRINE_BIN ?? join(root, 'target', 'release', 'vitrine');
-const wasmPath = process.env.VITRINE_WASM ?? join(root, 'target', 'wasm32-unknown-unknown', 'wasm', 'vitrine_wasm.wasm');
+import { fixture, fixtureNames, sha256, wasmPath } from './support/fixtures.mjs';
 
 async function codec() {
+  assert.ok(existsSync(wasmPath), `build the wasm first: ${wasmPath}`);
   return VitrineCodec.instantiate(readFileSync(wasmPath));
 }
 
+const BLESS = 'if the change is meant: bash scripts/bless-fixtures.sh';
+
 /**
- * Encodes a generated sample with the Rust CLI and dumps native levels.
- * @param {string} kind
- * @param {string[]} [extra]
+ * A level as the fixture's sidecar records it.
+ * @param {import('../src/codec.js').Level} level
  */
-function fixture(kind, extra = []) {
-  const dir = mkdtempSync(join(tmpdir(), `vitrine-${kind}-`));
-  const mesh = join(dir, 'mesh.ply');
-  const stream = join(dir, 'mesh.vtr');
-  execFileSync(vitrine, ['sample', kind, '-o', mesh, '--kilo-vertices', '20', ...extra], { stdio: 'pipe' });
-  execFileSync(vitrine, ['encode', mesh, '-o', stream], { stdio: 'pipe' });
-  execFileSync(vitrine, ['dump-levels', stream, join(dir, 'native')], { stdio: 'pipe' });
-  return { dir, stream: new Uint8Array(readFileSync(stream)) };
+function digest(level) {
+  return {
+    level: level.level,
+    vertices: level.vertices,
+    faces: level.indices.length / 3,
+    positions: sha256(level.positions),
+    indices: sha256(level.indices),
+    colours: level.colours && sha256(level.colours),
+  };
 }
 
-/** @param {ArrayBufferView} view */
-function bytesOf(view) {
-  return Buffer.from(view.buffer, view.byteOffset, view.byteLength);
-}
+test('the committed fixtures: small, each the stream its sidecar was blessed from', () => {
+  const names = fixtureNames();
+  assert.deepEqual(names, ['painted-torus', 'plate', 'sphere', 'torus']);
+  for (const name of names) {
+    const f = fixture(name);
+    assert.ok(f.stream.length < 16 << 10, `${name}.vtr is ${f.stream.length} bytes`);
+    assert.equal(f.stream.length, f.streamDigest.bytes, `${name}.vtr size`);
+    assert.equal(sha256(f.stream), f.streamDigest.sha256, `${name}.vtr is not the stream ${name}.json describes: ${BLESS}`);
+    assert.ok(f.levels.length >= 3, `${name}: a base and several batches`);
+    f.levels.forEach((level, k) => assert.equal(level.level, k));
+  }
+});
 
-for (const [kind, extra] of /** @type {Array<[string, string[]]>} */ ([['torus', ['--colour', '--noise', '0.003']], ['plate', []], ['sphere', ['--noise', '0.002']]])) {
-  test(`wasm decodes ${kind} exactly like the native decoder`, async () => {
-    assert.ok(existsSync(wasmPath), `build the wasm first: ${wasmPath}`);
-    const { dir, stream } = fixture(kind, extra);
-    const { base, batches } = splitStream(stream);
-    assert.ok(batches.length >= 2, 'several levels');
-    const c = await codec();
-    const decoder = c.decoder(base);
+for (const name of fixtureNames()) {
+  test(`wasm decodes ${name}.vtr exactly as the native decoder did`, async () => {
+    const f = fixture(name);
+    const { base, batches } = splitStream(f.stream);
+    assert.equal(batches.length + 1, f.levels.length, 'levels');
+    const decoder = (await codec()).decoder(base);
     for (let k = 0; k <= batches.length; k++) {
       if (k > 0) decoder.apply(batches[k - 1]);
-      const level = decoder.level();
-      assert.equal(level.level, k);
-      const native = (/** @type {string} */ what) => readFileSync(join(dir, 'native', `level-${k}.${what}`));
-      assert.ok(bytesOf(level.positions).equals(native('positions')), `positions at level ${k}`);
-      assert.ok(bytesOf(level.indices).equals(native('indices')), `indices at level ${k}`);
-      if (extra.includes('--colour')) {
-        assert.ok(level.colours && bytesOf(level.colours).equals(native('colours')), `colours at level ${k}`);
-      } else {
-        assert.equal(level.colours, null);
-      }
+      assert.deepEqual(digest(decoder.level()), f.levels[k], `${name} level ${k}: the decoder's output changed; ${BLESS}`);
+      // The zero-copy views the decode worker reads are the same bytes.
+      assert.deepEqual(digest(decoder.view()), f.levels[k], `${name} level ${k} through view()`);
     }
+    if (name === 'painted-torus') assert.ok(f.levels.every((l) => l.colours !== null), 'colour at every level');
+    else assert.ok(f.levels.every((l) => l.colours === null), 'no colour');
     decoder.free();
   });
 }
 
 test('wasm reports truncated and corrupt batches as errors', async () => {
-  const { stream } = fixture('torus');
-  const { base, batches } = splitStream(stream);
+  const { base, batches } = splitStream(fixture('torus').stream);
   const c = await codec();
   assert.throws(() => c.decoder(base.subarray(0, base.length - 7)), DecodeError);
   const d1 = c.decoder(base);

@@ -1,0 +1,63 @@
+#!/usr/bin/env bash
+# Re-records web/test/fixtures: small streams the Rust encoder writes from
+# generated samples (never from shared data), and beside each NAME.vtr a
+# NAME.json of what the native decoder makes of it: per level the vertex and
+# face counts and the SHA-256 of its positions (f32), indices (u32) and
+# colours (u8), little-endian, as `vitrine dump-levels` writes them. The
+# Node tests (web/test/wasm.test.mjs, reconstruction.test.mjs) decode the
+# committed bytes with the WebAssembly decoder and compare.
+#
+# Run it when a test says the decoder's output changed and the change is
+# meant (consider codec/core/FORMAT.md's version, as for
+# codec/core/tests/golden.txt), or to add a fixture:
+#
+#   bash scripts/bless-fixtures.sh            # builds the release CLI first
+#   VITRINE_BIN=path/to/vitrine bash scripts/bless-fixtures.sh
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+if [ -z "${VITRINE_BIN:-}" ]; then
+    cargo build --release -p vitrine
+    VITRINE_BIN=target/release/vitrine
+fi
+out=web/test/fixtures
+mkdir -p "$out"
+# A fixture dropped from the list below goes too.
+rm -f "$out"/*.vtr "$out"/*.json
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+
+sha() { if [ -f "$1" ]; then printf '"%s"' "$(sha256sum "$1" | cut -d' ' -f1)"; else printf 'null'; fi; }
+size() { stat -c %s "$1"; }
+
+# fixture NAME SAMPLE-ARGS...: `vitrine sample SAMPLE-ARGS`, then encode with the defaults.
+fixture() {
+    local name=$1
+    shift
+    "$VITRINE_BIN" sample "$@" -o "$tmp/$name.ply" 2>/dev/null
+    "$VITRINE_BIN" encode "$tmp/$name.ply" -o "$out/$name.vtr" >/dev/null 2>&1
+    "$VITRINE_BIN" dump-levels "$out/$name.vtr" "$tmp/$name"
+    local levels
+    levels=$(find "$tmp/$name" -name 'level-*.positions' | wc -l)
+    {
+        printf '{\n'
+        printf '  "made_by": "vitrine sample %s; vitrine encode; bash scripts/bless-fixtures.sh",\n' "$*"
+        printf '  "stream": { "bytes": %s, "sha256": %s },\n' "$(size "$out/$name.vtr")" "$(sha "$out/$name.vtr")"
+        printf '  "levels": [\n'
+        for ((k = 0; k < levels; k++)); do
+            local at="$tmp/$name/level-$k"
+            printf '    { "level": %d, "vertices": %d, "faces": %d, "positions": %s, "indices": %s, "colours": %s }' \
+                "$k" $(($(size "$at.positions") / 12)) $(($(size "$at.indices") / 12)) \
+                "$(sha "$at.positions")" "$(sha "$at.indices")" "$(sha "$at.colours")"
+            if ((k + 1 < levels)); then printf ',\n'; else printf '\n'; fi
+        done
+        printf '  ]\n}\n'
+    } >"$out/$name.json"
+    printf '%-36s %6d bytes, %2d levels, %5d vertices\n' "$out/$name.vtr" "$(size "$out/$name.vtr")" "$levels" \
+        $(($(size "$tmp/$name/level-$((levels - 1)).positions") / 12))
+}
+
+fixture torus torus --kilo-vertices 1
+fixture painted-torus torus --kilo-vertices 1 --colour --noise 0.003
+fixture plate plate --kilo-vertices 1
+fixture sphere sphere --kilo-vertices 1 --noise 0.002
