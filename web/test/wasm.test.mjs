@@ -65,21 +65,220 @@ for (const name of fixtureNames()) {
   });
 }
 
-test('wasm reports truncated and corrupt batches as errors', async () => {
-  const { base, batches } = splitStream(fixture('torus').stream);
+/** @returns {[number, number]} a LEB128 varint at `at` and the offset after it */
+function varint(/** @type {Uint8Array} */ bytes, /** @type {number} */ at) {
+  let value = 0;
+  for (let shift = 0; ; shift += 7) {
+    const byte = bytes[at++];
+    if (byte === undefined) throw new Error('varint runs past the end');
+    value += (byte & 0x7f) * 2 ** shift;
+    if (byte < 0x80) return [value, at];
+  }
+}
+
+/** @param {number} value */
+function leb128(value) {
+  /** @type {number[]} */
+  const out = [];
+  do {
+    const low = value % 128;
+    value = Math.floor(value / 128);
+    out.push(value > 0 ? low | 0x80 : low);
+  } while (value > 0);
+  return out;
+}
+
+/**
+ * @typedef {{ seeds: Array<[number, number]>, inserted: number, sections: Uint8Array[] }} Pass
+ * @typedef {{ head: Uint8Array, level: number, before: number, after: number, faces: number, passes: Pass[] }} Batch
+ */
+
+/**
+ * A batch chunk taken apart as codec/core/FORMAT.md lays it out: tag and
+ * version, five header varints, then two passes (seeds, inserted vertices,
+ * connectivity, geometry and colour sections).
+ * @param {Uint8Array} bytes
+ * @returns {Batch}
+ */
+function parseBatch(bytes) {
+  let at = 2;
+  /** @type {number[]} */
+  const header = [];
+  for (let i = 0; i < 5; i++) [header[i], at] = varint(bytes, at);
+  const [level, before, after, faces, length] = header;
+  assert.equal(at + length, bytes.length, 'payload length');
+  /** @type {Pass[]} */
+  const passes = [];
+  for (let p = 0; p < 2; p++) {
+    let count;
+    [count, at] = varint(bytes, at);
+    /** @type {Array<[number, number]>} */
+    const seeds = [];
+    for (let s = 0; s < count; s++) {
+      let a, b;
+      [a, at] = varint(bytes, at);
+      [b, at] = varint(bytes, at);
+      seeds.push([a, b]);
+    }
+    let inserted;
+    [inserted, at] = varint(bytes, at);
+    const sections = [];
+    for (let s = 0; s < 3; s++) {
+      let n;
+      [n, at] = varint(bytes, at);
+      sections.push(bytes.slice(at, at + n));
+      at += n;
+    }
+    passes.push({ seeds, inserted, sections });
+  }
+  assert.equal(at, bytes.length, 'the two passes fill the payload');
+  return { head: bytes.slice(0, 2), level, before, after, faces, passes };
+}
+
+/** @param {Batch} batch */
+function writeBatch(batch) {
+  /** @type {number[]} */
+  const payload = [];
+  for (const pass of batch.passes) {
+    payload.push(...leb128(pass.seeds.length));
+    for (const [a, b] of pass.seeds) payload.push(...leb128(a), ...leb128(b));
+    payload.push(...leb128(pass.inserted));
+    for (const section of pass.sections) payload.push(...leb128(section.length), ...section);
+  }
+  const header = [batch.level, batch.before, batch.after, batch.faces, payload.length].flatMap(leb128);
+  return Uint8Array.from([...batch.head, ...header, ...payload]);
+}
+
+/**
+ * Batch 1 of the painted torus, edited.
+ * @param {(batch: Batch) => void} edit
+ */
+function edited(edit) {
+  const { batches } = splitStream(fixture('painted-torus').stream);
+  const batch = parseBatch(batches[0]);
+  edit(batch);
+  return writeBatch(batch);
+}
+
+test('the test can take a batch apart and put it together again byte for byte', () => {
+  for (const name of fixtureNames()) {
+    for (const bytes of splitStream(fixture(name).stream).batches) assert.deepEqual(writeBatch(parseBatch(bytes)), bytes);
+  }
+});
+
+test('wasm reports truncated and out-of-order streams as errors', async () => {
+  const f = fixture('painted-torus');
+  const { base, batches } = splitStream(f.stream);
   const c = await codec();
   assert.throws(() => c.decoder(base.subarray(0, base.length - 7)), DecodeError);
   const d1 = c.decoder(base);
   assert.throws(() => d1.apply(batches[0].subarray(0, batches[0].length - 3)), /truncated/);
   const d2 = c.decoder(base);
-  assert.throws(() => d2.apply(batches[1]), /level/);
-  // Flipping bytes inside the payload must give an error or a different mesh, never a crash.
-  const corrupt = Uint8Array.from(batches[0]);
-  for (let i = 40; i < corrupt.length; i += 7) corrupt[i] ^= 0x5a;
-  const d3 = c.decoder(base);
-  try {
-    d3.apply(corrupt);
-  } catch (e) {
-    assert.ok(e instanceof DecodeError, String(e));
+  assert.throws(
+    () => d2.apply(batches[1]),
+    (/** @type {unknown} */ e) => e instanceof DecodeError && e.message === 'invalid stream: batch for level 2 applied at level 0',
+  );
+});
+
+test('wasm refuses corrupt batches: apply fails with the reason', async () => {
+  const f = fixture('painted-torus');
+  const { base, batches } = splitStream(f.stream);
+  const c = await codec();
+  /**
+   * Applies a corrupt batch 1 to a fresh decoder; it must throw a DecodeError matching `reason`.
+   * @param {Uint8Array} corrupt
+   * @param {RegExp} reason
+   */
+  const refused = (corrupt, reason) => {
+    assert.notDeepEqual(corrupt, batches[0], 'the batch was changed');
+    const decoder = c.decoder(base);
+    assert.throws(
+      () => decoder.apply(corrupt),
+      (/** @type {unknown} */ e) => e instanceof DecodeError && /^invalid stream: /.test(e.message) && reason.test(e.message),
+      `expected a DecodeError matching ${reason}`,
+    );
+    // Still at the base: the level number did not move.
+    assert.equal(decoder.level().level, 0);
+    return decoder;
+  };
+
+  // Counts that disagree with the header's level table are refused before
+  // anything changes: the intact batch then applies as if nothing happened.
+  for (const corrupt of [
+    edited((b) => (b.after += 1)),
+    edited((b) => (b.before -= 1)),
+    edited((b) => (b.faces += 2)),
+  ]) {
+    const decoder = refused(corrupt, /^invalid stream: batch counts disagree with the level table$/);
+    decoder.apply(batches[0]);
+    assert.deepEqual(digest(decoder.level()), f.levels[1], 'the intact batch after the refused one');
+    decoder.free();
+  }
+  // A pass claiming one vertex more than the batch adds.
+  const more = refused(
+    edited((b) => (b.passes[0].inserted += 1)),
+    /^invalid stream: passes insert a different number of vertices than the batch$/,
+  );
+  more.apply(batches[0]);
+  assert.deepEqual(digest(more.level()), f.levels[1]);
+  more.free();
+
+  // A seed gate from a vertex to itself is no edge: found during the
+  // traversal, after the level began to change, so the decoder refuses
+  // whatever comes next until it starts again from the base.
+  const seeded = edited((b) => {
+    const pass = /** @type {Pass} */ (b.passes.find((p) => p.seeds.length > 0));
+    pass.seeds[0] = [pass.seeds[0][0], pass.seeds[0][0]];
+  });
+  const broken = refused(seeded, /^invalid stream: seed gate is not an edge of the mesh$/);
+  assert.throws(() => broken.apply(batches[0]), /an earlier batch failed part-way: decode again from the base/);
+  broken.free();
+
+  // A seed vertex that does not exist yet.
+  refused(
+    edited((b) => {
+      const pass = /** @type {Pass} */ (b.passes.find((p) => p.seeds.length > 0));
+      pass.seeds[0] = [f.levels[0].vertices + 5, pass.seeds[0][1]];
+    }),
+    /^invalid stream: seed gate names a vertex that does not exist yet$/,
+  ).free();
+
+});
+
+test('wasm refuses every batch of every fixture with flipped bytes', async () => {
+  const c = await codec();
+  /** Every byte of the connectivity codes: the traversal finds other patches than the pass declares, or runs out of codes. */
+  const connectivity = (/** @type {Uint8Array} */ bytes) => {
+    const b = parseBatch(bytes);
+    for (const pass of b.passes) pass.sections[0] = pass.sections[0].map((x) => x ^ 0x5a);
+    return writeBatch(b);
+  };
+  /** Every seventh byte from the 40th on, wherever it falls (header fields, seeds, any section). */
+  const scattered = (/** @type {Uint8Array} */ bytes) => {
+    const out = Uint8Array.from(bytes);
+    for (let at = 40; at < out.length; at += 7) out[at] ^= 0x5a;
+    return out;
+  };
+  for (const name of fixtureNames()) {
+    const { base, batches } = splitStream(fixture(name).stream);
+    for (const [flip, reason] of /** @type {Array<[(b: Uint8Array) => Uint8Array, RegExp]>} */ ([
+      [connectivity, /pass insert|patch faces do not match their pattern|truncated entropy-coded payload/],
+      [scattered, /./],
+    ])) {
+      batches.forEach((batch, i) => {
+        // Batch i + 1 flipped, on a decoder at level i: apply must throw, and the level stay at i.
+        const corrupt = flip(batch);
+        assert.notDeepEqual(corrupt, batch);
+        const probe = c.decoder(base);
+        for (let k = 0; k < i; k++) probe.apply(batches[k]);
+        assert.throws(
+          () => probe.apply(corrupt),
+          (/** @type {unknown} */ e) => e instanceof DecodeError && /^invalid stream: /.test(e.message) && reason.test(e.message),
+          `${name} batch ${i + 1} (${flip.name}): expected a DecodeError matching ${reason}`,
+        );
+        assert.equal(probe.level().level, i, `${name}: still at level ${i}`);
+        probe.free();
+      });
+    }
   }
 });
