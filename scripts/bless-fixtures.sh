@@ -3,7 +3,7 @@
 # generated samples (never from shared data), and beside each NAME.vtr a
 # NAME.json of what the native decoder makes of it: per level the vertex and
 # face counts and the SHA-256 of its positions (f32), indices (u32) and
-# colours (u8), little-endian, as `vitrine dump-levels` writes them. The
+# colours (u8), little-endian, as `vitrine-dev dump-levels` writes them. The
 # Node tests (web/test/wasm.test.mjs, reconstruction.test.mjs) decode the
 # committed bytes with the WebAssembly decoder and compare.
 #
@@ -11,14 +11,18 @@
 # meant (consider codec/core/FORMAT.md's version, as for
 # codec/core/tests/golden.txt), or to add a fixture:
 #
-#   bash scripts/bless-fixtures.sh            # builds the release CLI first
-#   VITRINE_BIN=path/to/vitrine bash scripts/bless-fixtures.sh
+#   bash scripts/bless-fixtures.sh            # builds the release CLI and vitrine-dev first
+#   VITRINE_BIN=path/to/vitrine VITRINE_DEV_BIN=path/to/vitrine-dev bash scripts/bless-fixtures.sh
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
 if [ -z "${VITRINE_BIN:-}" ]; then
     cargo build --release -p vitrine
     VITRINE_BIN=target/release/vitrine
+fi
+if [ -z "${VITRINE_DEV_BIN:-}" ]; then
+    cargo build --release -p vitrine --features dev-tools --bin vitrine-dev
+    VITRINE_DEV_BIN=target/release/vitrine-dev
 fi
 out=web/test/fixtures
 mkdir -p "$out"
@@ -36,7 +40,7 @@ fixture() {
     shift
     "$VITRINE_BIN" sample "$@" -o "$tmp/$name.ply" 2>/dev/null
     "$VITRINE_BIN" encode "$tmp/$name.ply" -o "$out/$name.vtr" >/dev/null 2>&1
-    "$VITRINE_BIN" dump-levels "$out/$name.vtr" "$tmp/$name"
+    "$VITRINE_DEV_BIN" dump-levels "$out/$name.vtr" "$tmp/$name"
     local levels
     levels=$(find "$tmp/$name" -name 'level-*.positions' | wc -l)
     {

@@ -7,9 +7,11 @@ cd "$(dirname "$0")/.."
 bash scripts/setup.sh
 cargo fmt --all -- --check
 cargo clippy --workspace --all-targets -- -D warnings
+cargo clippy -p vitrine --no-deps --all-targets --features dev-tools -- -D warnings # vitrine-dev's tools
 bash scripts/check-layout.sh # wasm32 core, crate and module DAGs, priors
 bash scripts/build.sh
 cargo test --workspace
+cargo test -p vitrine --features dev-tools --lib # the tools' unit tests (bench's Draco peer)
 (cd web && npm run --silent typecheck && npm test && npm run test:e2e)
 bash scripts/load.sh --short && bash scripts/faults.sh --short # crowd, faults, hostile HTTP (~3 min)
 if [ -x scripts/fuzz.sh ] || [ -f scripts/fuzz.sh ]; then
