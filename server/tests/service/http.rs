@@ -9,7 +9,6 @@ use reqwest::StatusCode;
 use std::sync::Arc;
 use std::time::Duration;
 use tokio::io::{AsyncReadExt, AsyncWriteExt};
-use vitrine::storage::Storage;
 use vitrine_codec::StreamIndex;
 
 fn client() -> reqwest::Client {
@@ -182,10 +181,7 @@ pub async fn load_cap_under_real_load(db: TestDb) {
         .await
         .stored
         .compression_id;
-    let slow: Arc<dyn Storage> = Arc::new(SlowStorage {
-        inner: db.storage.clone(),
-        delay: Duration::from_millis(150),
-    });
+    let slow = SlowStorage::new(db.storage.clone(), Duration::from_millis(150));
     let mut config = test_config();
     config.cache.payload_bytes = 0; // every batch request reads the (slow) database
     config.load.high_inflight = 16;
@@ -367,10 +363,7 @@ pub async fn shedding_and_body_limit(db: TestDb) {
         .await
         .stored
         .compression_id;
-    let slow: Arc<dyn Storage> = Arc::new(SlowStorage {
-        inner: db.storage.clone(),
-        delay: Duration::from_secs(1),
-    });
+    let slow = SlowStorage::new(db.storage.clone(), Duration::from_secs(1));
     let mut config = test_config();
     config.cache.payload_bytes = 0;
     config.limits.max_concurrency = 2;
@@ -409,13 +402,10 @@ pub async fn graceful_shutdown(db: TestDb) {
         .await
         .stored
         .compression_id;
-    let slow: Arc<dyn Storage> = Arc::new(SlowStorage {
-        inner: db.storage.clone(),
-        delay: Duration::from_millis(500),
-    });
+    let slow = SlowStorage::new(db.storage.clone(), Duration::from_millis(500));
     let mut config = test_config();
     config.cache.payload_bytes = 0;
-    let server = TestServer::start(slow, config).await;
+    let server = TestServer::start(slow.clone(), config).await;
     let http = client();
     let url = server.url(&format!("/api/compressions/{id}/batches/1"));
     let healthz = server.url("/healthz");
@@ -424,7 +414,7 @@ pub async fn graceful_shutdown(db: TestDb) {
         StatusCode::OK
     );
     let in_flight = tokio::spawn(http.get(&url).send());
-    tokio::time::sleep(Duration::from_millis(100)).await;
+    slow.reached().await;
     let started = tokio::time::Instant::now();
     server.shut_down().await;
     // The request that was in flight finished; the listener is gone.

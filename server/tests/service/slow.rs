@@ -3,6 +3,7 @@
 use async_trait::async_trait;
 use std::sync::Arc;
 use std::time::Duration;
+use tokio::sync::Notify;
 use vitrine::storage::{
     ModelRecord, ModelSummary, NewModel, NewToken, Result, StagedModel, Storage, TexturePayload,
     TokenGrant,
@@ -11,8 +12,31 @@ use vitrine::storage::{
 /// Storage whose payload reads take `delay`: concurrent batch requests then
 /// pile up in flight as they would behind a slow disk.
 pub struct SlowStorage {
-    pub inner: Arc<dyn Storage>,
-    pub delay: Duration,
+    inner: Arc<dyn Storage>,
+    delay: Duration,
+    /// Told each time a payload read begins: a request is then in flight.
+    reached: Notify,
+}
+
+impl SlowStorage {
+    pub fn new(inner: Arc<dyn Storage>, delay: Duration) -> Arc<SlowStorage> {
+        Arc::new(SlowStorage {
+            inner,
+            delay,
+            reached: Notify::new(),
+        })
+    }
+
+    /// Returns once a payload read has begun (at once if one began since
+    /// the last call).
+    pub async fn reached(&self) {
+        self.reached.notified().await;
+    }
+
+    async fn payload_read(&self) {
+        self.reached.notify_one();
+        tokio::time::sleep(self.delay).await;
+    }
 }
 
 #[async_trait]
@@ -36,11 +60,11 @@ impl Storage for SlowStorage {
         self.inner.model_by_compression(id).await
     }
     async fn base_payload(&self, id: i64) -> Result<Option<Vec<u8>>> {
-        tokio::time::sleep(self.delay).await;
+        self.payload_read().await;
         self.inner.base_payload(id).await
     }
     async fn batch_payload(&self, id: i64, iteration: u32) -> Result<Option<Vec<u8>>> {
-        tokio::time::sleep(self.delay).await;
+        self.payload_read().await;
         self.inner.batch_payload(id, iteration).await
     }
     async fn texture(&self, id: i64) -> Result<Option<TexturePayload>> {
