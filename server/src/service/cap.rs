@@ -8,15 +8,16 @@
 
 use crate::storage::ModelRecord;
 use serde::Serialize;
+use utoipa::ToSchema;
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, ToSchema)]
 #[serde(rename_all = "lowercase")]
 pub enum Audience {
     Public,
     Researcher,
 }
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, ToSchema)]
 #[serde(rename_all = "lowercase")]
 pub enum DeviceClass {
     Phone,
@@ -37,7 +38,7 @@ impl DeviceClass {
 
 /// Which limit set the cap. Audience and device caps are answered with 403,
 /// load caps with 429 and `Retry-After`.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, ToSchema)]
 #[serde(rename_all = "lowercase")]
 pub enum CapReason {
     Audience,
@@ -78,7 +79,7 @@ impl Pressure {
 }
 
 /// A cap and the three limits it was taken from.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, ToSchema)]
 pub struct LevelCap {
     /// Highest level the visitor may reach: batches `1..=level` may be fetched.
     pub level: u32,

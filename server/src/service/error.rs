@@ -6,9 +6,10 @@ use crate::storage::StorageError;
 use axum::http::{header, HeaderValue, StatusCode};
 use axum::response::{IntoResponse, Response};
 use axum::Json;
-use serde_json::json;
+use serde::Serialize;
 use std::sync::Arc;
 use std::time::Duration;
+use utoipa::ToSchema;
 
 /// How long clients should wait after a 503 caused by the database.
 const DATABASE_RETRY_AFTER: Duration = Duration::from_secs(5);
@@ -86,19 +87,19 @@ impl AppError {
         }
     }
 
-    fn code(&self) -> &'static str {
+    fn code(&self) -> ErrorCode {
         match self {
-            AppError::BadRequest(_) => "bad_request",
-            AppError::InvalidToken => "invalid_token",
-            AppError::NotFound(_) => "not_found",
-            AppError::LevelCapped { .. } => "level_capped",
-            AppError::Storage(e) if e.is_unavailable() => "database_unavailable",
-            AppError::Storage(_) | AppError::Internal(_) => "internal",
-            AppError::PayloadTooLarge => "payload_too_large",
-            AppError::Overloaded { .. } => "overloaded",
-            AppError::Busy { .. } => "busy",
-            AppError::Timeout => "timeout",
-            AppError::StaleFormat { .. } => "stale_format",
+            AppError::BadRequest(_) => ErrorCode::BadRequest,
+            AppError::InvalidToken => ErrorCode::InvalidToken,
+            AppError::NotFound(_) => ErrorCode::NotFound,
+            AppError::LevelCapped { .. } => ErrorCode::LevelCapped,
+            AppError::Storage(e) if e.is_unavailable() => ErrorCode::DatabaseUnavailable,
+            AppError::Storage(_) | AppError::Internal(_) => ErrorCode::Internal,
+            AppError::PayloadTooLarge => ErrorCode::PayloadTooLarge,
+            AppError::Overloaded { .. } => ErrorCode::Overloaded,
+            AppError::Busy { .. } => ErrorCode::Busy,
+            AppError::Timeout => ErrorCode::Timeout,
+            AppError::StaleFormat { .. } => ErrorCode::StaleFormat,
         }
     }
 
@@ -115,31 +116,87 @@ impl AppError {
         }
     }
 
-    fn body(&self) -> serde_json::Value {
+    fn body(&self) -> Response {
         let retry_after_s = self.retry_after().map(|d| d.as_secs().max(1));
         match self {
-            AppError::LevelCapped { requested, cap, .. } => json!({
-                "error": self.code(),
-                "requested": requested,
-                "cap": cap.level,
-                "reason": cap.reason,
-                "retry_after_s": retry_after_s,
-            }),
+            AppError::LevelCapped { requested, cap, .. } => Json(LevelCappedBody {
+                error: LevelCappedCode::LevelCapped,
+                requested: *requested,
+                cap: cap.level,
+                reason: cap.reason,
+                retry_after_s,
+            })
+            .into_response(),
             // Internal detail stays in the log.
-            AppError::Storage(_) | AppError::Internal(_) => json!({
-                "error": self.code(),
-                "retry_after_s": retry_after_s,
-            }),
-            _ => {
-                json!({ "error": self.code(), "message": self.to_string(), "retry_after_s": retry_after_s })
-            }
+            AppError::Storage(_) | AppError::Internal(_) => Json(ErrorBody {
+                error: self.code(),
+                message: None,
+                retry_after_s,
+            })
+            .into_response(),
+            _ => Json(ErrorBody {
+                error: self.code(),
+                message: Some(self.to_string()),
+                retry_after_s,
+            })
+            .into_response(),
         }
     }
 }
 
+/// What went wrong, for clients to branch on.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, ToSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum ErrorCode {
+    BadRequest,
+    InvalidToken,
+    NotFound,
+    LevelCapped,
+    DatabaseUnavailable,
+    PayloadTooLarge,
+    Overloaded,
+    Busy,
+    StaleFormat,
+    Timeout,
+    Internal,
+}
+
+/// The body of every error response but a level cap's.
+#[derive(Serialize, ToSchema)]
+#[schema(as = Error)]
+pub struct ErrorBody {
+    pub error: ErrorCode,
+    /// What to tell a person; absent when the detail is internal.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    #[schema(nullable = false)]
+    pub message: Option<String>,
+    /// Seconds to wait before asking again, as in `Retry-After`.
+    pub retry_after_s: Option<u64>,
+}
+
+#[derive(Serialize, ToSchema)]
+#[serde(rename_all = "snake_case")]
+enum LevelCappedCode {
+    LevelCapped,
+}
+
+/// A batch above the visitor's level cap (403 or 429).
+#[derive(Serialize, ToSchema)]
+#[schema(as = LevelCapped)]
+pub struct LevelCappedBody {
+    error: LevelCappedCode,
+    /// The batch asked for.
+    requested: u32,
+    /// Highest level this visitor may reach now.
+    cap: u32,
+    reason: Option<CapReason>,
+    retry_after_s: Option<u64>,
+}
+
 impl IntoResponse for AppError {
     fn into_response(self) -> Response {
-        let mut response = (self.status(), Json(self.body())).into_response();
+        let mut response = self.body();
+        *response.status_mut() = self.status();
         let headers = response.headers_mut();
         headers.insert(header::CACHE_CONTROL, HeaderValue::from_static("no-store"));
         if let Some(after) = self.retry_after() {

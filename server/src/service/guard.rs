@@ -9,6 +9,7 @@
 use super::admission::Admit;
 use super::error::{AppError, LoggedError};
 use super::load::InflightGuard;
+use super::metrics::Route;
 use super::AppState;
 use axum::body::{Body, Bytes, HttpBody};
 use axum::extract::{Request, State};
@@ -18,6 +19,9 @@ use axum::response::{IntoResponse, Response};
 use std::pin::Pin;
 use std::task::{Context, Poll};
 use std::time::Instant;
+use utoipa::openapi::header::HeaderBuilder;
+use utoipa::openapi::schema::{Object, Ref, Type};
+use utoipa::openapi::{Content, OpenApi, ResponseBuilder};
 
 /// Routes that serve data and so count as load; operations routes do not.
 fn is_data_route(route: &str) -> bool {
@@ -29,7 +33,8 @@ fn is_data_route(route: &str) -> bool {
 
 pub async fn admit(State(state): State<AppState>, request: Request, next: Next) -> Response {
     let started = Instant::now();
-    let route = super::metrics::route_label(&request);
+    let label = Route::of(&request);
+    let route = label.as_str();
     let limits = &state.config().limits;
     // A new visit during a surge: refused before anything else is spent on it.
     let admit = if route == "/api/models/{slug}" && request.method() == Method::GET {
@@ -81,10 +86,58 @@ pub async fn admit(State(state): State<AppState>, request: Request, next: Next) 
         .headers_mut()
         .entry(header::X_CONTENT_TYPE_OPTIONS)
         .or_insert(HeaderValue::from_static("nosniff"));
-    state
-        .metrics()
-        .observe(route, response.status().as_u16(), started.elapsed());
+    let status = response.status().as_u16();
+    state.metrics().observe(label, status, started.elapsed());
     response
+}
+
+/// Describes on every operation the answers this guard, and the panic
+/// catcher around it ([`super::layers`]), may give instead of the handler's.
+pub fn describe_refusals(description: &mut OpenApi) {
+    let refusals = [
+        (
+            "413",
+            "Request body too large: no route takes one (`payload_too_large`)",
+            false,
+        ),
+        (
+            "500",
+            "Internal error (`internal`); the detail is in the server's log",
+            false,
+        ),
+        (
+            "503",
+            "Server overloaded: the concurrency limit is full (`overloaded`)",
+            true,
+        ),
+        (
+            "504",
+            "The handler ran past the request timeout (`timeout`)",
+            false,
+        ),
+    ];
+    for item in description.paths.paths.values_mut() {
+        for operation in [&mut item.get, &mut item.head].into_iter().flatten() {
+            for (status, text, retry_after) in refusals {
+                let mut response = ResponseBuilder::new().description(text).content(
+                    "application/json",
+                    Content::new(Some(Ref::from_schema_name("Error"))),
+                );
+                if retry_after {
+                    let header = HeaderBuilder::new()
+                        .schema(Some(Object::with_type(Type::Integer)))
+                        .description(Some("Seconds to wait before asking again"))
+                        .build();
+                    response = response.header("Retry-After", header);
+                }
+                operation
+                    .responses
+                    .responses
+                    .entry(status.to_owned())
+                    .or_insert_with(|| response.build().into());
+            }
+        }
+    }
 }
 
 /// No route takes a body: anything declared larger than the limit, or

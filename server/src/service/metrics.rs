@@ -3,7 +3,7 @@
 
 use super::AppState;
 use axum::extract::{MatchedPath, Request};
-use prometheus_client::encoding::EncodeLabelSet;
+use prometheus_client::encoding::{EncodeLabelSet, EncodeLabelValue, LabelValueEncoder};
 use prometheus_client::metrics::counter::Counter;
 use prometheus_client::metrics::family::Family;
 use prometheus_client::metrics::gauge::Gauge;
@@ -14,13 +14,49 @@ use std::time::Duration;
 
 #[derive(Clone, Debug, Hash, PartialEq, Eq, EncodeLabelSet)]
 struct RequestLabels {
-    route: &'static str,
+    route: Route,
     status: u16,
 }
 
 #[derive(Clone, Debug, Hash, PartialEq, Eq, EncodeLabelSet)]
 struct RouteLabels {
-    route: &'static str,
+    route: Route,
+}
+
+/// The `route` label: the template the router matched (so label values are
+/// bounded by the route list), or `unmatched` (fallbacks: the viewer's files,
+/// 404s).
+#[derive(Clone, Debug)]
+pub struct Route(Option<MatchedPath>);
+
+impl Route {
+    pub fn of(request: &Request) -> Route {
+        Route(request.extensions().get::<MatchedPath>().cloned())
+    }
+
+    pub fn as_str(&self) -> &str {
+        self.0.as_ref().map_or("unmatched", MatchedPath::as_str)
+    }
+}
+
+impl PartialEq for Route {
+    fn eq(&self, other: &Route) -> bool {
+        self.as_str() == other.as_str()
+    }
+}
+
+impl Eq for Route {}
+
+impl std::hash::Hash for Route {
+    fn hash<H: std::hash::Hasher>(&self, state: &mut H) {
+        self.as_str().hash(state);
+    }
+}
+
+impl EncodeLabelValue for Route {
+    fn encode(&self, encoder: &mut LabelValueEncoder<'_>) -> std::fmt::Result {
+        EncodeLabelValue::encode(&self.as_str(), encoder)
+    }
 }
 
 #[derive(Clone, Debug, Hash, PartialEq, Eq, EncodeLabelSet)]
@@ -150,31 +186,20 @@ impl Metrics {
             .inc();
     }
 
-    pub fn observe(&self, route: &'static str, status: u16, elapsed: Duration) {
+    pub fn observe(&self, route: Route, status: u16, elapsed: Duration) {
+        self.latency
+            .get_or_create(&RouteLabels {
+                route: route.clone(),
+            })
+            .observe(elapsed.as_secs_f64());
         self.requests
             .get_or_create(&RequestLabels { route, status })
             .inc();
-        self.latency
-            .get_or_create(&RouteLabels { route })
-            .observe(elapsed.as_secs_f64());
     }
 
     pub fn capped(&self, reason: &'static str) {
         self.capped.get_or_create(&ReasonLabels { reason }).inc();
     }
-}
-
-/// The route label: the matched route template, from a fixed list so label
-/// values stay bounded.
-pub fn route_label(request: &Request) -> &'static str {
-    let Some(path) = request.extensions().get::<MatchedPath>() else {
-        return "unmatched";
-    };
-    super::ROUTES
-        .iter()
-        .copied()
-        .find(|r| *r == path.as_str())
-        .unwrap_or("other")
 }
 
 /// Prometheus text exposition, with gauges refreshed at scrape time.

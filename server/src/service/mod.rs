@@ -13,15 +13,19 @@ mod error;
 mod guard;
 mod layers;
 pub mod load;
+mod manifest;
 mod metrics;
 mod ops;
 mod payload;
+mod routes;
+mod servable;
 mod visitor;
 mod web;
 
 pub use cache::CacheConfig;
 pub use error::AppError;
 pub use layers::RequestLimits;
+pub use routes::{openapi, openapi_json};
 pub use visitor::VisitorHints;
 
 use crate::storage::{sha256_hex, ModelRecord, Storage, TokenGrant};
@@ -34,23 +38,6 @@ use metrics::Metrics;
 use std::path::PathBuf;
 use std::sync::Arc;
 use tokio::sync::Semaphore;
-
-/// Route templates, also the `route` label values of the request metrics.
-pub const ROUTES: &[&str] = &[
-    "/api/models",
-    "/api/models/{slug}",
-    "/api/compressions/{id}/base",
-    "/api/compressions/{id}/batches/{iteration}",
-    "/api/textures/{id}",
-    "/api/openapi.json",
-    "/api/{*rest}",
-    "/healthz",
-    "/readyz",
-    "/metrics",
-    "/",
-    "/m/{slug}",
-    "/embed/{slug}",
-];
 
 /// Everything the service can be told at start-up.
 #[derive(Clone, Debug, PartialEq)]
@@ -219,24 +206,6 @@ impl AppState {
         })
     }
 
-    /// Restricted models do not exist for visitors without a token for them;
-    /// a visible model stored in a stream format this build cannot decode is
-    /// refused with a message that says so (checked after visibility, so a
-    /// restricted model's existence is not revealed).
-    pub fn ensure_servable(&self, record: &ModelRecord, visitor: &Visitor) -> Result<(), AppError> {
-        if !(record.policy.public_access || visitor.audience == Audience::Researcher) {
-            return Err(AppError::NotFound("model"));
-        }
-        if !record.servable() {
-            return Err(AppError::StaleFormat {
-                slug: record.slug.clone(),
-                stored: record.stream_format,
-                reads: vitrine_codec::VERSION,
-            });
-        }
-        Ok(())
-    }
-
     pub fn level_cap(&self, record: &ModelRecord, visitor: &Visitor) -> LevelCap {
         let pressure = self.load().pressure();
         cap::level_cap(
@@ -268,15 +237,11 @@ impl AppState {
 
 /// The whole service as one router.
 pub fn app(state: AppState) -> Router {
-    let router = Router::new()
-        .merge(api::routes())
-        .merge(web::routes(state.config()))
-        .merge(ops::routes());
-    layers::apply(router, &state).with_state(state)
+    layers::apply(routes::all(state.config()), &state).with_state(state)
 }
 
 /// Only `/healthz`, `/readyz`, `/metrics` and the OpenAPI description, for a
 /// separate metrics listener.
 pub fn ops_app(state: AppState) -> Router {
-    layers::apply(ops::routes(), &state).with_state(state)
+    layers::apply(routes::ops_only(), &state).with_state(state)
 }

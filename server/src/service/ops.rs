@@ -1,45 +1,87 @@
 //! Operations routes: liveness, readiness, metrics, the OpenAPI description.
 
-use super::error::AppError;
-use super::{metrics, AppState};
+use super::error::{AppError, ErrorBody, ErrorCode};
+use super::{metrics, routes, AppState};
 use axum::extract::State;
 use axum::http::{header, HeaderValue, StatusCode};
 use axum::response::{IntoResponse, Response};
-use axum::routing::get;
-use axum::{Json, Router};
-use serde_json::json;
+use axum::Json;
+use serde::Serialize;
 use std::time::Duration;
-
-/// Hand-written rather than derived (utoipa): the API is small, and a test
-/// checks that every route in [`super::ROUTES`] is described.
-pub const OPENAPI: &str = include_str!("../../openapi.json");
+use utoipa::ToSchema;
 
 /// `/readyz` gives up on the database after this long.
 const READY_TIMEOUT: Duration = Duration::from_secs(2);
 
-pub fn routes() -> Router<AppState> {
-    Router::new()
-        .route(
-            "/healthz",
-            get(|| async { Json(json!({ "status": "ok" })) }),
-        )
-        .route("/readyz", get(ready))
-        .route("/metrics", get(prometheus))
-        .route("/api/openapi.json", get(openapi))
+/// What `/readyz` answers after a timeout.
+const READY_RETRY_AFTER_S: u64 = 5;
+
+#[derive(Serialize, ToSchema)]
+#[serde(rename_all = "lowercase")]
+enum Liveness {
+    Ok,
 }
 
-/// Ready when the database answers: a load balancer stops sending data
-/// requests while it is away, and health checks keep the process alive.
-async fn ready(State(state): State<AppState>) -> Response {
+#[derive(Serialize, ToSchema)]
+pub struct Health {
+    status: Liveness,
+}
+
+#[derive(Serialize, ToSchema)]
+#[serde(rename_all = "lowercase")]
+enum Readiness {
+    Ready,
+}
+
+#[derive(Serialize, ToSchema)]
+pub struct Ready {
+    status: Readiness,
+    /// The storage backend: `sqlite` or `postgres`.
+    database: &'static str,
+}
+
+/// Liveness: the process answers.
+#[utoipa::path(
+    get,
+    path = "/healthz",
+    responses((status = 200, description = "Alive", body = Health))
+)]
+pub async fn healthz() -> Json<Health> {
+    Json(Health {
+        status: Liveness::Ok,
+    })
+}
+
+/// Readiness: the database answers.
+///
+/// A load balancer stops sending data requests while it is away, and health
+/// checks keep the process alive.
+#[utoipa::path(
+    get,
+    path = "/readyz",
+    responses(
+        (status = 200, description = "Ready", body = Ready),
+        (status = 503, description = "Database unavailable", body = ErrorBody,
+            headers(("Retry-After" = u64, description = "Seconds to wait before asking again"))),
+    )
+)]
+pub async fn readyz(State(state): State<AppState>) -> Response {
     match tokio::time::timeout(READY_TIMEOUT, state.storage().ping()).await {
-        Ok(Ok(())) => Json(json!({ "status": "ready", "database": state.storage().backend() }))
-            .into_response(),
+        Ok(Ok(())) => Json(Ready {
+            status: Readiness::Ready,
+            database: state.storage().backend(),
+        })
+        .into_response(),
         Ok(Err(e)) => AppError::from(e).into_response(),
         Err(_) => {
-            let body = json!({ "error": "database_unavailable", "retry_after_s": 5 });
+            let body = ErrorBody {
+                error: ErrorCode::DatabaseUnavailable,
+                message: None,
+                retry_after_s: Some(READY_RETRY_AFTER_S),
+            };
             (
                 StatusCode::SERVICE_UNAVAILABLE,
-                [(header::RETRY_AFTER, "5")],
+                [(header::RETRY_AFTER, HeaderValue::from(READY_RETRY_AFTER_S))],
                 Json(body),
             )
                 .into_response()
@@ -47,7 +89,16 @@ async fn ready(State(state): State<AppState>) -> Response {
     }
 }
 
-async fn prometheus(State(state): State<AppState>) -> Response {
+/// Prometheus metrics: requests, latencies, cache hits, load pressure, caps.
+#[utoipa::path(
+    get,
+    path = "/metrics",
+    responses(
+        (status = 200, description = "Text exposition format", body = String,
+            content_type = "text/plain"),
+    )
+)]
+pub async fn prometheus(State(state): State<AppState>) -> Response {
     let content_type = HeaderValue::from_static("text/plain; version=0.0.4; charset=utf-8");
     (
         [(header::CONTENT_TYPE, content_type)],
@@ -56,13 +107,19 @@ async fn prometheus(State(state): State<AppState>) -> Response {
         .into_response()
 }
 
-async fn openapi() -> Response {
+/// This description, generated from the routes' own types (OpenAPI 3.1).
+#[utoipa::path(
+    get,
+    path = "/api/openapi.json",
+    responses((status = 200, description = "OpenAPI 3.1", body = Object))
+)]
+pub async fn openapi() -> Response {
     (
         [(
             header::CONTENT_TYPE,
             HeaderValue::from_static("application/json"),
         )],
-        OPENAPI,
+        routes::openapi_json(),
     )
         .into_response()
 }

@@ -9,63 +9,132 @@
 
 use super::cache::{Payload, PayloadKey, TextureEntry};
 use super::cap::{audience_cap, Audience, CapReason};
-use super::error::AppError;
-use super::visitor::VisitorHints;
-use super::AppState;
+use super::error::{AppError, ErrorBody, LevelCappedBody};
+use super::servable::{PathParams, ServableModel};
+use super::visitor::{HintQuery, VisitorHints};
+use super::{AppState, Visitor};
 use crate::storage::{ModelRecord, StorageError};
-use axum::extract::{Path, State};
+use axum::extract::State;
 use axum::http::{header, HeaderMap, HeaderValue, StatusCode};
 use axum::response::{IntoResponse, Response};
 use bytes::Bytes;
+use serde::Deserialize;
 use std::sync::Arc;
+use utoipa::{IntoParams, ToSchema};
 
 const OCTET_STREAM: &str = "application/octet-stream";
 const PUBLIC_IMMUTABLE: &str = "public, max-age=31536000, immutable";
 /// Levels only a token unlocks: browsers may keep them, shared caches may not.
 const PRIVATE_IMMUTABLE: &str = "private, max-age=31536000, immutable";
 
+/// Ids stay text until [`parse_id`], so that a malformed one gets our 400.
+#[derive(Deserialize, IntoParams)]
+#[into_params(parameter_in = Path)]
+pub struct CompressionParam {
+    /// Compression id, from the manifest.
+    #[param(value_type = i64, minimum = 1)]
+    id: String,
+}
+
+#[derive(Deserialize, IntoParams)]
+#[into_params(parameter_in = Path)]
+pub struct BatchParams {
+    /// Compression id, from the manifest.
+    #[param(value_type = i64, minimum = 1)]
+    id: String,
+    /// Batch number, 1 … `last_level`.
+    #[param(value_type = i64, minimum = 1)]
+    iteration: String,
+}
+
+#[derive(Deserialize, IntoParams)]
+#[into_params(parameter_in = Path)]
+pub struct TextureParam {
+    /// Texture id, from the manifest.
+    #[param(value_type = i64, minimum = 1)]
+    id: String,
+}
+
+// Describes answers only (handlers send `Bytes`), as `Conditional` below
+// describes a header the handlers read from the `HeaderMap`.
+/// Opaque bytes: a payload of the stream (codec/FORMAT.md) or an image.
+#[derive(ToSchema)]
+#[schema(value_type = String, format = Binary)]
+#[allow(dead_code)]
+pub struct Binary(Bytes);
+
+#[derive(IntoParams)]
+#[into_params(parameter_in = Header)]
+#[allow(dead_code)]
+pub struct Conditional {
+    /// ETags from earlier answers: 304 when one is this payload's.
+    #[param(rename = "If-None-Match", value_type = String, required = false)]
+    if_none_match: Option<String>,
+}
+
+/// Stream header plus base mesh (level 0).
+#[utoipa::path(
+    get,
+    path = "/api/compressions/{id}/base",
+    params(CompressionParam, HintQuery,
+        Conditional),
+    responses(
+        (status = 200, description = "Payload", body = inline(Binary), content_type = "application/octet-stream",
+            headers(
+                ("ETag" = String, description = "Strong ETag (SHA-256 of the payload)"),
+                ("Cache-Control" = String, description = "`public, max-age=31536000, immutable`, \
+                    or `private, …` for levels only a token unlocks"))),
+        (status = 304, description = "Not modified", headers(("ETag" = String), ("Cache-Control" = String))),
+        (status = 400, description = "Malformed id, query or `Authorization`", body = ErrorBody),
+        (status = 401, description = "The token is unknown, revoked or expired", body = ErrorBody),
+        (status = 404, description = "No such compression", body = ErrorBody),
+        (status = 409, description = "Stored in a stream format this build cannot decode", body = ErrorBody),
+        (status = 503, description = "Database unavailable or server overloaded", body = ErrorBody,
+            headers(("Retry-After" = u64, description = "Seconds to wait before asking again"))),
+    )
+)]
 pub async fn base(
     State(state): State<AppState>,
-    Path(id): Path<String>,
+    PathParams(CompressionParam { id }): PathParams<CompressionParam>,
     hints: VisitorHints,
     headers: HeaderMap,
 ) -> Result<Response, AppError> {
     let id = parse_id(&id, "compression id")?;
     let record = state.record_by_compression(id).await?;
-    let visitor = state.visitor(&hints, &record.slug).await?;
-    state.ensure_servable(&record, &visitor)?;
-    let etag = etag(&record.levels[0].sha256);
-    let cache_control = cache_control(&record, 0);
-    if not_modified(&headers, &etag) {
-        return Ok(not_modified_response(etag, cache_control));
-    }
-    let storage = state.storage();
-    let load = async {
-        let bytes = storage.base_payload(id).await?;
-        bytes
-            .map(|b| Payload::Mesh(b.into()))
-            .ok_or_else(|| missing(id, 0))
-    };
-    let Payload::Mesh(bytes) = state
-        .caches()
-        .payload(state.metrics(), PayloadKey::Base(id), load)
-        .await?
-    else {
-        return Err(AppError::Internal(
-            "payload cache returned a texture for a mesh key".into(),
-        ));
-    };
-    Ok(payload_response(
-        bytes,
-        etag,
-        cache_control,
-        HeaderValue::from_static(OCTET_STREAM),
-    ))
+    let model = ServableModel::decide(&state, record, &hints).await?;
+    mesh(&state, &model.record, 0, &headers).await
 }
 
+/// Refinement batch `iteration` (1-based): applied to level iteration−1 it
+/// gives level iteration.
+#[utoipa::path(
+    get,
+    path = "/api/compressions/{id}/batches/{iteration}",
+    params(BatchParams, HintQuery,
+        Conditional),
+    responses(
+        (status = 200, description = "Payload", body = inline(Binary), content_type = "application/octet-stream",
+            headers(
+                ("ETag" = String, description = "Strong ETag (SHA-256 of the payload)"),
+                ("Cache-Control" = String, description = "`public, max-age=31536000, immutable`, \
+                    or `private, …` for levels only a token unlocks"))),
+        (status = 304, description = "Not modified", headers(("ETag" = String), ("Cache-Control" = String))),
+        (status = 400, description = "Malformed id, iteration, query or `Authorization`", body = ErrorBody),
+        (status = 401, description = "The token is unknown, revoked or expired", body = ErrorBody),
+        (status = 403, description = "Above the cap set by the audience policy or the device class \
+            (`reason`: `audience`, `device`)", body = LevelCappedBody),
+        (status = 404, description = "No such compression or batch", body = ErrorBody),
+        (status = 409, description = "Stored in a stream format this build cannot decode", body = ErrorBody),
+        (status = 429, description = "Above the cap set by server load (`reason`: `load`); ask \
+            again after `Retry-After`", body = LevelCappedBody,
+            headers(("Retry-After" = u64, description = "Seconds to wait before asking again"))),
+        (status = 503, description = "Database unavailable or server overloaded", body = ErrorBody,
+            headers(("Retry-After" = u64, description = "Seconds to wait before asking again"))),
+    )
+)]
 pub async fn batch(
     State(state): State<AppState>,
-    Path((id, iteration)): Path<(String, String)>,
+    PathParams(BatchParams { id, iteration }): PathParams<BatchParams>,
     hints: VisitorHints,
     headers: HeaderMap,
 ) -> Result<Response, AppError> {
@@ -74,39 +143,67 @@ pub async fn batch(
         .try_into()
         .map_err(|_| AppError::NotFound("batch"))?;
     let record = state.record_by_compression(id).await?;
-    let visitor = state.visitor(&hints, &record.slug).await?;
-    state.ensure_servable(&record, &visitor)?;
+    let ServableModel { record, visitor } = ServableModel::decide(&state, record, &hints).await?;
     if iteration == 0 || iteration > record.batch_count() {
         return Err(AppError::NotFound("batch"));
     }
-    let cap = state.level_cap(&record, &visitor);
-    if iteration > cap.level {
-        let reason = match cap.reason {
-            Some(CapReason::Audience) => "audience",
-            Some(CapReason::Device) => "device",
-            _ => "load",
-        };
-        state.metrics().capped(reason);
-        let retry_after = state.load().config().retry_after;
-        return Err(AppError::LevelCapped {
-            requested: iteration,
-            cap,
-            retry_after,
-        });
+    within_cap(&state, &record, &visitor, iteration)?;
+    mesh(&state, &record, iteration, &headers).await
+}
+
+/// Refuses a batch above the visitor's level cap.
+fn within_cap(
+    state: &AppState,
+    record: &ModelRecord,
+    visitor: &Visitor,
+    iteration: u32,
+) -> Result<(), AppError> {
+    let cap = state.level_cap(record, visitor);
+    if iteration <= cap.level {
+        return Ok(());
     }
-    let etag = etag(&record.levels[iteration as usize].sha256);
-    let cache_control = cache_control(&record, iteration);
-    if not_modified(&headers, &etag) {
+    let reason = match cap.reason {
+        Some(CapReason::Audience) => "audience",
+        Some(CapReason::Device) => "device",
+        _ => "load",
+    };
+    state.metrics().capped(reason);
+    Err(AppError::LevelCapped {
+        requested: iteration,
+        cap,
+        retry_after: state.load().config().retry_after,
+    })
+}
+
+/// Level `level`'s payload: the base mesh for 0, else batch `level`.
+async fn mesh(
+    state: &AppState,
+    record: &ModelRecord,
+    level: u32,
+    headers: &HeaderMap,
+) -> Result<Response, AppError> {
+    let id = record.compression_id;
+    let etag = etag(&record.levels[level as usize].sha256);
+    let cache_control = cache_control(record, level);
+    if not_modified(headers, &etag) {
         return Ok(not_modified_response(etag, cache_control));
     }
     let storage = state.storage();
     let load = async {
-        let bytes = storage.batch_payload(id, iteration).await?;
+        let bytes = if level == 0 {
+            storage.base_payload(id).await?
+        } else {
+            storage.batch_payload(id, level).await?
+        };
         bytes
             .map(|b| Payload::Mesh(b.into()))
-            .ok_or_else(|| missing(id, iteration))
+            .ok_or_else(|| missing(id, level))
     };
-    let key = PayloadKey::Batch(id, iteration);
+    let key = if level == 0 {
+        PayloadKey::Base(id)
+    } else {
+        PayloadKey::Batch(id, level)
+    };
     let Payload::Mesh(bytes) = state.caches().payload(state.metrics(), key, load).await? else {
         return Err(AppError::Internal(
             "payload cache returned a texture for a mesh key".into(),
@@ -120,9 +217,33 @@ pub async fn batch(
     ))
 }
 
+/// An image of a CCC colour mapping: the cell texture (PNG) or the full- or
+/// low-resolution colour atlas (JPEG).
+#[utoipa::path(
+    get,
+    path = "/api/textures/{id}",
+    params(TextureParam, HintQuery,
+        Conditional),
+    responses(
+        (status = 200, description = "Texture. Shared by every level of the model, so its cache \
+            rule follows the model's policy: `public, max-age=31536000, immutable` for a public \
+            model, `private, …` when only a token shows it",
+            content((inline(Binary) = "image/png"), (inline(Binary) = "image/jpeg")),
+            headers(
+                ("ETag" = String, description = "Strong ETag (SHA-256 of the payload)"),
+                ("Cache-Control" = String))),
+        (status = 304, description = "Not modified", headers(("ETag" = String), ("Cache-Control" = String))),
+        (status = 400, description = "Malformed id, query or `Authorization`", body = ErrorBody),
+        (status = 401, description = "The token is unknown, revoked or expired", body = ErrorBody),
+        (status = 404, description = "No such texture, or a restricted model's without a token for it",
+            body = ErrorBody),
+        (status = 503, description = "Database unavailable or server overloaded", body = ErrorBody,
+            headers(("Retry-After" = u64, description = "Seconds to wait before asking again"))),
+    )
+)]
 pub async fn texture(
     State(state): State<AppState>,
-    Path(id): Path<String>,
+    PathParams(TextureParam { id }): PathParams<TextureParam>,
     hints: VisitorHints,
     headers: HeaderMap,
 ) -> Result<Response, AppError> {
@@ -140,11 +261,8 @@ pub async fn texture(
         });
         Ok(Payload::Texture(entry))
     };
-    let Payload::Texture(entry) = state
-        .caches()
-        .payload(state.metrics(), PayloadKey::Texture(id), load)
-        .await?
-    else {
+    let key = PayloadKey::Texture(id);
+    let Payload::Texture(entry) = state.caches().payload(state.metrics(), key, load).await? else {
         return Err(AppError::Internal(
             "payload cache returned a mesh for a texture key".into(),
         ));

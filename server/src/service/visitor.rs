@@ -7,6 +7,7 @@ use axum::extract::FromRequestParts;
 use axum::http::request::Parts;
 use axum::http::{header, HeaderMap};
 use serde::Deserialize;
+use utoipa::IntoParams;
 
 /// What the request says about the visitor, before the token is checked.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -17,9 +18,15 @@ pub struct VisitorHints {
     pub token: Option<String>,
 }
 
-#[derive(Deserialize)]
-struct HintQuery {
+/// The query parameters every visitor route reads.
+#[derive(Deserialize, IntoParams)]
+#[into_params(parameter_in = Query)]
+pub struct HintQuery {
+    /// Device class; without it the class is guessed from `Sec-CH-UA-Mobile`
+    /// and `User-Agent`.
+    #[param(value_type = Option<DeviceClass>)]
     device: Option<String>,
+    /// Researcher token, when `Authorization: Bearer` cannot be sent.
     token: Option<String>,
 }
 

@@ -4,35 +4,78 @@
 //! gallery so a fresh install shows something.
 
 use super::api::visible_models;
-use super::error::AppError;
-use super::visitor::VisitorHints;
+use super::error::{AppError, ErrorBody};
+use super::servable::{ServableModel, SlugParam};
+use super::visitor::{HintQuery, VisitorHints};
 use super::AppState;
-use crate::storage::valid_slug;
-use axum::extract::{Path, State};
+use axum::extract::{Request, State};
 use axum::http::{header, HeaderValue};
 use axum::response::{Html, IntoResponse, Response};
-use axum::routing::get;
-use axum::Router;
-use std::path::Path as FsPath;
+use axum::routing::get_service;
+use std::convert::Infallible;
+use std::path::{Path, PathBuf};
+use tower::Service;
 use tower_http::services::{ServeDir, ServeFile};
+use utoipa_axum::router::{UtoipaMethodRouter, UtoipaMethodRouterExt};
 
-pub fn routes(config: &super::ServiceConfig) -> Router<AppState> {
-    let dir: &FsPath = &config.web_dir;
-    let index = dir.join("index.html");
-    if index.is_file() {
-        Router::new()
-            .route_service("/m/{slug}", ServeFile::new(&index))
-            .route_service("/embed/{slug}", ServeFile::new(&index))
-            .fallback_service(ServeDir::new(dir).precompressed_br().precompressed_gzip())
-    } else {
-        Router::new()
-            .route("/", get(gallery))
-            .route("/m/{slug}", get(model_page))
-            .route("/embed/{slug}", get(model_page))
+/// The built web app, when `web_dir` has an `index.html`.
+pub struct Viewer {
+    dir: PathBuf,
+    index: PathBuf,
+}
+
+impl Viewer {
+    pub fn find(dir: &Path) -> Option<Viewer> {
+        let index = dir.join("index.html");
+        index.is_file().then(|| Viewer {
+            dir: dir.to_owned(),
+            index,
+        })
+    }
+
+    /// The build's files, precompressed where it has `.br` or `.gz` beside them.
+    pub fn files(&self) -> ServeDir {
+        ServeDir::new(&self.dir)
+            .precompressed_br()
+            .precompressed_gzip()
+    }
+
+    /// The page every model route gets: the app reads the slug from the path.
+    pub fn index(&self) -> ServeFile {
+        ServeFile::new(&self.index)
     }
 }
 
-async fn gallery(State(state): State<AppState>, hints: VisitorHints) -> Result<Response, AppError> {
+/// A documented page route, served by the viewer's build when there is one
+/// and by its built-in handler otherwise.
+pub fn or_viewer<T>(
+    route: UtoipaMethodRouter<AppState>,
+    viewer: Option<T>,
+) -> UtoipaMethodRouter<AppState>
+where
+    T: Service<Request, Error = Infallible> + Clone + Send + Sync + 'static,
+    T::Response: IntoResponse + 'static,
+    T::Future: Send + 'static,
+{
+    route.map(|handler| viewer.map_or(handler, get_service))
+}
+
+/// Gallery (the viewer's index.html, or a built-in list).
+#[utoipa::path(
+    get,
+    path = "/",
+    params(HintQuery),
+    responses(
+        (status = 200, description = "HTML", body = String, content_type = "text/html"),
+        (status = 400, description = "Malformed query or `Authorization`", body = ErrorBody),
+        (status = 401, description = "The token is unknown, revoked or expired", body = ErrorBody),
+        (status = 503, description = "Database unavailable or server overloaded", body = ErrorBody),
+    )
+)]
+pub async fn gallery(
+    State(state): State<AppState>,
+    hints: VisitorHints,
+) -> Result<Response, AppError> {
     let mut items = String::new();
     for m in visible_models(&state, &hints).await? {
         items.push_str(&format!(
@@ -51,19 +94,45 @@ async fn gallery(State(state): State<AppState>, hints: VisitorHints) -> Result<R
     ))
 }
 
-async fn model_page(
-    State(state): State<AppState>,
-    Path(slug): Path<String>,
-    hints: VisitorHints,
-) -> Result<Response, AppError> {
-    if !valid_slug(&slug) {
-        return Err(AppError::BadRequest(format!(
-            "{slug:?} is not a model slug"
-        )));
-    }
-    let record = state.record_by_slug(&slug).await?;
-    let visitor = state.visitor(&hints, &record.slug).await?;
-    state.ensure_servable(&record, &visitor)?;
+/// Model page (the viewer's index.html).
+#[utoipa::path(
+    get,
+    path = "/m/{slug}",
+    params(SlugParam, HintQuery),
+    responses(
+        (status = 200, description = "HTML", body = String, content_type = "text/html"),
+        (status = 400, description = "Malformed slug, query or `Authorization`", body = ErrorBody),
+        (status = 401, description = "The token is unknown, revoked or expired", body = ErrorBody),
+        (status = 404, description = "No such model", body = ErrorBody),
+        (status = 409, description = "Stored in a stream format this build cannot decode",
+            body = ErrorBody),
+        (status = 503, description = "Database unavailable or server overloaded", body = ErrorBody),
+    )
+)]
+pub async fn model_page(model: ServableModel) -> Response {
+    built_in_page(model)
+}
+
+/// Embeddable model view (the viewer's index.html).
+#[utoipa::path(
+    get,
+    path = "/embed/{slug}",
+    params(SlugParam, HintQuery),
+    responses(
+        (status = 200, description = "HTML", body = String, content_type = "text/html"),
+        (status = 400, description = "Malformed slug, query or `Authorization`", body = ErrorBody),
+        (status = 401, description = "The token is unknown, revoked or expired", body = ErrorBody),
+        (status = 404, description = "No such model", body = ErrorBody),
+        (status = 409, description = "Stored in a stream format this build cannot decode",
+            body = ErrorBody),
+        (status = 503, description = "Database unavailable or server overloaded", body = ErrorBody),
+    )
+)]
+pub async fn embed_page(model: ServableModel) -> Response {
+    built_in_page(model)
+}
+
+fn built_in_page(ServableModel { record, .. }: ServableModel) -> Response {
     let body = format!(
         "<h1>{title}</h1>\n<p>{description}</p>\n<p>The viewer is not installed on this server; \
          the <a href=\"/api/models/{slug}\">manifest</a> lists the levels it would load.</p>",
@@ -71,7 +140,7 @@ async fn model_page(
         description = escape(&record.description),
         slug = escape(&record.slug),
     );
-    Ok(page(&record.title, &body))
+    page(&record.title, &body)
 }
 
 fn page(title: &str, body: &str) -> Response {

@@ -272,7 +272,11 @@ pub struct TestServer {
 
 impl TestServer {
     pub async fn start(storage: Arc<dyn Storage>, config: ServiceConfig) -> TestServer {
-        let state = AppState::new(storage, config);
+        TestServer::serve(AppState::new(storage, config)).await
+    }
+
+    /// Serves `state`, which the test may keep to steer the service.
+    pub async fn serve(state: AppState) -> TestServer {
         state.spawn_load_sampler();
         let listener = TcpListener::bind("127.0.0.1:0").await.expect("bind");
         let base = format!("http://{}", listener.local_addr().expect("addr"));

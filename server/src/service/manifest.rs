@@ -1,0 +1,290 @@
+//! A model's manifest: what the viewer loads, level by level, and how far
+//! this visitor may go now. The types are the response and, through
+//! `ToSchema`, its OpenAPI description.
+
+use super::cap::{good_enough_level, Audience, CapReason, DeviceClass, LevelCap};
+use super::{AppState, Visitor};
+use crate::storage::{ModelRecord, TextureRef};
+use serde::Serialize;
+use utoipa::ToSchema;
+
+#[derive(Serialize, ToSchema)]
+pub struct Manifest<'a> {
+    slug: &'a str,
+    version: u32,
+    title: &'a str,
+    description: &'a str,
+    compression_id: i64,
+    quantization_bits: u8,
+    has_colour: bool,
+    /// Index of the full-resolution level (= number of batches).
+    last_level: u32,
+    /// Where load caps stop falling.
+    good_enough_level: u32,
+    levels: Vec<ManifestLevel>,
+    /// Every level's quality against the original, when it was measured at
+    /// ingest (`vitrine ingest --quality`, codec/quality/src/levels.rs);
+    /// absent otherwise. The model page plots it.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    #[schema(nullable = false)]
+    quality: Option<Vec<LevelQuality>>,
+    colour: Colour<'a>,
+    /// Every image of the colour mapping (also under `colour`).
+    textures: Vec<Texture<'a>>,
+    visitor: ManifestVisitor,
+    cap: ManifestCap,
+}
+
+#[derive(Serialize, ToSchema)]
+struct ManifestLevel {
+    level: u32,
+    vertices: u32,
+    faces: u32,
+    bytes: u64,
+    /// Symmetric Hausdorff distance to the original over its bounding-box
+    /// diagonal, when measured at ingest; also in `quality`.
+    hausdorff: Option<f64>,
+    /// Lindstrom–Turk image RMSE (luma, 0–255, 24 views) against the
+    /// original, when measured at ingest; also in `quality`.
+    rmse: Option<f64>,
+    /// The payload that produces this level: the base for level 0.
+    url: String,
+    /// Within this visitor's cap now.
+    allowed: bool,
+}
+
+/// One point of the quality curve.
+#[derive(Serialize, ToSchema)]
+struct LevelQuality {
+    /// 0 is the base mesh.
+    level: u32,
+    vertices: u32,
+    /// Symmetric Hausdorff distance over the bounding-box diagonal.
+    hausdorff: f64,
+    /// Roy et al. colour RMSE (0–255); null without colour.
+    roy_rmse: Option<f64>,
+    /// Lindstrom–Turk luma RMSE (0–255) over 24 views.
+    image_rmse: f64,
+}
+
+#[derive(Serialize, ToSchema)]
+struct Texture<'a> {
+    id: i64,
+    /// `cell` or `colour`.
+    kind: &'a str,
+    /// Which image of the mapping: `cell`, `colour` or `colour_low`.
+    role: &'a str,
+    /// `image/png` or `image/jpeg`.
+    media_type: &'a str,
+    bytes: u64,
+    width: Option<u32>,
+    height: Option<u32>,
+    url: String,
+}
+
+/// How the model is coloured.
+#[derive(Serialize, ToSchema)]
+#[serde(tag = "mode", rename_all = "lowercase")]
+#[allow(
+    clippy::large_enum_variant,
+    reason = "one per manifest, serialised at once; a boxed variant would be described as allOf"
+)]
+enum Colour<'a> {
+    /// Colour textures reached through a cubic cell complex
+    /// (`codec/colour/CCC.md`), the same for every level: the viewer loads
+    /// the cell texture and the low-resolution colour texture after the base
+    /// mesh, then the full-resolution one.
+    Ccc {
+        #[schema(value_type = CccParameters)]
+        parameters: &'a serde_json::Value,
+        cell_texture: Texture<'a>,
+        colour_texture: Texture<'a>,
+        colour_texture_low: Texture<'a>,
+    },
+    /// Per-vertex colour travels in the stream.
+    Vertex,
+    None,
+}
+
+// Served as ingest stored it, from `vitrine_colour::ccc::CccParameters`:
+// these types only describe it (the codec crate knows nothing of OpenAPI),
+// and tests/service/spec.rs checks real manifests against them.
+/// The cubic cell complex: grid, cell texture layout, tiles and atlas
+/// (`codec/colour/CCC.md`, "Parameters").
+#[derive(ToSchema)]
+#[allow(dead_code)]
+struct CccParameters {
+    version: u32,
+    /// World position of the grid's minimum corner.
+    origin: [f32; 3],
+    /// Edge of one cube, model units.
+    cell_size: f32,
+    dims: [u32; 3],
+    cells: u32,
+    cell_texture: CellTextureLayout,
+    tile_size: u32,
+    gutter: u32,
+    atlas: AtlasLayout,
+    low_res_factor: u32,
+    fallback_colour: [u8; 3],
+}
+
+#[derive(ToSchema)]
+#[allow(dead_code)]
+struct CellTextureLayout {
+    width: u32,
+    height: u32,
+    cells_offset: u32,
+}
+
+#[derive(ToSchema)]
+#[allow(dead_code)]
+struct AtlasLayout {
+    width: u32,
+    height: u32,
+    tiles_per_row: u32,
+    tiles: u32,
+}
+
+#[derive(Serialize, ToSchema)]
+struct ManifestVisitor {
+    audience: Audience,
+    device: DeviceClass,
+    device_source: DeviceSource,
+}
+
+/// `query` when `?device=` was given, else `hints`.
+#[derive(Serialize, ToSchema)]
+#[serde(rename_all = "lowercase")]
+enum DeviceSource {
+    Query,
+    Hints,
+}
+
+#[derive(Serialize, ToSchema)]
+struct ManifestCap {
+    level: u32,
+    reason: Option<CapReason>,
+    limits: LevelCap,
+    /// Set when load sets the cap: when to fetch the manifest again.
+    retry_after_s: Option<u64>,
+    load_pressure: u8,
+    load_steps: u8,
+}
+
+pub fn build<'a>(
+    state: &AppState,
+    record: &'a ModelRecord,
+    visitor: &Visitor,
+    cap: LevelCap,
+) -> Manifest<'a> {
+    let pressure = state.load().pressure();
+    Manifest {
+        slug: &record.slug,
+        version: record.version,
+        title: &record.title,
+        description: &record.description,
+        compression_id: record.compression_id,
+        quantization_bits: record.quantization_bits,
+        has_colour: record.has_colour,
+        last_level: record.batch_count(),
+        good_enough_level: good_enough_level(record, &state.config().caps),
+        levels: levels(record, cap),
+        quality: quality(record),
+        colour: colour(record),
+        textures: record.textures.iter().map(texture).collect(),
+        visitor: ManifestVisitor {
+            audience: visitor.audience,
+            device: visitor.device,
+            device_source: if visitor.device_explicit {
+                DeviceSource::Query
+            } else {
+                DeviceSource::Hints
+            },
+        },
+        cap: ManifestCap {
+            level: cap.level,
+            reason: cap.reason,
+            limits: cap,
+            retry_after_s: (cap.reason == Some(CapReason::Load))
+                .then(|| state.load().config().retry_after.as_secs().max(1)),
+            load_pressure: pressure.level,
+            load_steps: pressure.steps,
+        },
+    }
+}
+
+fn levels(record: &ModelRecord, cap: LevelCap) -> Vec<ManifestLevel> {
+    let id = record.compression_id;
+    record
+        .levels
+        .iter()
+        .enumerate()
+        .map(|(k, l)| ManifestLevel {
+            level: k as u32,
+            vertices: l.vertices,
+            faces: l.faces,
+            bytes: l.bytes,
+            hausdorff: l.hausdorff,
+            rmse: l.rmse,
+            url: if k == 0 {
+                format!("/api/compressions/{id}/base")
+            } else {
+                format!("/api/compressions/{id}/batches/{k}")
+            },
+            allowed: k as u32 <= cap.level,
+        })
+        .collect()
+}
+
+/// Every level's point, or none when any level was not measured.
+fn quality(record: &ModelRecord) -> Option<Vec<LevelQuality>> {
+    record
+        .levels
+        .iter()
+        .enumerate()
+        .map(|(k, l)| {
+            l.metrics().map(|m| LevelQuality {
+                level: k as u32,
+                vertices: l.vertices,
+                hausdorff: m.hausdorff,
+                roy_rmse: m.roy_rmse,
+                image_rmse: m.image_rmse,
+            })
+        })
+        .collect()
+}
+
+fn texture(t: &TextureRef) -> Texture<'_> {
+    Texture {
+        id: t.id,
+        kind: &t.kind,
+        role: &t.role,
+        media_type: &t.media_type,
+        bytes: t.bytes,
+        width: t.width,
+        height: t.height,
+        url: format!("/api/textures/{}", t.id),
+    }
+}
+
+fn colour(record: &ModelRecord) -> Colour<'_> {
+    let role = |r: &str| record.textures.iter().find(|t| t.role == r).map(texture);
+    match (
+        &record.mapping,
+        role("cell"),
+        role("colour"),
+        role("colour_low"),
+    ) {
+        (Some(mapping), Some(cell_texture), Some(colour_texture), Some(colour_texture_low)) => {
+            Colour::Ccc {
+                parameters: &mapping.parameters,
+                cell_texture,
+                colour_texture,
+                colour_texture_low,
+            }
+        }
+        _ if record.has_colour => Colour::Vertex,
+        _ => Colour::None,
+    }
+}

@@ -1,0 +1,129 @@
+//! Every route, listed once: the router serves this list, and the OpenAPI
+//! description served at `/api/openapi.json` is generated from it (each
+//! handler's `#[utoipa::path]` and its types' `ToSchema`).
+
+use super::error::AppError;
+use super::web::{self, Viewer};
+use super::{api, guard, ops, payload, AppState, ServiceConfig};
+use axum::routing::any;
+use bytes::Bytes;
+use std::sync::OnceLock;
+use utoipa::openapi::security::{HttpAuthScheme, HttpBuilder, SecurityScheme};
+use utoipa::openapi::OpenApi as Description;
+use utoipa::{Modify, OpenApi};
+use utoipa_axum::router::OpenApiRouter;
+use utoipa_axum::routes;
+
+#[derive(OpenApi)]
+#[openapi(
+    info(
+        title = "Vitrine",
+        version = "1",
+        description = "Progressive 3D scans for museum websites. A viewer fetches a model's \
+            manifest, then the base mesh, then refinement batches 1, 2, … up to the level cap the \
+            manifest states. Payloads are immutable: strong ETags, `Cache-Control: immutable`, \
+            304 on `If-None-Match`.\n\nLevel cap: the lowest of the audience policy's cap \
+            (public exhibition vs. researcher token; the full-resolution level only where the \
+            policy allows it), the device class's vertex budget, and the load cap (falls toward \
+            the model's good-enough level as server load rises, rises again when it falls). A \
+            batch above the cap is refused with 403 (reason `audience` or `device`) or 429 with \
+            `Retry-After` (reason `load`).\n\nEvery route may also answer 413 \
+            (`payload_too_large`: no route takes a body), 431 (request headers over the limit), \
+            500 (`internal`), 503 (`overloaded`: the concurrency limit is full; `Retry-After`) \
+            and 504 (`timeout`). Any other path under `/api/` answers 404 (`not_found`)."
+    ),
+    security((), ("bearer" = [])),
+    modifiers(&BearerToken)
+)]
+struct Api;
+
+struct BearerToken;
+
+impl Modify for BearerToken {
+    fn modify(&self, openapi: &mut Description) {
+        let scheme = HttpBuilder::new()
+            .scheme(HttpAuthScheme::Bearer)
+            .description(Some("Researcher token (`vitrine token`)"))
+            .build();
+        openapi
+            .components
+            .get_or_insert_with(Default::default)
+            .add_security_scheme("bearer", SecurityScheme::Http(scheme));
+    }
+}
+
+/// The whole service's routes; the viewer's build serves the pages when
+/// `web_dir` has one.
+pub fn all(config: &ServiceConfig) -> axum::Router<AppState> {
+    let viewer = Viewer::find(&config.web_dir);
+    let (router, _) = list(viewer.as_ref()).split_for_parts();
+    match viewer {
+        Some(viewer) => router.fallback_service(viewer.files()),
+        None => router,
+    }
+}
+
+/// Only `/healthz`, `/readyz`, `/metrics` and the OpenAPI description.
+pub fn ops_only() -> axum::Router<AppState> {
+    ops_list().split_for_parts().0
+}
+
+fn list(viewer: Option<&Viewer>) -> OpenApiRouter<AppState> {
+    OpenApiRouter::with_openapi(Api::openapi())
+        .routes(routes!(api::list))
+        .routes(routes!(api::manifest))
+        .routes(routes!(payload::base))
+        .routes(routes!(payload::batch))
+        .routes(routes!(payload::texture))
+        // Never the viewer's files. Not described: OpenAPI has no template
+        // for "any path below".
+        .route(
+            "/api/{*rest}",
+            any(|| async { AppError::NotFound("route") }),
+        )
+        .merge(ops_list())
+        .routes(web::or_viewer(
+            routes!(web::gallery),
+            viewer.map(Viewer::files),
+        ))
+        .routes(web::or_viewer(
+            routes!(web::model_page),
+            viewer.map(Viewer::index),
+        ))
+        .routes(web::or_viewer(
+            routes!(web::embed_page),
+            viewer.map(Viewer::index),
+        ))
+}
+
+fn ops_list() -> OpenApiRouter<AppState> {
+    OpenApiRouter::new()
+        .routes(routes!(ops::healthz))
+        .routes(routes!(ops::readyz))
+        .routes(routes!(ops::prometheus))
+        .routes(routes!(ops::openapi))
+}
+
+/// The OpenAPI description of [`all`]'s routes (which do not depend on the
+/// configuration: the viewer only changes who answers the pages).
+pub fn openapi() -> &'static Description {
+    static DESCRIPTION: OnceLock<Description> = OnceLock::new();
+    DESCRIPTION.get_or_init(|| {
+        let mut description = list(None).into_openapi();
+        guard::describe_refusals(&mut description);
+        description
+    })
+}
+
+/// [`openapi`] as served: pretty JSON, built once.
+pub fn openapi_json() -> Bytes {
+    static JSON: OnceLock<Bytes> = OnceLock::new();
+    JSON.get_or_init(|| {
+        let mut text = openapi()
+            .to_pretty_json()
+            .expect("an OpenAPI description serialises");
+        text.push('\n');
+        Bytes::from(text)
+    })
+    .clone()
+}
