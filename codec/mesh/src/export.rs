@@ -127,26 +127,62 @@ pub fn write_obj(mesh: &IndexedMesh, w: &mut impl Write) -> Result<()> {
 /// the importer recovers them) and uint32 indices.
 pub fn write_glb(mesh: &IndexedMesh, w: &mut impl Write) -> Result<()> {
     validate(mesh)?;
-    let n = mesh.positions.len();
-    let f = mesh.triangles.len();
-    if n == 0 || f == 0 {
+    if mesh.positions.is_empty() || mesh.triangles.is_empty() {
         return Err(Error::Parameter(
             "cannot write an empty mesh as glTF (accessors need at least one element)".into(),
         ));
     }
-    let pos_len = 12 * n;
-    let idx_len = 12 * f;
-    let col_len = if mesh.colors.is_some() { 12 * n } else { 0 };
-    let bin_len = pos_len + idx_len + col_len;
+    let layout = BinLayout::of(mesh);
+    let json = glb_json(mesh, &layout);
+    let bin_len = layout.len();
+    let total = 12 + 8 + json.len() + 8 + bin_len;
+    let total = u32::try_from(total)
+        .map_err(|_| Error::Limit(format!("GLB would be {total} bytes, over 4 GiB")))?;
 
-    let mut min = [f32::INFINITY; 3];
-    let mut max = [f32::NEG_INFINITY; 3];
-    for p in &mesh.positions {
-        for k in 0..3 {
-            min[k] = min[k].min(p[k]);
-            max[k] = max[k].max(p[k]);
+    let mut buf = Vec::with_capacity(CHUNK + 64);
+    buf.extend_from_slice(b"glTF");
+    buf.extend_from_slice(&2u32.to_le_bytes());
+    buf.extend_from_slice(&total.to_le_bytes());
+    buf.extend_from_slice(&(json.len() as u32).to_le_bytes());
+    buf.extend_from_slice(b"JSON");
+    buf.extend_from_slice(json.as_bytes());
+    buf.extend_from_slice(&(bin_len as u32).to_le_bytes());
+    buf.extend_from_slice(b"BIN\0");
+    write_glb_bin(mesh, buf, w)
+}
+
+/// Byte lengths of the GLB's BIN chunk parts, in order: positions, indices,
+/// colours (0 without).
+struct BinLayout {
+    pos_len: usize,
+    idx_len: usize,
+    col_len: usize,
+}
+
+impl BinLayout {
+    fn of(mesh: &IndexedMesh) -> Self {
+        let n = mesh.positions.len();
+        BinLayout {
+            pos_len: 12 * n,
+            idx_len: 12 * mesh.triangles.len(),
+            col_len: if mesh.colors.is_some() { 12 * n } else { 0 },
         }
     }
+
+    fn len(&self) -> usize {
+        self.pos_len + self.idx_len + self.col_len
+    }
+}
+
+/// The GLB's JSON chunk, padded with spaces to a multiple of 4 bytes.
+fn glb_json(mesh: &IndexedMesh, layout: &BinLayout) -> String {
+    let n = mesh.positions.len();
+    let BinLayout {
+        pos_len,
+        idx_len,
+        col_len,
+    } = *layout;
+    let (min, max) = bounds(&mesh.positions);
     let (colour_attr, colour_view, colour_acc) = if mesh.colors.is_some() {
         (
             r#","COLOR_0":2"#.to_string(),
@@ -172,7 +208,7 @@ pub fn write_glb(mesh: &IndexedMesh, w: &mut impl Write) -> Result<()> {
             r#"{{"bufferView":1,"componentType":5125,"count":{ni},"type":"SCALAR"}}{cacc}]}}"#
         ),
         ca = colour_attr,
-        bin_len = bin_len,
+        bin_len = layout.len(),
         pos_len = pos_len,
         idx_len = idx_len,
         cv = colour_view,
@@ -183,24 +219,30 @@ pub fn write_glb(mesh: &IndexedMesh, w: &mut impl Write) -> Result<()> {
         max0 = max[0],
         max1 = max[1],
         max2 = max[2],
-        ni = 3 * f,
+        ni = 3 * mesh.triangles.len(),
         cacc = colour_acc,
     );
     let padded = json.len().next_multiple_of(4);
     json.extend(std::iter::repeat_n(' ', padded - json.len()));
-    let total = 12 + 8 + json.len() + 8 + bin_len;
-    let total = u32::try_from(total)
-        .map_err(|_| Error::Limit(format!("GLB would be {total} bytes, over 4 GiB")))?;
+    json
+}
 
-    let mut buf = Vec::with_capacity(CHUNK + 64);
-    buf.extend_from_slice(b"glTF");
-    buf.extend_from_slice(&2u32.to_le_bytes());
-    buf.extend_from_slice(&total.to_le_bytes());
-    buf.extend_from_slice(&(json.len() as u32).to_le_bytes());
-    buf.extend_from_slice(b"JSON");
-    buf.extend_from_slice(json.as_bytes());
-    buf.extend_from_slice(&(bin_len as u32).to_le_bytes());
-    buf.extend_from_slice(b"BIN\0");
+/// Per-axis minimum and maximum of the positions.
+fn bounds(positions: &[[f32; 3]]) -> ([f32; 3], [f32; 3]) {
+    let mut min = [f32::INFINITY; 3];
+    let mut max = [f32::NEG_INFINITY; 3];
+    for p in positions {
+        for k in 0..3 {
+            min[k] = min[k].min(p[k]);
+            max[k] = max[k].max(p[k]);
+        }
+    }
+    (min, max)
+}
+
+/// Appends the BIN chunk's data to `buf` (which holds what comes before it)
+/// and writes it all to `w`, about [`CHUNK`] bytes at a time.
+fn write_glb_bin(mesh: &IndexedMesh, mut buf: Vec<u8>, w: &mut impl Write) -> Result<()> {
     let mut flush = |buf: &mut Vec<u8>, force: bool| -> Result<()> {
         if force || buf.len() >= CHUNK {
             w.write_all(buf)?;

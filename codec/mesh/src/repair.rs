@@ -279,35 +279,91 @@ pub fn prepare(mesh: IndexedMesh, opts: &RepairOptions) -> Result<(IndexedMesh, 
         colors,
         triangles,
     } = mesh;
-
-    // 1. Weld. `first[v]` is the input index of post-weld vertex v.
-    let (mut pos, mut col, remap, first) = if opts.weld {
-        let n = positions.len();
-        // `remap[i]`: first vertex at i's position, then its new index.
-        let mut remap = first_same_position(&positions);
-        let mut first = Vec::new();
-        for i in 0..n {
-            if remap[i] as usize == i {
-                remap[i] = first.len() as u32;
-                first.push(i as u32);
-            } else {
-                remap[i] = remap[remap[i] as usize];
-            }
-        }
-        report.welded_vertices = n - first.len();
-        if first.len() == n {
-            (positions, colors, None, first)
-        } else {
-            let pos: Vec<[f32; 3]> = first.iter().map(|&i| positions[i as usize]).collect();
-            let col = colors.map(|c| first.iter().map(|&i| c[i as usize]).collect());
-            (pos, col, Some(remap), first)
-        }
-    } else {
-        let n = positions.len() as u32;
-        (positions, colors, None, (0..n).collect())
+    let welded = weld(positions, colors, opts, &mut report);
+    let (tris, face_of) = drop_degenerate_faces(triangles, welded.remap, &mut report);
+    let (tris, face_of) = sort_by_lowest_vertex(tris, face_of);
+    let mut work = Work {
+        pos: welded.pos,
+        col: welded.col,
+        tris,
+        face_of,
+        first: welded.first,
     };
+    let edges = drop_duplicate_faces(&mut work, &mut report)?;
+    let nv0 = work.pos.len();
+    let edges = orient_faces(&mut work.tris, edges, nv0, &mut report);
+    split_until_manifold(&mut work, edges, opts, &mut report)?;
+    let tris = restore_input_order(work.tris, work.face_of);
+    let mesh = drop_unreferenced_vertices(work.pos, work.col, tris, &mut report);
+    debug_assert!(check_manifold(&mesh).is_ok(), "{:?}", check_manifold(&mesh));
+    Ok((mesh, report))
+}
 
-    // 2. Remap and drop degenerate faces. `face_of[f]` is the input index of face f.
+/// The vertices after welding, and how to renumber the faces.
+struct Welded {
+    pos: Vec<[f32; 3]>,
+    col: Option<Vec<[u8; 3]>>,
+    /// Input vertex → post-weld vertex; `None` when no vertex was merged.
+    remap: Option<Vec<u32>>,
+    /// `first[v]` is the input index of post-weld vertex v.
+    first: Vec<u32>,
+}
+
+/// Step 1, weld (with [`RepairOptions::weld`]): vertices with bit-identical
+/// positions merge into the first, which keeps its colour.
+fn weld(
+    positions: Vec<[f32; 3]>,
+    colors: Option<Vec<[u8; 3]>>,
+    opts: &RepairOptions,
+    report: &mut RepairReport,
+) -> Welded {
+    if !opts.weld {
+        let n = positions.len() as u32;
+        return Welded {
+            pos: positions,
+            col: colors,
+            remap: None,
+            first: (0..n).collect(),
+        };
+    }
+    let n = positions.len();
+    // `remap[i]`: first vertex at i's position, then its new index.
+    let mut remap = first_same_position(&positions);
+    let mut first = Vec::new();
+    for i in 0..n {
+        if remap[i] as usize == i {
+            remap[i] = first.len() as u32;
+            first.push(i as u32);
+        } else {
+            remap[i] = remap[remap[i] as usize];
+        }
+    }
+    report.welded_vertices = n - first.len();
+    if first.len() == n {
+        return Welded {
+            pos: positions,
+            col: colors,
+            remap: None,
+            first,
+        };
+    }
+    let pos: Vec<[f32; 3]> = first.iter().map(|&i| positions[i as usize]).collect();
+    let col = colors.map(|c| first.iter().map(|&i| c[i as usize]).collect());
+    Welded {
+        pos,
+        col,
+        remap: Some(remap),
+        first,
+    }
+}
+
+/// Step 2: remap and drop degenerate faces. Returns the faces left and
+/// `face_of`: `face_of[f]` is the input index of face f.
+fn drop_degenerate_faces(
+    triangles: Vec<[u32; 3]>,
+    remap: Option<Vec<u32>>,
+    report: &mut RepairReport,
+) -> (Vec<[u32; 3]>, Vec<u32>) {
     let mut tris: Vec<[u32; 3]> = Vec::with_capacity(triangles.len());
     let mut face_of: Vec<u32> = Vec::with_capacity(triangles.len());
     for (f, t) in triangles.iter().enumerate() {
@@ -322,164 +378,268 @@ pub fn prepare(mesh: IndexedMesh, opts: &RepairOptions) -> Result<(IndexedMesh, 
         tris.push(t);
         face_of.push(f as u32);
     }
-    drop(triangles);
-    drop(remap);
-    // Work on the faces in the order of their lowest vertex, so that the
-    // passes below, which visit edges by vertex, touch faces near each other
-    // in memory (a scan's faces often come scattered); the input's order
-    // comes back at the end. Stable radix sorts: sequential passes only.
+    (tris, face_of)
+}
+
+/// Work on the faces in the order of their lowest vertex, so that the
+/// later passes, which visit edges by vertex, touch faces near each other
+/// in memory (a scan's faces often come scattered); the input's order
+/// comes back at the end ([`restore_input_order`]). Stable radix sorts:
+/// sequential passes only.
+fn sort_by_lowest_vertex(tris: Vec<[u32; 3]>, face_of: Vec<u32>) -> (Vec<[u32; 3]>, Vec<u32>) {
     let mut faces: Vec<([u32; 3], u32)> = tris.into_iter().zip(face_of).collect();
     radsort::sort_by_key(&mut faces, |(t, _)| t[0].min(t[1]).min(t[2]));
-    let (mut tris, mut face_of): (Vec<[u32; 3]>, Vec<u32>) = faces.into_iter().unzip();
+    faces.into_iter().unzip()
+}
 
-    // 3. Drop duplicate faces (found through their shared edges).
-    let nv0 = pos.len();
-    let mut edges = Edges::build(&tris, nv0);
-    let dup = duplicate_faces(&tris, &edges);
+/// The mesh between the steps of [`prepare`], its faces in working order.
+struct Work {
+    pos: Vec<[f32; 3]>,
+    col: Option<Vec<[u8; 3]>>,
+    tris: Vec<[u32; 3]>,
+    /// `face_of[f]` is the input index of face f.
+    face_of: Vec<u32>,
+    /// `first[v]` is the input index of post-weld vertex v.
+    first: Vec<u32>,
+}
+
+/// Step 3: drop duplicate faces (found through their shared edges). Returns
+/// the edges of the faces left; a mesh left without faces is refused.
+fn drop_duplicate_faces(work: &mut Work, report: &mut RepairReport) -> Result<Edges> {
+    let nv0 = work.pos.len();
+    let mut edges = Edges::build(&work.tris, nv0);
+    let dup = duplicate_faces(&work.tris, &edges);
     report.duplicate_faces = dup.iter().filter(|&&d| d).count();
     if report.duplicate_faces > 0 {
         let mut f = 0;
-        tris.retain(|_| {
+        work.tris.retain(|_| {
             f += 1;
             !dup[f - 1]
         });
         let mut f = 0;
-        face_of.retain(|_| {
+        work.face_of.retain(|_| {
             f += 1;
             !dup[f - 1]
         });
-        edges = Edges::build(&tris, nv0);
+        edges = Edges::build(&work.tris, nv0);
     }
     drop(dup);
-    if tris.is_empty() {
+    if work.tris.is_empty() {
         return Err(Error::Unsupported(
             "mesh has no triangles left after dropping degenerate and duplicate faces".into(),
         ));
     }
+    Ok(edges)
+}
 
-    // 4a. Orientation: spread across edges with exactly two faces.
-    report.flipped_faces = orient(&mut tris, &edges);
-    let mut edges = if report.flipped_faces > 0 {
+/// Step 4a, orientation: spread across edges with exactly two faces.
+/// Returns the edges of the faces as they now are.
+fn orient_faces(
+    tris: &mut [[u32; 3]],
+    edges: Edges,
+    nv0: usize,
+    report: &mut RepairReport,
+) -> Edges {
+    report.flipped_faces = orient(tris, &edges);
+    if report.flipped_faces > 0 {
         drop(edges);
-        Edges::build(&tris, nv0)
+        Edges::build(tris, nv0)
     } else {
         edges
+    }
+}
+
+/// The vertices splitting adds.
+struct Splits {
+    /// `base[v]` is the post-weld vertex v copies.
+    base: Vec<u32>,
+    /// Post-weld vertices that were split.
+    marked: Vec<bool>,
+}
+
+impl Work {
+    /// A new vertex at the end, a copy of `v` (position and colour); the
+    /// post-weld vertex it copies is marked split.
+    fn copy_vertex(&mut self, splits: &mut Splits, v: u32) -> u32 {
+        let id = self.pos.len() as u32;
+        self.pos.push(self.pos[v as usize]);
+        if let Some(c) = self.col.as_mut() {
+            c.push(c[v as usize]);
+        }
+        splits.base.push(splits.base[v as usize]);
+        splits.marked[splits.base[v as usize] as usize] = true;
+        id
+    }
+}
+
+/// Steps 4b–5, split until manifold: non-manifold edges are cut and each
+/// fan of a vertex gets its own vertex, until a pass finds nothing to cut.
+/// Refused at the first offending edge or vertex without
+/// [`RepairOptions::split_non_manifold`].
+fn split_until_manifold(
+    work: &mut Work,
+    mut edges: Edges,
+    opts: &RepairOptions,
+    report: &mut RepairReport,
+) -> Result<()> {
+    let nv0 = work.pos.len();
+    let mut splits = Splits {
+        base: (0..nv0 as u32).collect(),
+        marked: vec![false; nv0],
     };
-
-    // 4b–5. Split until manifold. `base[v]` is the post-weld vertex v copies.
-    let mut base: Vec<u32> = (0..nv0 as u32).collect();
-    let mut split_mark = vec![false; nv0];
-    let nc = tris.len() * 3;
     for iteration in 0.. {
-        let nv = pos.len();
-        let mut uf = Corners::new(nc);
-        let mut bad: Vec<u32> = Vec::new(); // flattened: len, then half-edges
-        edges.for_each(|hs| match hs.len() {
-            1 => {}
-            2 if from(&tris, hs[0]) != from(&tris, hs[1]) => uf.glue(hs[0], hs[1]),
-            _ => {
-                if let Some((a, b)) = first_pair(&tris, hs) {
-                    uf.glue(a, b);
-                }
-                bad.push(hs.len() as u32);
-                bad.extend_from_slice(hs);
-            }
-        });
+        let (mut uf, bad) = glue_fans(&work.tris, &edges);
         if iteration == 0 {
-            let mut i = 0;
-            while i < bad.len() {
-                report.non_manifold_edges += 1;
-                i += bad[i] as usize + 1;
-            }
-            if !opts.split_non_manifold && !bad.is_empty() {
-                let hs = &bad[1..=bad[0] as usize];
-                let (a, b) = (from(&tris, hs[0]), to(&tris, hs[0]));
-                let faces: Vec<u32> = hs.iter().map(|&h| face_of[h as usize / 3]).collect();
-                let why = if hs.len() == 2 {
-                    "2 faces with orientations that cannot be made consistent".to_string()
-                } else {
-                    format!("{} faces", hs.len())
-                };
-                return Err(Error::Unsupported(format!(
-                    "non-manifold edge between vertices {} and {}: shared by {why} (faces {faces:?})",
-                    first[a as usize], first[b as usize]
-                )));
-            }
-        }
-
-        // One vertex per fan: the first fan met (in corner order) keeps the id.
-        let mut first_root = vec![NONE; nv];
-        let mut root_vertex = vec![NONE; nc];
-        let mut added = 0usize;
-        for c in 0..nc as u32 {
-            let (f, k) = (c as usize / 3, c as usize % 3);
-            let v = tris[f][k];
-            let r = uf.find(c);
-            if root_vertex[r as usize] == NONE {
-                if first_root[v as usize] == NONE {
-                    first_root[v as usize] = r;
-                    root_vertex[r as usize] = v;
-                } else {
-                    if !opts.split_non_manifold {
-                        return Err(Error::Unsupported(format!(
-                            "non-manifold vertex {}: its faces form several separate fans \
-                             (e.g. faces {} and {})",
-                            first[base[v as usize] as usize],
-                            face_of[first_root[v as usize] as usize / 3],
-                            face_of[f]
-                        )));
-                    }
-                    root_vertex[r as usize] = copy_vertex(&mut pos, &mut col, &mut base, v);
-                    split_mark[base[v as usize] as usize] = true;
-                    added += 1;
+            report.non_manifold_edges += bad_edges(&bad).count();
+            if !opts.split_non_manifold {
+                if let Some(hs) = bad_edges(&bad).next() {
+                    return Err(non_manifold_edge(work, hs));
                 }
             }
-            tris[f][k] = root_vertex[r as usize];
         }
-        drop(root_vertex);
-        drop(first_root);
+        let added = split_fans(work, &mut splits, &mut uf, opts)?;
         report.split_vertices += added;
         if bad.is_empty() {
             break;
         }
         if added == 0 {
-            // Splitting fans did not separate the remaining bad edges (their
-            // extra faces sit in the same fans as the kept pair): give each
-            // extra face its own copy of the edge's lower vertex.
-            let mut i = 0;
-            while i < bad.len() {
-                let hs = &bad[i + 1..=i + bad[i] as usize];
-                i += bad[i] as usize + 1;
-                let keep = first_pair(&tris, hs).unwrap_or((hs[0], hs[0]));
-                let lo = from(&tris, hs[0]).min(to(&tris, hs[0]));
-                for &h in hs {
-                    if h == keep.0 || h == keep.1 {
-                        continue;
-                    }
-                    let c = if from(&tris, h) == lo {
-                        h
-                    } else {
-                        to_corner(h)
-                    };
-                    let (f, k) = (c as usize / 3, c as usize % 3);
-                    let v = tris[f][k];
-                    tris[f][k] = copy_vertex(&mut pos, &mut col, &mut base, v);
-                    split_mark[base[v as usize] as usize] = true;
-                    report.split_vertices += 1;
-                }
-            }
+            report.split_vertices += detach_extra_faces(work, &mut splits, &bad);
         }
-        edges = Edges::build(&tris, pos.len());
+        edges = Edges::build(&work.tris, work.pos.len());
     }
     drop(edges);
-    report.non_manifold_vertices = split_mark.iter().filter(|&&m| m).count();
+    report.non_manifold_vertices = splits.marked.iter().filter(|&&m| m).count();
+    Ok(())
+}
 
-    // Back to the input's face order.
+/// Glues the corners across every manifold edge, and across the first
+/// manifold pair of every other edge ([`first_pair`]). Returns the corner
+/// union-find and the non-manifold edges, flattened: length, then
+/// half-edges (read them with [`bad_edges`]).
+fn glue_fans(tris: &[[u32; 3]], edges: &Edges) -> (Corners, Vec<u32>) {
+    let mut uf = Corners::new(tris.len() * 3);
+    let mut bad: Vec<u32> = Vec::new();
+    edges.for_each(|hs| match hs.len() {
+        1 => {}
+        2 if from(tris, hs[0]) != from(tris, hs[1]) => uf.glue(hs[0], hs[1]),
+        _ => {
+            if let Some((a, b)) = first_pair(tris, hs) {
+                uf.glue(a, b);
+            }
+            bad.push(hs.len() as u32);
+            bad.extend_from_slice(hs);
+        }
+    });
+    (uf, bad)
+}
+
+/// The half-edges of each edge of a flattened list from [`glue_fans`].
+fn bad_edges(bad: &[u32]) -> impl Iterator<Item = &[u32]> + '_ {
+    let mut i = 0;
+    std::iter::from_fn(move || {
+        let len = *bad.get(i)? as usize;
+        let hs = &bad[i + 1..=i + len];
+        i += len + 1;
+        Some(hs)
+    })
+}
+
+/// The refusal of non-manifold edge `hs` when splitting is not allowed.
+fn non_manifold_edge(work: &Work, hs: &[u32]) -> Error {
+    let tris = &work.tris;
+    let (a, b) = (from(tris, hs[0]), to(tris, hs[0]));
+    let faces: Vec<u32> = hs.iter().map(|&h| work.face_of[h as usize / 3]).collect();
+    let why = if hs.len() == 2 {
+        "2 faces with orientations that cannot be made consistent".to_string()
+    } else {
+        format!("{} faces", hs.len())
+    };
+    Error::Unsupported(format!(
+        "non-manifold edge between vertices {} and {}: shared by {why} (faces {faces:?})",
+        work.first[a as usize], work.first[b as usize]
+    ))
+}
+
+/// One vertex per fan: the first fan met (in corner order) keeps the id,
+/// the others get copies. Returns the number of vertices added.
+fn split_fans(
+    work: &mut Work,
+    splits: &mut Splits,
+    uf: &mut Corners,
+    opts: &RepairOptions,
+) -> Result<usize> {
+    let nv = work.pos.len();
+    let nc = work.tris.len() * 3;
+    let mut first_root = vec![NONE; nv];
+    let mut root_vertex = vec![NONE; nc];
+    let mut added = 0usize;
+    for c in 0..nc as u32 {
+        let (f, k) = (c as usize / 3, c as usize % 3);
+        let v = work.tris[f][k];
+        let r = uf.find(c);
+        if root_vertex[r as usize] == NONE {
+            if first_root[v as usize] == NONE {
+                first_root[v as usize] = r;
+                root_vertex[r as usize] = v;
+            } else {
+                if !opts.split_non_manifold {
+                    return Err(Error::Unsupported(format!(
+                        "non-manifold vertex {}: its faces form several separate fans \
+                         (e.g. faces {} and {})",
+                        work.first[splits.base[v as usize] as usize],
+                        work.face_of[first_root[v as usize] as usize / 3],
+                        work.face_of[f]
+                    )));
+                }
+                root_vertex[r as usize] = work.copy_vertex(splits, v);
+                added += 1;
+            }
+        }
+        work.tris[f][k] = root_vertex[r as usize];
+    }
+    Ok(added)
+}
+
+/// Splitting fans did not separate the remaining bad edges (their extra
+/// faces sit in the same fans as the kept pair): give each extra face its
+/// own copy of the edge's lower vertex. Returns the number of vertices added.
+fn detach_extra_faces(work: &mut Work, splits: &mut Splits, bad: &[u32]) -> usize {
+    let mut added = 0;
+    for hs in bad_edges(bad) {
+        let keep = first_pair(&work.tris, hs).unwrap_or((hs[0], hs[0]));
+        let lo = from(&work.tris, hs[0]).min(to(&work.tris, hs[0]));
+        for &h in hs {
+            if h == keep.0 || h == keep.1 {
+                continue;
+            }
+            let c = if from(&work.tris, h) == lo {
+                h
+            } else {
+                to_corner(h)
+            };
+            let (f, k) = (c as usize / 3, c as usize % 3);
+            let v = work.tris[f][k];
+            work.tris[f][k] = work.copy_vertex(splits, v);
+            added += 1;
+        }
+    }
+    added
+}
+
+/// Back to the input's face order (less the dropped faces).
+fn restore_input_order(tris: Vec<[u32; 3]>, face_of: Vec<u32>) -> Vec<[u32; 3]> {
     let mut faces: Vec<([u32; 3], u32)> = tris.into_iter().zip(face_of).collect();
     radsort::sort_by_key(&mut faces, |&(_, input)| input);
-    let mut tris: Vec<[u32; 3]> = faces.into_iter().map(|(t, _)| t).collect();
+    faces.into_iter().map(|(t, _)| t).collect()
+}
 
-    // 6. Drop unreferenced vertices, keeping order.
+/// Step 6: drop unreferenced vertices, keeping order.
+fn drop_unreferenced_vertices(
+    mut pos: Vec<[f32; 3]>,
+    mut col: Option<Vec<[u8; 3]>>,
+    mut tris: Vec<[u32; 3]>,
+    report: &mut RepairReport,
+) -> IndexedMesh {
     let mut new_id = vec![NONE; pos.len()];
     for t in &tris {
         for &v in t {
@@ -512,28 +672,11 @@ pub fn prepare(mesh: IndexedMesh, opts: &RepairOptions) -> Result<(IndexedMesh, 
             *t = t.map(|v| new_id[v as usize]);
         }
     }
-    let mesh = IndexedMesh {
+    IndexedMesh {
         positions: pos,
         colors: col,
         triangles: tris,
-    };
-    debug_assert!(check_manifold(&mesh).is_ok(), "{:?}", check_manifold(&mesh));
-    Ok((mesh, report))
-}
-
-fn copy_vertex(
-    pos: &mut Vec<[f32; 3]>,
-    col: &mut Option<Vec<[u8; 3]>>,
-    base: &mut Vec<u32>,
-    v: u32,
-) -> u32 {
-    let id = pos.len() as u32;
-    pos.push(pos[v as usize]);
-    if let Some(c) = col.as_mut() {
-        c.push(c[v as usize]);
     }
-    base.push(base[v as usize]);
-    id
 }
 
 /// Flips faces so that faces sharing an edge (with exactly two faces) agree,

@@ -430,13 +430,17 @@ pub(super) fn read_textured(
     max_pixels: u64,
     warnings: &mut Vec<String>,
 ) -> Result<(IndexedMesh, Option<TexturedSurface>)> {
-    read_inner(
-        bytes,
-        format,
-        Some(base),
-        opts,
-        Some((max_pixels, warnings)),
-    )
+    let request = TextureRequest {
+        max_pixels,
+        warnings,
+    };
+    read_inner(bytes, format, Some(base), opts, Some(request))
+}
+
+/// A textured import's image budget and the place its warnings go.
+struct TextureRequest<'w> {
+    max_pixels: u64,
+    warnings: &'w mut Vec<String>,
 }
 
 /// A primitive with a base colour texture, in the combined mesh.
@@ -447,18 +451,59 @@ struct TexturedPrimitive {
     uvs: Vec<[f32; 2]>,
 }
 
+/// The textured primitives of a document, for [`read_surface`].
+struct TexturedPrimitives {
+    primitives: Vec<TexturedPrimitive>,
+    /// Triangles whose material has a texture but no such TEXCOORD_n.
+    without_uvs: usize,
+}
+
 fn read_inner(
     bytes: &[u8],
     format: MeshFormat,
     base: Option<&Path>,
     opts: &ImportOptions,
-    mut textured: Option<(u64, &mut Vec<String>)>,
+    mut textured: Option<TextureRequest<'_>>,
 ) -> Result<(IndexedMesh, Option<TexturedSurface>)> {
     let what = if bytes.starts_with(b"glTF") {
         MeshFormat::Glb.name()
     } else {
         format.name()
     };
+    let (doc, bin) = parse_document(bytes, format, what)?;
+    let mut buffers = Buffers {
+        what,
+        base,
+        bin,
+        loaded: Vec::new(),
+    };
+    let instances = mesh_instances(&doc, what)?;
+    let mut reading = Reading {
+        what,
+        opts,
+        buffers: &mut buffers,
+        warnings: textured.as_mut().map(|t| &mut *t.warnings),
+    };
+    let mut combined = Combined::default();
+    for (mesh, world) in &instances {
+        for prim in mesh.primitives() {
+            combined.add_primitive(&mut reading, &prim, mesh.index(), world)?;
+        }
+    }
+    let (mesh, found) = combined.finish(what)?;
+    let Some(request) = textured else {
+        return Ok((mesh, None));
+    };
+    let surface = read_surface(&doc, &mesh, &found, &mut buffers, request)?;
+    Ok((mesh, surface))
+}
+
+/// The JSON document of a `.gltf` or GLB file, and the GLB's binary chunk.
+fn parse_document<'a>(
+    bytes: &'a [u8],
+    format: MeshFormat,
+    what: &'static str,
+) -> Result<(gltf::Document, Option<&'a [u8]>)> {
     let (json, bin) = if bytes.starts_with(b"glTF") {
         split_glb(bytes, what)?
     } else if format == MeshFormat::Glb {
@@ -473,14 +518,16 @@ fn read_inner(
         .map_err(|e| gltf_error(gltf::Error::Deserialize(e), what))?;
     check_attribute_accessors(&root, what)?;
     let doc = gltf::Document::from_json(root).map_err(|e| gltf_error(e, what))?;
-    let mut buffers = Buffers {
-        what,
-        base,
-        bin,
-        loaded: Vec::new(),
-    };
+    Ok((doc, bin))
+}
 
-    // Mesh instances with their world matrices.
+/// Mesh instances with their world matrices: the meshes of the default
+/// scene (or the first), depth first in node order; every mesh,
+/// untransformed, when no scene instances one.
+fn mesh_instances<'d>(
+    doc: &'d gltf::Document,
+    what: &'static str,
+) -> Result<Vec<(gltf::Mesh<'d>, Mat4)>> {
     let mut instances: Vec<(gltf::Mesh<'_>, Mat4)> = Vec::new();
     if let Some(scene) = doc.default_scene().or_else(|| doc.scenes().next()) {
         let mut stack: Vec<(gltf::Node<'_>, Mat4, usize)> =
@@ -510,248 +557,428 @@ fn read_inner(
     if instances.is_empty() {
         instances = doc.meshes().map(|m| (m, IDENTITY)).collect();
     }
+    Ok(instances)
+}
 
-    let mut positions: Vec<[f32; 3]> = Vec::new();
-    let mut colors: Vec<[u8; 3]> = Vec::new();
-    let mut any_colour = false;
-    let mut triangles: Vec<[u32; 3]> = Vec::new();
-    let mut textured_prims: Vec<TexturedPrimitive> = Vec::new();
-    // Triangles whose material has a texture but no such TEXCOORD_n.
-    let mut without_uvs = 0usize;
-    for (mesh, world) in &instances {
-        for prim in mesh.primitives() {
-            let mode = prim.mode();
-            if !matches!(
-                mode,
-                Mode::Triangles | Mode::TriangleStrip | Mode::TriangleFan
-            ) {
-                continue;
-            }
-            let Some(pos_acc) = prim.get(&Semantic::Positions) else {
-                continue;
-            };
-            let ctx = format!("mesh {} primitive {}", mesh.index(), prim.index());
-            let colour_acc = prim.get(&Semantic::Colors(0));
-            let index_acc = prim.indices();
-            // (image, TEXCOORD_n accessor) of a textured primitive.
-            let texture = match &textured {
-                Some(_) => prim
-                    .material()
-                    .pbr_metallic_roughness()
-                    .base_color_texture()
-                    .map(|info| {
-                        let set = info.tex_coord();
-                        (
-                            info.texture().source().index(),
-                            set,
-                            prim.get(&Semantic::TexCoords(set)),
-                        )
-                    }),
-                None => None,
-            };
-            let uv_acc = texture.as_ref().and_then(|t| t.2.as_ref());
-            for acc in [Some(&pos_acc), colour_acc.as_ref(), index_acc.as_ref()]
-                .into_iter()
-                .flatten()
-            {
-                if let Some(view) = acc.view() {
-                    buffers.load(&view.buffer())?;
-                }
-            }
+/// What every primitive is read with.
+struct Reading<'r, 'b> {
+    what: &'static str,
+    opts: &'r ImportOptions,
+    buffers: &'r mut Buffers<'b>,
+    /// `Some` when textures are read: unreadable texture coordinates are
+    /// reported here.
+    warnings: Option<&'r mut Vec<String>>,
+}
 
-            let pos = open(&pos_acc, &buffers, what)?;
-            if pos.dims != 3 {
-                return Err(Error::input(what, format!("{ctx}: POSITION is not VEC3")));
+/// A primitive's base colour texture: its image, and the `TEXCOORD_<set>`
+/// accessor it is read through (absent when the primitive has none).
+struct BaseColour<'a> {
+    image: usize,
+    set: u32,
+    uvs: Option<gltf::Accessor<'a>>,
+}
+
+fn base_colour<'a>(prim: &gltf::Primitive<'a>) -> Option<BaseColour<'a>> {
+    let info = prim
+        .material()
+        .pbr_metallic_roughness()
+        .base_color_texture()?;
+    let set = info.tex_coord();
+    Some(BaseColour {
+        image: info.texture().source().index(),
+        set,
+        uvs: prim.get(&Semantic::TexCoords(set)),
+    })
+}
+
+/// One primitive in the combined mesh.
+struct Placed {
+    /// "mesh M primitive P", for error messages.
+    ctx: String,
+    /// Index of its first vertex in the combined mesh.
+    base: usize,
+    /// Its vertex count.
+    n: usize,
+    /// Index of its first triangle in the combined mesh.
+    first_triangle: usize,
+    /// Its world transform mirrors: windings are reversed.
+    flip: bool,
+}
+
+/// The primitives read so far, as one mesh.
+#[derive(Default)]
+struct Combined {
+    positions: Vec<[f32; 3]>,
+    colors: Vec<[u8; 3]>,
+    any_colour: bool,
+    triangles: Vec<[u32; 3]>,
+    textured: Vec<TexturedPrimitive>,
+    /// Triangles whose material has a texture but no such TEXCOORD_n.
+    without_uvs: usize,
+}
+
+impl Combined {
+    /// Adds one primitive of mesh `mesh` under the world transform `world`;
+    /// primitives that are not triangles, or have no positions, are skipped.
+    fn add_primitive(
+        &mut self,
+        r: &mut Reading<'_, '_>,
+        prim: &gltf::Primitive<'_>,
+        mesh: usize,
+        world: &Mat4,
+    ) -> Result<()> {
+        let mode = prim.mode();
+        if !matches!(
+            mode,
+            Mode::Triangles | Mode::TriangleStrip | Mode::TriangleFan
+        ) {
+            return Ok(());
+        }
+        let Some(pos_acc) = prim.get(&Semantic::Positions) else {
+            return Ok(());
+        };
+        let ctx = format!("mesh {} primitive {}", mesh, prim.index());
+        let colour_acc = prim.get(&Semantic::Colors(0));
+        let index_acc = prim.indices();
+        let texture = r.warnings.as_ref().and_then(|_| base_colour(prim));
+        for acc in [Some(&pos_acc), colour_acc.as_ref(), index_acc.as_ref()]
+            .into_iter()
+            .flatten()
+        {
+            if let Some(view) = acc.view() {
+                r.buffers.load(&view.buffer())?;
             }
-            let n = pos.count;
-            let base = positions.len();
-            if base + n > opts.max_vertices {
-                return Err(Error::Limit(format!(
-                    "{what} has more than {} vertices",
-                    opts.max_vertices
-                )));
+        }
+        let base = self.positions.len();
+        let n = self.push_positions(r, &pos_acc, world, &ctx)?;
+        self.push_colours(r, colour_acc.as_ref(), base, n, &ctx)?;
+        // Unreadable texture coordinates cost the texture, not the geometry.
+        let uvs = texture.as_ref().and_then(|t| {
+            let acc = t.uvs.as_ref()?;
+            Some(read_uvs(acc, r.buffers, r.what, &ctx, t.set, n))
+        });
+        let placed = Placed {
+            ctx,
+            base,
+            n,
+            first_triangle: self.triangles.len(),
+            flip: det3(world) < 0.0,
+        };
+        self.push_triangles(r, mode, index_acc.as_ref(), &placed)?;
+        self.record_texture(r, texture, uvs, &placed);
+        Ok(())
+    }
+
+    /// Appends the primitive's `POSITION`s, transformed; returns their count.
+    fn push_positions(
+        &mut self,
+        r: &Reading<'_, '_>,
+        acc: &gltf::Accessor<'_>,
+        world: &Mat4,
+        ctx: &str,
+    ) -> Result<usize> {
+        let what = r.what;
+        let pos = open(acc, r.buffers, what)?;
+        if pos.dims != 3 {
+            return Err(Error::input(what, format!("{ctx}: POSITION is not VEC3")));
+        }
+        let n = pos.count;
+        let base = self.positions.len();
+        if base + n > r.opts.max_vertices {
+            return Err(Error::Limit(format!(
+                "{what} has more than {} vertices",
+                r.opts.max_vertices
+            )));
+        }
+        if base + n > u32::MAX as usize {
+            return Err(Error::Limit(format!("{what} has more than 2^32 vertices")));
+        }
+        self.positions.reserve(n);
+        let identity = *world == IDENTITY;
+        for i in 0..n {
+            let p = [pos.value(i, 0), pos.value(i, 1), pos.value(i, 2)];
+            let p = if identity {
+                p.map(|v| v as f32)
+            } else {
+                let w = world;
+                [0, 1, 2].map(|row| {
+                    (w[0][row] * p[0] + w[1][row] * p[1] + w[2][row] * p[2] + w[3][row]) as f32
+                })
+            };
+            if !p.iter().all(|v| v.is_finite()) {
+                return Err(Error::input(
+                    what,
+                    format!("{ctx}: vertex {i} has a non-finite coordinate {p:?}"),
+                ));
             }
-            if base + n > u32::MAX as usize {
-                return Err(Error::Limit(format!("{what} has more than 2^32 vertices")));
-            }
-            positions.reserve(n);
-            let identity = *world == IDENTITY;
-            for i in 0..n {
-                let p = [pos.value(i, 0), pos.value(i, 1), pos.value(i, 2)];
-                let p = if identity {
-                    p.map(|v| v as f32)
-                } else {
-                    let w = world;
-                    [0, 1, 2].map(|r| {
-                        (w[0][r] * p[0] + w[1][r] * p[1] + w[2][r] * p[2] + w[3][r]) as f32
-                    })
-                };
-                if !p.iter().all(|v| v.is_finite()) {
+            self.positions.push(p);
+        }
+        Ok(n)
+    }
+
+    /// Appends the primitive's `COLOR_0` as sRGB bytes; vertices without
+    /// colour are white once any primitive has had one.
+    fn push_colours(
+        &mut self,
+        r: &Reading<'_, '_>,
+        acc: Option<&gltf::Accessor<'_>>,
+        base: usize,
+        n: usize,
+        ctx: &str,
+    ) -> Result<()> {
+        match acc {
+            Some(acc) => {
+                let c = open(acc, r.buffers, r.what)?;
+                if !(c.dims == 3 || c.dims == 4) || c.count != n {
                     return Err(Error::input(
-                        what,
-                        format!("{ctx}: vertex {i} has a non-finite coordinate {p:?}"),
+                        r.what,
+                        format!("{ctx}: COLOR_0 must be VEC3/VEC4 with one value per vertex"),
                     ));
                 }
-                positions.push(p);
+                if !self.any_colour {
+                    self.colors.resize(base, [255; 3]);
+                    self.any_colour = true;
+                }
+                self.colors
+                    .extend((0..n).map(|i| [0, 1, 2].map(|j| linear_to_srgb_u8(c.value(i, j)))));
             }
+            None if self.any_colour => self.colors.resize(base + n, [255; 3]),
+            None => {}
+        }
+        Ok(())
+    }
 
-            match colour_acc {
-                Some(acc) => {
-                    let c = open(&acc, &buffers, what)?;
-                    if !(c.dims == 3 || c.dims == 4) || c.count != n {
-                        return Err(Error::input(
-                            what,
-                            format!("{ctx}: COLOR_0 must be VEC3/VEC4 with one value per vertex"),
-                        ));
-                    }
-                    if !any_colour {
-                        colors.resize(base, [255; 3]);
-                        any_colour = true;
-                    }
-                    colors.extend(
-                        (0..n).map(|i| [0, 1, 2].map(|j| linear_to_srgb_u8(c.value(i, j)))),
-                    );
+    /// Appends the primitive's triangles, through its indices when it has
+    /// them.
+    fn push_triangles(
+        &mut self,
+        r: &Reading<'_, '_>,
+        mode: Mode,
+        acc: Option<&gltf::Accessor<'_>>,
+        placed: &Placed,
+    ) -> Result<()> {
+        let indices = match acc {
+            Some(acc) => {
+                let ix = open(acc, r.buffers, r.what)?;
+                if ix.dims != 1 || ix.ty == DataType::F32 {
+                    return Err(Error::input(
+                        r.what,
+                        format!("{}: indices must be unsigned integer scalars", placed.ctx),
+                    ));
                 }
-                None if any_colour => colors.resize(base + n, [255; 3]),
-                None => {}
+                Some(ix)
             }
+            None => None,
+        };
+        let count = indices.as_ref().map_or(placed.n, |ix| ix.count);
+        let at = |i: usize| indices.as_ref().map_or(i as u64, |ix| ix.index(i));
+        let emit = |t: [u64; 3], k: usize| self.add_triangle(r, placed, t, k);
+        for_each_triangle(mode, count, at, emit)
+    }
 
-            // Unreadable texture coordinates cost the texture, not the geometry.
-            let uvs = uv_acc.map(|acc| {
-                let set = texture.as_ref().map_or(0, |t| t.1);
-                read_uvs(acc, &mut buffers, what, &ctx, set, n)
-            });
-            let first_triangle = triangles.len();
+    /// Appends triangle `k` of the primitive, `t` in its own vertex numbers.
+    fn add_triangle(
+        &mut self,
+        r: &Reading<'_, '_>,
+        placed: &Placed,
+        t: [u64; 3],
+        k: usize,
+    ) -> Result<()> {
+        let n = placed.n;
+        for &v in &t {
+            if v >= n as u64 {
+                return Err(Error::input(
+                    r.what,
+                    format!(
+                        "{}: triangle {k} has vertex index {v} out of range ({n} vertices)",
+                        placed.ctx
+                    ),
+                ));
+            }
+        }
+        let [a, b, c] = t.map(|v| (v as usize + placed.base) as u32);
+        let t = if placed.flip { [a, c, b] } else { [a, b, c] };
+        push_triangle(&mut self.triangles, t, r.what, r.opts.max_faces)
+    }
 
-            let flip = det3(world) < 0.0;
-            let mut emit = |t: [u64; 3], k: usize| -> Result<()> {
-                for &v in &t {
-                    if v >= n as u64 {
-                        return Err(Error::input(
-                            what,
-                            format!("{ctx}: triangle {k} has vertex index {v} out of range ({n} vertices)"),
-                        ));
-                    }
-                }
-                let [a, b, c] = t.map(|v| (v as usize + base) as u32);
-                let t = if flip { [a, c, b] } else { [a, b, c] };
-                push_triangle(&mut triangles, t, what, opts.max_faces)
-            };
-            let index_reader = match &index_acc {
-                Some(acc) => {
-                    let ix = open(acc, &buffers, what)?;
-                    if ix.dims != 1 || ix.ty == DataType::F32 {
-                        return Err(Error::input(
-                            what,
-                            format!("{ctx}: indices must be unsigned integer scalars"),
-                        ));
-                    }
-                    Some(ix)
-                }
-                None => None,
-            };
-            let count = index_reader.as_ref().map_or(n, |ix| ix.count);
-            let at = |i: usize| index_reader.as_ref().map_or(i as u64, |ix| ix.index(i));
-            match mode {
-                Mode::Triangles => {
-                    for k in 0..count / 3 {
-                        emit([at(3 * k), at(3 * k + 1), at(3 * k + 2)], k)?;
-                    }
-                }
-                Mode::TriangleStrip => {
-                    for k in 0..count.saturating_sub(2) {
-                        let t = if k % 2 == 0 {
-                            [at(k), at(k + 1), at(k + 2)]
-                        } else {
-                            [at(k + 1), at(k), at(k + 2)]
-                        };
-                        if t[0] != t[1] && t[1] != t[2] && t[0] != t[2] {
-                            emit(t, k)?;
-                        }
-                    }
-                }
-                _ => {
-                    for k in 0..count.saturating_sub(2) {
-                        emit([at(0), at(k + 1), at(k + 2)], k)?;
-                    }
+    /// Notes what the primitive brings to the textured surface: its UVs, a
+    /// warning about unreadable ones, or triangles without any.
+    fn record_texture(
+        &mut self,
+        r: &mut Reading<'_, '_>,
+        texture: Option<BaseColour<'_>>,
+        uvs: Option<Result<Vec<[f32; 2]>>>,
+        placed: &Placed,
+    ) {
+        let triangles = placed.first_triangle..self.triangles.len();
+        match (texture, uvs) {
+            (Some(texture), Some(Ok(uvs))) => self.textured.push(TexturedPrimitive {
+                vertices: placed.base..placed.base + placed.n,
+                triangles,
+                image: texture.image,
+                uvs,
+            }),
+            (Some(_), Some(Err(e))) => {
+                if let Some(warnings) = r.warnings.as_mut() {
+                    warnings.push(format!(
+                        "{e}; its {} triangles are left out of the textured surface",
+                        triangles.len()
+                    ));
                 }
             }
-            match (texture, uvs) {
-                (Some((image, _, _)), Some(Ok(uvs))) => textured_prims.push(TexturedPrimitive {
-                    vertices: base..base + n,
-                    triangles: first_triangle..triangles.len(),
-                    image,
-                    uvs,
-                }),
-                (Some(_), Some(Err(e))) => {
-                    if let Some((_, warnings)) = textured.as_mut() {
-                        warnings.push(format!(
-                            "{e}; its {} triangles are left out of the textured surface",
-                            triangles.len() - first_triangle
-                        ));
-                    }
+            (Some(_), None) => self.without_uvs += triangles.len(),
+            _ => {}
+        }
+    }
+
+    /// The combined mesh (refused when it has no triangles) and its
+    /// textured primitives.
+    fn finish(self, what: &'static str) -> Result<(IndexedMesh, TexturedPrimitives)> {
+        if self.positions.is_empty() || self.triangles.is_empty() {
+            return Err(Error::input(
+                what,
+                "contains no triangle meshes (empty mesh)",
+            ));
+        }
+        let mesh = IndexedMesh {
+            positions: self.positions,
+            colors: self.any_colour.then_some(self.colors),
+            triangles: self.triangles,
+        };
+        let found = TexturedPrimitives {
+            primitives: self.textured,
+            without_uvs: self.without_uvs,
+        };
+        Ok((mesh, found))
+    }
+}
+
+/// Calls `emit(triangle, k)` for each triangle of a `TRIANGLES`,
+/// `TRIANGLE_STRIP` or `TRIANGLE_FAN` primitive with `count` vertex
+/// references, `at(i)` being reference `i`. Degenerate strip triangles
+/// (stitching) are dropped.
+fn for_each_triangle(
+    mode: Mode,
+    count: usize,
+    at: impl Fn(usize) -> u64,
+    mut emit: impl FnMut([u64; 3], usize) -> Result<()>,
+) -> Result<()> {
+    match mode {
+        Mode::Triangles => {
+            for k in 0..count / 3 {
+                emit([at(3 * k), at(3 * k + 1), at(3 * k + 2)], k)?;
+            }
+        }
+        Mode::TriangleStrip => {
+            for k in 0..count.saturating_sub(2) {
+                let t = if k % 2 == 0 {
+                    [at(k), at(k + 1), at(k + 2)]
+                } else {
+                    [at(k + 1), at(k), at(k + 2)]
+                };
+                if t[0] != t[1] && t[1] != t[2] && t[0] != t[2] {
+                    emit(t, k)?;
                 }
-                (Some(_), None) => without_uvs += triangles.len() - first_triangle,
-                _ => {}
+            }
+        }
+        _ => {
+            for k in 0..count.saturating_sub(2) {
+                emit([at(0), at(k + 1), at(k + 2)], k)?;
             }
         }
     }
-    if positions.is_empty() || triangles.is_empty() {
-        return Err(Error::input(
-            what,
-            "contains no triangle meshes (empty mesh)",
-        ));
-    }
-    let mesh = IndexedMesh {
-        positions,
-        colors: any_colour.then_some(colors),
-        triangles,
-    };
-    let Some((max_pixels, warnings)) = textured.as_mut() else {
-        return Ok((mesh, None));
-    };
-    if without_uvs > 0 {
-        warnings.push(format!(
-            "{without_uvs} {what} triangles have a base colour texture but not its TEXCOORD \
-             attribute; they are left out of the textured surface"
-        ));
-    }
-    // The image covering the most triangles (lowest index on a tie).
+    Ok(())
+}
+
+/// The image the textured primitives use most.
+struct ImageChoice {
+    image: usize,
+    /// Triangles that use it.
+    used: usize,
+    /// Triangles with any base colour image and texture coordinates.
+    textured: usize,
+}
+
+/// The image covering the most triangles (lowest index on a tie).
+fn most_used_image(primitives: &[TexturedPrimitive]) -> Option<ImageChoice> {
     let mut votes: Vec<(usize, usize)> = Vec::new();
-    for p in &textured_prims {
+    for p in primitives {
         match votes.iter_mut().find(|v| v.0 == p.image) {
             Some(v) => v.1 += p.triangles.len(),
             None => votes.push((p.image, p.triangles.len())),
         }
     }
-    let Some(&(image_index, used)) = votes
+    let &(image, used) = votes
         .iter()
-        .max_by(|a, b| a.1.cmp(&b.1).then_with(|| b.0.cmp(&a.0)))
-    else {
-        return Ok((mesh, None));
+        .max_by(|a, b| a.1.cmp(&b.1).then_with(|| b.0.cmp(&a.0)))?;
+    Some(ImageChoice {
+        image,
+        used,
+        textured: votes.iter().map(|v| v.1).sum(),
+    })
+}
+
+/// The textured surface of the most used base colour image, with warnings
+/// for the triangles it leaves out; `None` when there is no texture to read.
+fn read_surface(
+    doc: &gltf::Document,
+    mesh: &IndexedMesh,
+    found: &TexturedPrimitives,
+    buffers: &mut Buffers<'_>,
+    request: TextureRequest<'_>,
+) -> Result<Option<TexturedSurface>> {
+    let TextureRequest {
+        max_pixels,
+        warnings,
+    } = request;
+    let what = buffers.what;
+    if found.without_uvs > 0 {
+        warnings.push(format!(
+            "{} {what} triangles have a base colour texture but not its TEXCOORD \
+             attribute; they are left out of the textured surface",
+            found.without_uvs
+        ));
+    }
+    let Some(choice) = most_used_image(&found.primitives) else {
+        return Ok(None);
     };
-    let image = match load_image(&doc, image_index, &mut buffers, what, *max_pixels)? {
+    let image = match load_image(doc, choice.image, buffers, what, max_pixels)? {
         Ok(image) => image,
         Err(w) => {
             warnings.push(w);
-            return Ok((mesh, None));
+            return Ok(None);
         }
     };
-    let textured_total: usize = votes.iter().map(|v| v.1).sum();
-    if textured_total > used {
+    if choice.textured > choice.used {
         warnings.push(format!(
-            "{} {what} triangles use another base colour image than image {image_index}; \
+            "{} {what} triangles use another base colour image than image {}; \
              they are left out of the textured surface",
-            textured_total - used
+            choice.textured - choice.used,
+            choice.image
         ));
     }
+    Ok(Some(assemble_surface(
+        mesh,
+        &found.primitives,
+        &choice,
+        image,
+    )))
+}
 
-    let chosen = || textured_prims.iter().filter(|p| p.image == image_index);
+/// The primitives that use the chosen image, one after the other, with
+/// their vertices and triangles renumbered.
+fn assemble_surface(
+    mesh: &IndexedMesh,
+    primitives: &[TexturedPrimitive],
+    choice: &ImageChoice,
+    image: image::RgbImage,
+) -> TexturedSurface {
+    let chosen = || primitives.iter().filter(|p| p.image == choice.image);
     let nv: usize = chosen().map(|p| p.vertices.len()).sum();
     let mut surface = TexturedSurface {
         positions: Vec::with_capacity(nv),
         uvs: Vec::with_capacity(nv),
-        triangles: Vec::with_capacity(used),
+        triangles: Vec::with_capacity(choice.used),
         image,
     };
     for p in chosen() {
@@ -767,7 +994,7 @@ fn read_inner(
                 .map(|t| t.map(|v| v - from + offset)),
         );
     }
-    Ok((mesh, Some(surface)))
+    surface
 }
 
 /// A primitive's `TEXCOORD_<set>`, `n` finite values.

@@ -206,56 +206,10 @@ impl Reader<'_> {
             let mut parts = t.split(|&b| b == b'/');
             let v = parts.next().unwrap_or(t);
             if let Some(tex) = self.tex.as_mut() {
-                let vt = match parts.next() {
-                    Some(vt) if !vt.is_empty() && tex.broken.is_none() => {
-                        tex.corner(vt, no, face).unwrap_or_else(|e| {
-                            tex.broken = Some(e);
-                            NONE
-                        })
-                    }
-                    _ => NONE,
-                };
-                tex.corners.push(vt);
+                tex.push_corner(parts.next(), no, face);
             }
-            let s = token_str(v, no)?;
-            let i: i64 = s
-                .parse()
-                .map_err(|_| err(no, format!("face {}: bad vertex index {s:?}", face + 1)))?;
-            let index = match i {
-                0 => {
-                    return Err(err(
-                        no,
-                        format!("face {}: vertex index 0 (OBJ indices start at 1)", face + 1),
-                    ))
-                }
-                i if i < 0 => {
-                    let abs = nv + i;
-                    if abs < 0 {
-                        return Err(err(
-                            no,
-                            format!(
-                                "face {}: relative index {i} reaches before the first vertex \
-                                 (only {nv} vertices so far)",
-                                face + 1
-                            ),
-                        ));
-                    }
-                    abs
-                }
-                i => {
-                    if i > nv {
-                        if i > u32::MAX as i64 {
-                            return Err(err(
-                                no,
-                                format!("face {}: vertex index {i} is out of range", face + 1),
-                            ));
-                        }
-                        self.forward.push((no, face + 1, i));
-                    }
-                    i - 1
-                }
-            };
-            self.corners.push(index as u32);
+            let index = self.vertex_index(v, no, face, nv)?;
+            self.corners.push(index);
         }
         if self.corners.len() < 3 {
             return Err(err(
@@ -267,6 +221,55 @@ impl Reader<'_> {
                 ),
             ));
         }
+        self.push_fan()
+    }
+
+    /// A corner's vertex index `v`, 0-based, with `nv` vertices read so far
+    /// (forward references are checked at the end).
+    fn vertex_index(&mut self, v: &[u8], no: usize, face: usize, nv: i64) -> Result<u32> {
+        let s = token_str(v, no)?;
+        let i: i64 = s
+            .parse()
+            .map_err(|_| err(no, format!("face {}: bad vertex index {s:?}", face + 1)))?;
+        let index = match i {
+            0 => {
+                return Err(err(
+                    no,
+                    format!("face {}: vertex index 0 (OBJ indices start at 1)", face + 1),
+                ))
+            }
+            i if i < 0 => {
+                let abs = nv + i;
+                if abs < 0 {
+                    return Err(err(
+                        no,
+                        format!(
+                            "face {}: relative index {i} reaches before the first vertex \
+                             (only {nv} vertices so far)",
+                            face + 1
+                        ),
+                    ));
+                }
+                abs
+            }
+            i => {
+                if i > nv {
+                    if i > u32::MAX as i64 {
+                        return Err(err(
+                            no,
+                            format!("face {}: vertex index {i} is out of range", face + 1),
+                        ));
+                    }
+                    self.forward.push((no, face + 1, i));
+                }
+                i - 1
+            }
+        };
+        Ok(index as u32)
+    }
+
+    /// Fan-triangulates the face just read (`corners`).
+    fn push_fan(&mut self) -> Result<()> {
         let first = self.corners[0];
         for k in 2..self.corners.len() {
             let t = [first, self.corners[k - 1], self.corners[k]];
@@ -279,9 +282,81 @@ impl Reader<'_> {
         }
         Ok(())
     }
+
+    /// Reads every line, joining those that end in a backslash to the next.
+    fn read_lines(&mut self, bytes: &[u8]) -> Result<()> {
+        let mut joined: Vec<u8> = Vec::new();
+        let mut joined_from = 0usize;
+        for (i, raw) in bytes.split(|&b| b == b'\n').enumerate() {
+            let no = i + 1;
+            let raw = raw.strip_suffix(b"\r").unwrap_or(raw);
+            if let Some(body) = raw.trim_ascii_end().strip_suffix(b"\\") {
+                if joined.is_empty() {
+                    joined_from = no;
+                }
+                joined.extend_from_slice(body);
+                joined.push(b' ');
+                continue;
+            }
+            if joined.is_empty() {
+                self.line(raw, no)?;
+            } else {
+                joined.extend_from_slice(raw);
+                self.line(&joined, joined_from)?;
+                joined.clear();
+            }
+        }
+        if !joined.is_empty() {
+            self.line(&joined, joined_from)?;
+        }
+        Ok(())
+    }
+
+    /// Indices that referred forward, now that the whole file is read: a
+    /// vertex index past the end is an error, a texture coordinate index
+    /// past the end costs the texture.
+    fn check_forward_references(&mut self) -> Result<()> {
+        let nv = self.positions.len();
+        if let Some(&(line, face, i)) = self.forward.iter().find(|f| f.2 > nv as i64) {
+            return Err(err(
+                line,
+                format!(
+                    "face {face}: vertex index {i} is out of range: the file has {nv} vertices"
+                ),
+            ));
+        }
+        if let Some(tex) = self.tex.as_mut().filter(|t| t.broken.is_none()) {
+            let n = tex.uvs.len();
+            if let Some(&(line, face, i)) = tex.forward.iter().find(|f| f.2 > n as i64) {
+                tex.broken = Some(err(
+                    line,
+                    format!(
+                        "face {face}: texture coordinate index {i} is out of range: \
+                         the file has {n} texture coordinates"
+                    ),
+                ));
+            }
+        }
+        Ok(())
+    }
 }
 
 impl TexState {
+    /// Records a corner's `vt` index (`NONE` without one); an unreadable
+    /// one breaks the texture, not the geometry.
+    fn push_corner(&mut self, vt: Option<&[u8]>, no: usize, face: usize) {
+        let vt = match vt {
+            Some(vt) if !vt.is_empty() && self.broken.is_none() => {
+                self.corner(vt, no, face).unwrap_or_else(|e| {
+                    self.broken = Some(e);
+                    NONE
+                })
+            }
+            _ => NONE,
+        };
+        self.corners.push(vt);
+    }
+
     /// A corner's `vt` index, 0-based (forward references are checked at the end).
     fn corner(&mut self, vt: &[u8], no: usize, face: usize) -> Result<u32> {
         let s = token_str(vt, no)?;
@@ -363,51 +438,8 @@ fn parse(
         forward: Vec::new(),
         corners: Vec::new(),
     };
-    // Lines ending in a backslash continue on the next line.
-    let mut joined: Vec<u8> = Vec::new();
-    let mut joined_from = 0usize;
-    for (i, raw) in bytes.split(|&b| b == b'\n').enumerate() {
-        let no = i + 1;
-        let raw = raw.strip_suffix(b"\r").unwrap_or(raw);
-        if let Some(body) = raw.trim_ascii_end().strip_suffix(b"\\") {
-            if joined.is_empty() {
-                joined_from = no;
-            }
-            joined.extend_from_slice(body);
-            joined.push(b' ');
-            continue;
-        }
-        if joined.is_empty() {
-            r.line(raw, no)?;
-        } else {
-            joined.extend_from_slice(raw);
-            r.line(&joined, joined_from)?;
-            joined.clear();
-        }
-    }
-    if !joined.is_empty() {
-        r.line(&joined, joined_from)?;
-    }
-
-    let nv = r.positions.len();
-    if let Some(&(line, face, i)) = r.forward.iter().find(|f| f.2 > nv as i64) {
-        return Err(err(
-            line,
-            format!("face {face}: vertex index {i} is out of range: the file has {nv} vertices"),
-        ));
-    }
-    if let Some(tex) = r.tex.as_mut().filter(|t| t.broken.is_none()) {
-        let n = tex.uvs.len();
-        if let Some(&(line, face, i)) = tex.forward.iter().find(|f| f.2 > n as i64) {
-            tex.broken = Some(err(
-                line,
-                format!(
-                    "face {face}: texture coordinate index {i} is out of range: \
-                     the file has {n} texture coordinates"
-                ),
-            ));
-        }
-    }
+    r.read_lines(bytes)?;
+    r.check_forward_references()?;
     // Colours are 0–1 floats; files whose colours exceed 1 wrote 0–255.
     let colors = r.colors.map(|cols| {
         let scale = if r.max_colour > 1.0 { 1.0 / 255.0 } else { 1.0 };
@@ -452,10 +484,34 @@ pub(super) fn read_textured(
         warnings.push(format!("{e}; imported without texture"));
         return Ok((mesh, None));
     }
+    let maps = MaterialMaps::new(read_mtllibs(&tex.mtllibs, base, warnings)?, &tex.materials);
+    let Some(chosen) = most_used_map(&tex, &maps, warnings) else {
+        return Ok((mesh, None));
+    };
+    let Some(image) = load_map(base, chosen.reference, max_pixels, warnings)? else {
+        return Ok((mesh, None));
+    };
+    let left_out = mesh.triangles.len() - chosen.used;
+    if left_out > 0 {
+        warnings.push(format!(
+            "{left_out} of {} OBJ triangles have no texture coordinates or another material's \
+             texture; they are left out of the textured surface",
+            mesh.triangles.len()
+        ));
+    }
+    let surface = assemble_surface(&mesh, &tex, &maps, &chosen, image);
+    Ok((mesh, Some(surface)))
+}
 
-    // Material name → `map_Kd` reference, first definition winning.
+/// Material name → `map_Kd` reference of the `mtllib` files, first
+/// definition winning.
+fn read_mtllibs(
+    mtllibs: &[String],
+    base: &Path,
+    warnings: &mut Vec<String>,
+) -> Result<HashMap<String, String>> {
     let mut maps: HashMap<String, String> = HashMap::new();
-    for lib in &tex.mtllibs {
+    for lib in mtllibs {
         for path in mtllib_paths(base, lib, warnings) {
             match std::fs::read(&path) {
                 Ok(text) => parse_mtl(&text, &mut maps),
@@ -472,23 +528,58 @@ pub(super) fn read_textured(
             }
         }
     }
-    // Files without `usemtl` but with a single textured material use it.
-    let mut only: Option<&String> = None;
-    if tex.materials.is_empty() && maps.len() == 1 {
-        only = maps.values().next();
-    }
-    let map_of = |m: u32| -> Option<&String> {
-        match m {
-            NONE => only,
-            m => maps.get(tex.materials.get(m as usize)?),
-        }
-    };
+    Ok(maps)
+}
 
-    // The texture used by the most triangles (with texture coordinates) wins.
+/// The `map_Kd` of each `usemtl` material.
+struct MaterialMaps<'t> {
+    /// Material name → `map_Kd` reference.
+    maps: HashMap<String, String>,
+    /// `usemtl` names, by material index.
+    materials: &'t [String],
+    /// Files without `usemtl` but with a single textured material use it.
+    only: Option<String>,
+}
+
+impl<'t> MaterialMaps<'t> {
+    fn new(maps: HashMap<String, String>, materials: &'t [String]) -> Self {
+        let mut only = None;
+        if materials.is_empty() && maps.len() == 1 {
+            only = maps.values().next().cloned();
+        }
+        MaterialMaps {
+            maps,
+            materials,
+            only,
+        }
+    }
+
+    /// The `map_Kd` of material `m` (`NONE`: before any `usemtl`).
+    fn of(&self, m: u32) -> Option<&String> {
+        match m {
+            NONE => self.only.as_ref(),
+            m => self.maps.get(self.materials.get(m as usize)?),
+        }
+    }
+}
+
+/// The texture a textured surface is made for.
+struct ChosenMap<'m> {
+    reference: &'m String,
+    /// Triangles with texture coordinates that use it.
+    used: usize,
+}
+
+/// The texture used by the most triangles (with texture coordinates) wins.
+fn most_used_map<'m>(
+    tex: &TexState,
+    maps: &'m MaterialMaps<'_>,
+    warnings: &mut Vec<String>,
+) -> Option<ChosenMap<'m>> {
     let mut votes: HashMap<&String, usize> = HashMap::new();
     let mut without_uvs = 0usize;
     for (uv, &m) in tex.tri_uvs.iter().zip(&tex.tri_material) {
-        if let Some(map) = map_of(m) {
+        if let Some(map) = maps.of(m) {
             if uv.contains(&NONE) {
                 without_uvs += 1;
             } else {
@@ -507,8 +598,19 @@ pub(super) fn read_textured(
                     .to_string(),
             );
         }
-        return Ok((mesh, None));
+        return None;
     };
+    Some(ChosenMap { reference, used })
+}
+
+/// The image of `map_Kd reference`; `None` (with a warning) when it is
+/// refused, absent or in a format that is not read.
+fn load_map(
+    base: &Path,
+    reference: &str,
+    max_pixels: u64,
+    warnings: &mut Vec<String>,
+) -> Result<Option<image::RgbImage>> {
     let name = format!("map_Kd {reference:?}");
     let path = match texture::resolve(base, reference, &name) {
         Resolved::Inside(p) => p,
@@ -518,37 +620,38 @@ pub(super) fn read_textured(
         }
         Resolved::Refused(w) => {
             warnings.push(w);
-            return Ok((mesh, None));
+            return Ok(None);
         }
     };
-    let image = match texture::load(texture::Source::File(&path), &name, max_pixels)? {
-        Ok(image) => image,
+    match texture::load(texture::Source::File(&path), &name, max_pixels)? {
+        Ok(image) => Ok(Some(image)),
         Err(w) => {
             warnings.push(w);
-            return Ok((mesh, None));
+            Ok(None)
         }
-    };
-    let left_out = mesh.triangles.len() - used;
-    if left_out > 0 {
-        warnings.push(format!(
-            "{left_out} of {} OBJ triangles have no texture coordinates or another material's \
-             texture; they are left out of the textured surface",
-            mesh.triangles.len()
-        ));
     }
+}
 
-    // One surface vertex per distinct (v, vt) pair: UV seams stay open.
+/// The triangles that use the chosen texture, with one surface vertex per
+/// distinct (v, vt) pair: UV seams stay open.
+fn assemble_surface(
+    mesh: &IndexedMesh,
+    tex: &TexState,
+    maps: &MaterialMaps<'_>,
+    chosen: &ChosenMap<'_>,
+    image: image::RgbImage,
+) -> TexturedSurface {
     let mut index: HashMap<(u32, u32), u32> = HashMap::with_capacity(mesh.positions.len());
     let mut positions = Vec::with_capacity(mesh.positions.len());
     let mut uvs = Vec::with_capacity(mesh.positions.len());
-    let mut triangles = Vec::with_capacity(used);
+    let mut triangles = Vec::with_capacity(chosen.used);
     for ((t, uv), &m) in mesh
         .triangles
         .iter()
         .zip(&tex.tri_uvs)
         .zip(&tex.tri_material)
     {
-        if uv.contains(&NONE) || map_of(m) != Some(reference) {
+        if uv.contains(&NONE) || maps.of(m) != Some(chosen.reference) {
             continue;
         }
         let corner = |k: usize| (t[k], uv[k]);
@@ -565,13 +668,12 @@ pub(super) fn read_textured(
         }
         triangles.push(out);
     }
-    let surface = TexturedSurface {
+    TexturedSurface {
         positions,
         uvs,
         triangles,
         image,
-    };
-    Ok((mesh, Some(surface)))
+    }
 }
 
 /// The files an `mtllib` statement names. The whole argument is taken as

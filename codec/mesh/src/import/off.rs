@@ -111,24 +111,36 @@ fn number<T: std::str::FromStr>(t: &[u8], line: usize, what: &str) -> Result<T> 
 
 pub(super) fn read(bytes: &[u8], opts: &ImportOptions) -> Result<IndexedMesh> {
     let mut lines = Lines::new(bytes);
+    let header = read_header(&mut lines, opts)?;
+    let Vertices { positions, colors } = read_vertices(&mut lines, &header)?;
+    let triangles = read_faces(&mut lines, &header, opts)?;
+    finish(
+        WHAT,
+        IndexedMesh {
+            positions,
+            colors,
+            triangles,
+        },
+    )
+}
+
+/// What the first lines of an OFF file say.
+struct Header {
+    flags: Flags,
+    /// Vertex count, checked.
+    nv: usize,
+    /// Face count, checked.
+    nf: usize,
+}
+
+/// The keyword, and the vertex and face counts (on the keyword's line or
+/// the next) checked against the options and the bytes that remain.
+fn read_header(lines: &mut Lines<'_>, opts: &ImportOptions) -> Result<Header> {
     let (kw_line, first) = lines
         .next_line()
         .ok_or_else(|| Error::input(WHAT, "is empty"))?;
     let mut toks = tokens(first);
-    let word = toks.next().unwrap_or_default();
-    let flags = match parse_keyword(word) {
-        Some(Ok(f)) => f,
-        Some(Err(e)) => return Err(Error::Unsupported(format!("{WHAT}: {e}"))),
-        None => {
-            return Err(err(
-                kw_line,
-                format!(
-                    "not an OFF file: expected OFF or COFF, found {:?}",
-                    String::from_utf8_lossy(word)
-                ),
-            ))
-        }
-    };
+    let flags = keyword_flags(toks.next().unwrap_or_default(), kw_line)?;
     // Counts may follow the keyword on the same line.
     let mut rest: Vec<&[u8]> = toks.collect();
     if rest.first() == Some(&&b"BINARY"[..]) {
@@ -153,12 +165,41 @@ pub(super) fn read(bytes: &[u8], opts: &ImportOptions) -> Result<IndexedMesh> {
     let remaining = lines.remaining();
     let nv = check_count(WHAT, "vertices", nv, 6, remaining, opts.max_vertices)?;
     let nf = check_count(WHAT, "faces", nf, 8, remaining - nv * 6, opts.max_faces)?;
+    Ok(Header { flags, nv, nf })
+}
 
+/// The flags of the first word of the file, `kw_line`; anything but an
+/// `[ST][C][N]OFF` keyword is refused.
+fn keyword_flags(word: &[u8], kw_line: usize) -> Result<Flags> {
+    match parse_keyword(word) {
+        Some(Ok(f)) => Ok(f),
+        Some(Err(e)) => Err(Error::Unsupported(format!("{WHAT}: {e}"))),
+        None => Err(err(
+            kw_line,
+            format!(
+                "not an OFF file: expected OFF or COFF, found {:?}",
+                String::from_utf8_lossy(word)
+            ),
+        )),
+    }
+}
+
+/// What the vertex lines hold.
+struct Vertices {
+    positions: Vec<[f32; 3]>,
+    /// For a COFF file.
+    colors: Option<Vec<[u8; 3]>>,
+}
+
+/// The vertex lines: positions, and colours for a COFF file.
+fn read_vertices(lines: &mut Lines<'_>, header: &Header) -> Result<Vertices> {
+    let (flags, nv) = (&header.flags, header.nv);
     let mut positions = Vec::with_capacity(nv);
-    let mut raw_colours: Vec<[f32; 3]> = Vec::with_capacity(if flags.colour { nv } else { 0 });
-    let mut float_colours = false;
-    let mut max_colour = 0f32;
-    let skip = if flags.normal { 6 } else { 3 };
+    let mut colours = RawColours {
+        values: Vec::with_capacity(if flags.colour { nv } else { 0 }),
+        floats: false,
+        max: 0.0,
+    };
     for i in 0..nv {
         let (no, line) = lines.next_line().ok_or_else(|| {
             Error::input(
@@ -167,47 +208,78 @@ pub(super) fn read(bytes: &[u8], opts: &ImportOptions) -> Result<IndexedMesh> {
             )
         })?;
         let vals: Vec<&[u8]> = tokens(line).collect();
-        if vals.len() < 3 {
-            return Err(err(
-                no,
-                format!("vertex {i} has {} values, expected 3", vals.len()),
-            ));
-        }
-        let mut p = [0f32; 3];
-        for k in 0..3 {
-            p[k] = number(vals[k], no, "coordinate")?;
-        }
-        if !p.iter().all(|v| v.is_finite()) {
-            return Err(err(
-                no,
-                format!("vertex {i} has a non-finite coordinate {p:?}"),
-            ));
-        }
-        positions.push(p);
+        positions.push(vertex_position(&vals, i, no)?);
         if flags.colour {
-            let end = vals.len() - if flags.texture { 2 } else { 0 };
-            let c = vals.get(skip..end).unwrap_or_default();
-            if c.len() < 3 {
-                return Err(err(
-                    no,
-                    format!(
-                        "COFF vertex {i} has {} colour values, expected 3 or 4",
-                        c.len()
-                    ),
-                ));
-            }
-            let mut rgb = [0f32; 3];
-            for k in 0..3 {
-                rgb[k] = number(c[k], no, "colour value")?;
-                max_colour = max_colour.max(rgb[k]);
-                float_colours |= c[k].iter().any(|b| matches!(b, b'.' | b'e' | b'E'));
-            }
-            raw_colours.push(rgb);
+            colours.push(&vals, flags, i, no)?;
         }
     }
-    let float_colours = float_colours || max_colour <= 1.0;
-    let colors = flags.colour.then(|| {
-        raw_colours
+    Ok(Vertices {
+        positions,
+        colors: flags.colour.then(|| colours.to_srgb()),
+    })
+}
+
+/// The finite position of vertex `i`, the first three values of line `no`.
+fn vertex_position(vals: &[&[u8]], i: usize, no: usize) -> Result<[f32; 3]> {
+    if vals.len() < 3 {
+        return Err(err(
+            no,
+            format!("vertex {i} has {} values, expected 3", vals.len()),
+        ));
+    }
+    let mut p = [0f32; 3];
+    for k in 0..3 {
+        p[k] = number(vals[k], no, "coordinate")?;
+    }
+    if !p.iter().all(|v| v.is_finite()) {
+        return Err(err(
+            no,
+            format!("vertex {i} has a non-finite coordinate {p:?}"),
+        ));
+    }
+    Ok(p)
+}
+
+/// COFF vertex colours as written, until their scale is known.
+struct RawColours {
+    values: Vec<[f32; 3]>,
+    /// Some value is written with a `.` or an exponent.
+    floats: bool,
+    /// The largest value.
+    max: f32,
+}
+
+impl RawColours {
+    /// The colour of vertex `i` on line `no`: the values after the position
+    /// (and normal), before the texture coordinates.
+    fn push(&mut self, vals: &[&[u8]], flags: &Flags, i: usize, no: usize) -> Result<()> {
+        let skip = if flags.normal { 6 } else { 3 };
+        let end = vals.len() - if flags.texture { 2 } else { 0 };
+        let c = vals.get(skip..end).unwrap_or_default();
+        if c.len() < 3 {
+            return Err(err(
+                no,
+                format!(
+                    "COFF vertex {i} has {} colour values, expected 3 or 4",
+                    c.len()
+                ),
+            ));
+        }
+        let mut rgb = [0f32; 3];
+        for k in 0..3 {
+            rgb[k] = number(c[k], no, "colour value")?;
+            self.max = self.max.max(rgb[k]);
+            self.floats |= c[k].iter().any(|b| matches!(b, b'.' | b'e' | b'E'));
+        }
+        self.values.push(rgb);
+        Ok(())
+    }
+
+    /// 8-bit colours: the values are 0–1 floats when any is written as a
+    /// float or all are ≤ 1, 0–255 integers otherwise.
+    fn to_srgb(&self) -> Vec<[u8; 3]> {
+        let float_colours = self.floats || self.max <= 1.0;
+        self.values
             .iter()
             .map(|c| {
                 c.map(|v| {
@@ -219,8 +291,16 @@ pub(super) fn read(bytes: &[u8], opts: &ImportOptions) -> Result<IndexedMesh> {
                 })
             })
             .collect()
-    });
+    }
+}
 
+/// The face lines, fan-triangulated (face colours are ignored).
+fn read_faces(
+    lines: &mut Lines<'_>,
+    header: &Header,
+    opts: &ImportOptions,
+) -> Result<Vec<[u32; 3]>> {
+    let nf = header.nf;
     let mut triangles = Vec::with_capacity(nf);
     for f in 0..nf {
         let (no, line) = lines.next_line().ok_or_else(|| {
@@ -229,39 +309,42 @@ pub(super) fn read(bytes: &[u8], opts: &ImportOptions) -> Result<IndexedMesh> {
                 format!("truncated: the file ends after {f} of {nf} faces"),
             )
         })?;
-        let mut toks = tokens(line);
-        let n: u64 = number(toks.next().unwrap_or_default(), no, "face vertex count")?;
-        let (mut first, mut prev) = (0u32, 0u32);
-        for j in 0..n {
-            let t = toks
-                .next()
-                .ok_or_else(|| err(no, format!("face {f} declares {n} vertices but lists {j}")))?;
-            let v: i64 = number(t, no, "vertex index")?;
-            if v < 0 || v as u64 >= nv as u64 {
-                return Err(err(
-                    no,
-                    format!(
-                        "face {f}: vertex index {v} is out of range: the file has {nv} vertices"
-                    ),
-                ));
-            }
-            let v = v as u32;
-            match j {
-                0 => first = v,
-                1 => {}
-                _ => push_triangle(&mut triangles, [first, prev, v], WHAT, opts.max_faces)?,
-            }
-            prev = v;
-        }
+        read_face(line, (f, no), header.nv, &mut triangles, opts)?;
     }
-    finish(
-        WHAT,
-        IndexedMesh {
-            positions,
-            colors,
-            triangles,
-        },
-    )
+    Ok(triangles)
+}
+
+/// Face `f` on line `no`: `n i0 … i(n-1)`, its fan appended to `triangles`.
+fn read_face(
+    line: &[u8],
+    (f, no): (usize, usize),
+    nv: usize,
+    triangles: &mut Vec<[u32; 3]>,
+    opts: &ImportOptions,
+) -> Result<()> {
+    let mut toks = tokens(line);
+    let n: u64 = number(toks.next().unwrap_or_default(), no, "face vertex count")?;
+    let (mut first, mut prev) = (0u32, 0u32);
+    for j in 0..n {
+        let t = toks
+            .next()
+            .ok_or_else(|| err(no, format!("face {f} declares {n} vertices but lists {j}")))?;
+        let v: i64 = number(t, no, "vertex index")?;
+        if v < 0 || v as u64 >= nv as u64 {
+            return Err(err(
+                no,
+                format!("face {f}: vertex index {v} is out of range: the file has {nv} vertices"),
+            ));
+        }
+        let v = v as u32;
+        match j {
+            0 => first = v,
+            1 => {}
+            _ => push_triangle(triangles, [first, prev, v], WHAT, opts.max_faces)?,
+        }
+        prev = v;
+    }
+    Ok(())
 }
 
 #[cfg(test)]

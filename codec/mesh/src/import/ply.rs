@@ -143,59 +143,13 @@ fn parse_header(bytes: &[u8]) -> Result<Header> {
         };
         match keyword {
             "comment" | "obj_info" => {}
-            "format" => {
-                encoding = Some(match words.next() {
-                    Some("ascii") => Encoding::Ascii,
-                    Some("binary_little_endian") => Encoding::LittleEndian,
-                    Some("binary_big_endian") => Encoding::BigEndian,
-                    other => {
-                        return Err(header_err(
-                            line_no,
-                            format!("unknown format {:?}", other.unwrap_or("")),
-                        ))
-                    }
-                });
-            }
-            "element" => {
-                let (Some(name), Some(count)) = (words.next(), words.next()) else {
-                    return Err(header_err(line_no, "expected \"element NAME COUNT\""));
-                };
-                let count: u64 = count.parse().map_err(|_| {
-                    header_err(line_no, format!("element {name}: bad count {count:?}"))
-                })?;
-                elements.push(Element {
-                    name: name.to_string(),
-                    count,
-                    props: Vec::new(),
-                });
-            }
+            "format" => encoding = Some(parse_format(words.next(), line_no)?),
+            "element" => elements.push(parse_element(words, line_no)?),
             "property" => {
                 let Some(element) = elements.last_mut() else {
                     return Err(header_err(line_no, "property before any element"));
                 };
-                let ty = |s: Option<&str>| -> Result<Ty> {
-                    let s = s.unwrap_or("");
-                    Ty::parse(s)
-                        .ok_or_else(|| header_err(line_no, format!("unknown property type {s:?}")))
-                };
-                let first = words.next();
-                let (kind, name) = if first == Some("list") {
-                    let count = ty(words.next())?;
-                    let item = ty(words.next())?;
-                    if matches!(count, Ty::F32 | Ty::F64) {
-                        return Err(header_err(line_no, "list count type must be an integer"));
-                    }
-                    (Kind::List { count, item }, words.next())
-                } else {
-                    (Kind::Scalar(ty(first)?), words.next())
-                };
-                let Some(name) = name else {
-                    return Err(header_err(line_no, "property has no name"));
-                };
-                element.props.push(Property {
-                    name: name.to_string(),
-                    kind,
-                });
+                element.props.push(parse_property(words, line_no)?);
             }
             "end_header" => break,
             other => {
@@ -208,6 +162,66 @@ fn parse_header(bytes: &[u8]) -> Result<Header> {
         encoding,
         elements,
         data_start: pos,
+    })
+}
+
+/// `format ENCODING VERSION`: the encoding word.
+fn parse_format(word: Option<&str>, line_no: usize) -> Result<Encoding> {
+    Ok(match word {
+        Some("ascii") => Encoding::Ascii,
+        Some("binary_little_endian") => Encoding::LittleEndian,
+        Some("binary_big_endian") => Encoding::BigEndian,
+        other => {
+            return Err(header_err(
+                line_no,
+                format!("unknown format {:?}", other.unwrap_or("")),
+            ))
+        }
+    })
+}
+
+/// `element NAME COUNT`: the words after the keyword.
+fn parse_element<'a>(mut words: impl Iterator<Item = &'a str>, line_no: usize) -> Result<Element> {
+    let (Some(name), Some(count)) = (words.next(), words.next()) else {
+        return Err(header_err(line_no, "expected \"element NAME COUNT\""));
+    };
+    let count: u64 = count
+        .parse()
+        .map_err(|_| header_err(line_no, format!("element {name}: bad count {count:?}")))?;
+    Ok(Element {
+        name: name.to_string(),
+        count,
+        props: Vec::new(),
+    })
+}
+
+/// `property TYPE NAME` or `property list COUNT_TYPE ITEM_TYPE NAME`: the
+/// words after the keyword.
+fn parse_property<'a>(
+    mut words: impl Iterator<Item = &'a str>,
+    line_no: usize,
+) -> Result<Property> {
+    let ty = |s: Option<&str>| -> Result<Ty> {
+        let s = s.unwrap_or("");
+        Ty::parse(s).ok_or_else(|| header_err(line_no, format!("unknown property type {s:?}")))
+    };
+    let first = words.next();
+    let (kind, name) = if first == Some("list") {
+        let count = ty(words.next())?;
+        let item = ty(words.next())?;
+        if matches!(count, Ty::F32 | Ty::F64) {
+            return Err(header_err(line_no, "list count type must be an integer"));
+        }
+        (Kind::List { count, item }, words.next())
+    } else {
+        (Kind::Scalar(ty(first)?), words.next())
+    };
+    let Some(name) = name else {
+        return Err(header_err(line_no, "property has no name"));
+    };
+    Ok(Property {
+        name: name.to_string(),
+        kind,
     })
 }
 
@@ -453,16 +467,45 @@ fn read_payload<S: Source>(
     payload_len: usize,
     opts: &ImportOptions,
 ) -> Result<IndexedMesh> {
-    let ascii = header.encoding == Encoding::Ascii;
     let vertex_pos = header
         .elements
         .iter()
         .position(|e| e.name == "vertex")
         .ok_or_else(|| Error::input(WHAT, "has no \"vertex\" element"))?;
+    let counts = check_counts(header, payload_len, opts)?;
+    let n_vertices = counts[vertex_pos];
 
-    // Check every count against the payload before reserving anything: the
-    // records of all elements together must fit in the bytes after the header.
-    // (An ascii record's last token may lack a separator: allow one byte.)
+    let mut mesh = IndexedMesh {
+        positions: Vec::new(),
+        colors: None,
+        triangles: Vec::new(),
+    };
+    let mut seen_vertex = false;
+    for (element, &count) in header.elements.iter().zip(&counts) {
+        let records = Records { element, count };
+        match element.name.as_str() {
+            "vertex" if !seen_vertex => {
+                seen_vertex = true;
+                mesh.colors = read_vertices(records, src, &mut mesh.positions)?;
+            }
+            "face" | "tristrips" => {
+                let faces = Faces::new(records, n_vertices)?;
+                faces.read(src, &mut mesh.triangles, opts)?;
+            }
+            _ if element.props.is_empty() => {} // no payload at all
+            // Unknown element (or a second vertex element): skip its records.
+            _ => skip_records(records, src)?,
+        }
+    }
+    debug_assert_eq!(mesh.positions.len(), n_vertices);
+    finish(WHAT, mesh)
+}
+
+/// Every element's count, checked before anything is reserved: the records
+/// of all elements together must fit in the bytes after the header.
+fn check_counts(header: &Header, payload_len: usize, opts: &ImportOptions) -> Result<Vec<usize>> {
+    let ascii = header.encoding == Encoding::Ascii;
+    // An ascii record's last token may lack a separator: allow one byte.
     let mut budget = payload_len + usize::from(ascii);
     let mut counts = Vec::with_capacity(header.elements.len());
     for e in &header.elements {
@@ -481,183 +524,248 @@ fn read_payload<S: Source>(
         budget -= e.count.saturating_mul(min) as usize;
         counts.push(n);
     }
-    let n_vertices = counts[vertex_pos];
+    Ok(counts)
+}
 
-    let mut positions: Vec<[f32; 3]> = Vec::new();
-    let mut colors: Option<Vec<[u8; 3]>> = None;
-    let mut triangles: Vec<[u32; 3]> = Vec::new();
-    let mut seen_vertex = false;
+/// The records of one element, for error messages.
+#[derive(Clone, Copy)]
+struct Records<'h> {
+    element: &'h Element,
+    /// Its checked count.
+    count: usize,
+}
 
-    for (e, &count) in header.elements.iter().zip(&counts) {
-        let ctx = |i: usize, src: &S, f: Fail| -> Error {
-            match f {
-                Fail::Eof => Error::input(
-                    WHAT,
-                    format!(
-                        "truncated: the file ends inside {} {i} of {count} ({})",
-                        e.name,
-                        src.location()
-                    ),
+impl Records<'_> {
+    /// The error for a failed read in record `i`.
+    fn fail<S: Source>(&self, i: usize, src: &S, f: Fail) -> Error {
+        let (name, count) = (&self.element.name, self.count);
+        match f {
+            Fail::Eof => Error::input(
+                WHAT,
+                format!(
+                    "truncated: the file ends inside {name} {i} of {count} ({})",
+                    src.location()
                 ),
-                Fail::Number(t) => Error::input(
-                    WHAT,
-                    format!("{} {i} ({}): bad number {t:?}", e.name, src.location()),
+            ),
+            Fail::Number(t) => Error::input(
+                WHAT,
+                format!("{name} {i} ({}): bad number {t:?}", src.location()),
+            ),
+        }
+    }
+}
+
+/// The roles of the vertex element's properties, and whether it has all
+/// three colour channels. Refused without scalar `x`, `y` and `z`.
+fn vertex_roles(e: &Element) -> Result<(Vec<Role>, bool)> {
+    let roles: Vec<Role> = e
+        .props
+        .iter()
+        .map(|p| match (p.name.as_str(), p.kind) {
+            ("x", Kind::Scalar(_)) => Role::Coord(0),
+            ("y", Kind::Scalar(_)) => Role::Coord(1),
+            ("z", Kind::Scalar(_)) => Role::Coord(2),
+            (n, Kind::Scalar(_)) if colour_channel(n).is_some() => {
+                Role::Colour(colour_channel(n).unwrap_or(0))
+            }
+            _ => Role::Skip,
+        })
+        .collect();
+    for axis in 0..3 {
+        if !roles
+            .iter()
+            .any(|r| matches!(r, Role::Coord(a) if *a == axis))
+        {
+            return Err(Error::input(
+                WHAT,
+                format!(
+                    "vertex element has no scalar \"{}\" property",
+                    ["x", "y", "z"][axis]
                 ),
+            ));
+        }
+    }
+    let has_colour = (0..3).all(|c| {
+        roles
+            .iter()
+            .any(|r| matches!(r, Role::Colour(k) if *k == c))
+    });
+    Ok((roles, has_colour))
+}
+
+/// Reads the vertex element into `positions`; returns the colours when it
+/// has them.
+fn read_vertices<S: Source>(
+    records: Records<'_>,
+    src: &mut S,
+    positions: &mut Vec<[f32; 3]>,
+) -> Result<Option<Vec<[u8; 3]>>> {
+    let (roles, has_colour) = vertex_roles(records.element)?;
+    let count = records.count;
+    positions.reserve_exact(count);
+    let mut cols = has_colour.then(|| Vec::with_capacity(count));
+    for i in 0..count {
+        let (p, c) = read_vertex(records, &roles, i, src)?;
+        positions.push(p);
+        if let Some(cols) = cols.as_mut() {
+            cols.push(c);
+        }
+    }
+    Ok(cols)
+}
+
+/// Vertex `i`: its position (finite) and colour (black without one).
+fn read_vertex<S: Source>(
+    records: Records<'_>,
+    roles: &[Role],
+    i: usize,
+    src: &mut S,
+) -> Result<([f32; 3], [u8; 3])> {
+    let mut p = [0f32; 3];
+    let mut c = [0u8; 3];
+    for (prop, role) in records.element.props.iter().zip(roles) {
+        match (*role, prop.kind) {
+            (Role::Coord(a), Kind::Scalar(t)) => {
+                p[a] = src.coord(t).map_err(|f| records.fail(i, src, f))?
             }
-        };
-        match e.name.as_str() {
-            "vertex" if !seen_vertex => {
-                seen_vertex = true;
-                let roles: Vec<Role> = e
-                    .props
-                    .iter()
-                    .map(|p| match (p.name.as_str(), p.kind) {
-                        ("x", Kind::Scalar(_)) => Role::Coord(0),
-                        ("y", Kind::Scalar(_)) => Role::Coord(1),
-                        ("z", Kind::Scalar(_)) => Role::Coord(2),
-                        (n, Kind::Scalar(_)) if colour_channel(n).is_some() => {
-                            Role::Colour(colour_channel(n).unwrap_or(0))
-                        }
-                        _ => Role::Skip,
-                    })
-                    .collect();
-                for axis in 0..3 {
-                    if !roles
-                        .iter()
-                        .any(|r| matches!(r, Role::Coord(a) if *a == axis))
-                    {
-                        return Err(Error::input(
-                            WHAT,
-                            format!(
-                                "vertex element has no scalar \"{}\" property",
-                                ["x", "y", "z"][axis]
-                            ),
-                        ));
-                    }
-                }
-                let has_colour = (0..3).all(|c| {
-                    roles
-                        .iter()
-                        .any(|r| matches!(r, Role::Colour(k) if *k == c))
-                });
-                positions.reserve_exact(count);
-                let mut cols = has_colour.then(|| Vec::with_capacity(count));
-                for i in 0..count {
-                    let mut p = [0f32; 3];
-                    let mut c = [0u8; 3];
-                    for (prop, role) in e.props.iter().zip(&roles) {
-                        match (*role, prop.kind) {
-                            (Role::Coord(a), Kind::Scalar(t)) => {
-                                p[a] = src.coord(t).map_err(|f| ctx(i, src, f))?
-                            }
-                            (Role::Colour(k), Kind::Scalar(t)) => {
-                                c[k] = colour_u8(src.real(t).map_err(|f| ctx(i, src, f))?, t)
-                            }
-                            (_, kind) => skip(src, kind).map_err(|f| ctx(i, src, f))?,
-                        }
-                    }
-                    if !p.iter().all(|v| v.is_finite()) {
-                        return Err(Error::input(
-                            WHAT,
-                            format!(
-                                "vertex {i} ({}) has a non-finite coordinate {p:?}",
-                                src.location()
-                            ),
-                        ));
-                    }
-                    positions.push(p);
-                    if let Some(cols) = cols.as_mut() {
-                        cols.push(c);
-                    }
-                }
-                colors = cols;
+            (Role::Colour(k), Kind::Scalar(t)) => {
+                c[k] = colour_u8(src.real(t).map_err(|f| records.fail(i, src, f))?, t)
             }
-            "face" | "tristrips" => {
-                let strips = e.name == "tristrips";
-                let roles: Vec<Role> = e
-                    .props
-                    .iter()
-                    .map(|p| match (p.name.as_str(), p.kind) {
-                        ("vertex_indices" | "vertex_index", Kind::List { .. }) => Role::Indices,
-                        _ => Role::Skip,
-                    })
-                    .collect();
-                if !roles.iter().any(|r| matches!(r, Role::Indices)) {
-                    return Err(Error::input(
-                        WHAT,
-                        format!("{} element has no vertex_indices list", e.name),
-                    ));
-                }
-                if triangles.is_empty() {
-                    // Reasonable first guess, bounded by what the file can hold.
-                    triangles.reserve(if strips { 0 } else { count });
-                }
-                for i in 0..count {
-                    // A second index list in the same element is skipped.
-                    let mut done_indices = false;
-                    for (prop, role) in e.props.iter().zip(&roles) {
-                        match (*role, prop.kind) {
-                            (Role::Indices, Kind::List { count: ct, item }) if !done_indices => {
-                                done_indices = true;
-                                let k = src.int(ct).map_err(|f| ctx(i, src, f))?;
-                                if k < 0 {
-                                    return Err(Error::input(
-                                        WHAT,
-                                        format!(
-                                            "{} {i} ({}): negative list length {k}",
-                                            e.name,
-                                            src.location()
-                                        ),
-                                    ));
-                                }
-                                let mut idx = |j: u64, src: &mut S| -> Result<Option<u32>> {
-                                    let v = src.int(item).map_err(|f| ctx(i, src, f))?;
-                                    if strips && v == -1 {
-                                        return Ok(None);
-                                    }
-                                    if v < 0 || v as u64 >= n_vertices as u64 {
-                                        return Err(Error::input(
-                                            WHAT,
-                                            format!(
-                                                "{} {i} ({}): vertex index {v} (entry {j}) is out of range: the file has {n_vertices} vertices",
-                                                e.name,
-                                                src.location()
-                                            ),
-                                        ));
-                                    }
-                                    Ok(Some(v as u32))
-                                };
-                                if strips {
-                                    read_strip(k as u64, &mut idx, src, &mut triangles, opts)?;
-                                } else {
-                                    read_polygon(k as u64, &mut idx, src, &mut triangles, opts)?;
-                                }
-                            }
-                            (_, kind) => skip(src, kind).map_err(|f| ctx(i, src, f))?,
-                        }
+            (_, kind) => skip(src, kind).map_err(|f| records.fail(i, src, f))?,
+        }
+    }
+    if !p.iter().all(|v| v.is_finite()) {
+        return Err(Error::input(
+            WHAT,
+            format!(
+                "vertex {i} ({}) has a non-finite coordinate {p:?}",
+                src.location()
+            ),
+        ));
+    }
+    Ok((p, c))
+}
+
+/// A `face` or `tristrips` element: polygons or strips of vertex indices.
+struct Faces<'h> {
+    records: Records<'h>,
+    roles: Vec<Role>,
+    strips: bool,
+    n_vertices: usize,
+}
+
+impl<'h> Faces<'h> {
+    /// Refused without a `vertex_indices` (or `vertex_index`) list.
+    fn new(records: Records<'h>, n_vertices: usize) -> Result<Self> {
+        let e = records.element;
+        let roles: Vec<Role> = e
+            .props
+            .iter()
+            .map(|p| match (p.name.as_str(), p.kind) {
+                ("vertex_indices" | "vertex_index", Kind::List { .. }) => Role::Indices,
+                _ => Role::Skip,
+            })
+            .collect();
+        if !roles.iter().any(|r| matches!(r, Role::Indices)) {
+            return Err(Error::input(
+                WHAT,
+                format!("{} element has no vertex_indices list", e.name),
+            ));
+        }
+        Ok(Faces {
+            records,
+            roles,
+            strips: e.name == "tristrips",
+            n_vertices,
+        })
+    }
+
+    /// Reads every record, its polygons or strips appended to `triangles`.
+    fn read<S: Source>(
+        &self,
+        src: &mut S,
+        triangles: &mut Vec<[u32; 3]>,
+        opts: &ImportOptions,
+    ) -> Result<()> {
+        if triangles.is_empty() {
+            // Reasonable first guess, bounded by what the file can hold.
+            triangles.reserve(if self.strips { 0 } else { self.records.count });
+        }
+        for i in 0..self.records.count {
+            // A second index list in the same element is skipped.
+            let mut done_indices = false;
+            for (prop, role) in self.records.element.props.iter().zip(&self.roles) {
+                match (*role, prop.kind) {
+                    (Role::Indices, Kind::List { count, item }) if !done_indices => {
+                        done_indices = true;
+                        let list = ListTypes { count, item };
+                        self.read_indices(i, list, src, triangles, opts)?;
                     }
-                }
-            }
-            _ if e.props.is_empty() => {} // no payload at all
-            _ => {
-                // Unknown element (or a second vertex element): skip its records.
-                for i in 0..count {
-                    for prop in &e.props {
-                        skip(src, prop.kind).map_err(|f| ctx(i, src, f))?;
-                    }
+                    (_, kind) => skip(src, kind).map_err(|f| self.records.fail(i, src, f))?,
                 }
             }
         }
+        Ok(())
     }
-    debug_assert_eq!(positions.len(), n_vertices);
-    finish(
-        WHAT,
-        IndexedMesh {
-            positions,
-            colors,
-            triangles,
-        },
-    )
+
+    /// The index list of record `i`, triangulated into `triangles`.
+    fn read_indices<S: Source>(
+        &self,
+        i: usize,
+        list: ListTypes,
+        src: &mut S,
+        triangles: &mut Vec<[u32; 3]>,
+        opts: &ImportOptions,
+    ) -> Result<()> {
+        let records = self.records;
+        let name = &records.element.name;
+        let k = src.int(list.count).map_err(|f| records.fail(i, src, f))?;
+        if k < 0 {
+            return Err(Error::input(
+                WHAT,
+                format!("{name} {i} ({}): negative list length {k}", src.location()),
+            ));
+        }
+        let (strips, n_vertices) = (self.strips, self.n_vertices);
+        let mut idx = |j: u64, src: &mut S| -> Result<Option<u32>> {
+            let v = src.int(list.item).map_err(|f| records.fail(i, src, f))?;
+            if strips && v == -1 {
+                return Ok(None);
+            }
+            if v < 0 || v as u64 >= n_vertices as u64 {
+                return Err(Error::input(
+                    WHAT,
+                    format!(
+                        "{name} {i} ({}): vertex index {v} (entry {j}) is out of range: the file has {n_vertices} vertices",
+                        src.location()
+                    ),
+                ));
+            }
+            Ok(Some(v as u32))
+        };
+        if strips {
+            read_strip(k as u64, &mut idx, src, triangles, opts)
+        } else {
+            read_polygon(k as u64, &mut idx, src, triangles, opts)
+        }
+    }
+}
+
+/// The types of a list property: its length and its items.
+#[derive(Clone, Copy)]
+struct ListTypes {
+    count: Ty,
+    item: Ty,
+}
+
+/// Skips every record of an element that is not read.
+fn skip_records<S: Source>(records: Records<'_>, src: &mut S) -> Result<()> {
+    for i in 0..records.count {
+        for prop in &records.element.props {
+            skip(src, prop.kind).map_err(|f| records.fail(i, src, f))?;
+        }
+    }
+    Ok(())
 }
 
 fn skip<S: Source>(src: &mut S, kind: Kind) -> Result<(), Fail> {
