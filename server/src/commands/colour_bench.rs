@@ -117,19 +117,22 @@ fn bench_mesh(path: &Path, args: &ColourBenchArgs, tables: &mut Tables) -> anyho
         runs.push(run);
     }
     mode_rows(tables, &name, &runs, plain_conn)?;
+    write_curves(&args.out, &name, &runs)?;
+    eprintln!("  unguarded connectivity {plain_conn:.3} b/v");
+    Ok(())
+}
+
+/// Every level of every mode as `NAME.json`, and the curves as `NAME.svg`.
+fn write_curves(out: &Path, name: &str, runs: &[ModeRun]) -> anyhow::Result<()> {
     let json: Vec<_> = runs
         .iter()
         .map(|r| serde_json::json!({ "mode": r.mode, "levels": r.quality }))
         .collect();
     std::fs::write(
-        args.out.join(format!("{name}.json")),
+        out.join(format!("{name}.json")),
         serde_json::to_string_pretty(&json)?,
     )?;
-    std::fs::write(
-        args.out.join(format!("{name}.svg")),
-        curves_svg(&name, &runs),
-    )?;
-    eprintln!("  unguarded connectivity {plain_conn:.3} b/v");
+    std::fs::write(out.join(format!("{name}.svg")), curves_svg(name, runs))?;
     Ok(())
 }
 
@@ -276,6 +279,41 @@ fn curves_svg(name: &str, runs: &[ModeRun]) -> String {
     svg
 }
 
+/// Where a panel's values land: x on a log scale over the vertex counts, y
+/// linear from 0 to a little above the largest value.
+struct Scale {
+    x0: f64,
+    xmin: f64,
+    xmax: f64,
+    ymax: f64,
+}
+
+impl Scale {
+    fn over(x0: f64, points: &[(f64, f64)]) -> Scale {
+        let (xmin, xmax) = points
+            .iter()
+            .fold((f64::INFINITY, 0.0f64), |(a, b), &(x, _)| {
+                (a.min(x), b.max(x))
+            });
+        let ymax = points.iter().fold(0.0f64, |m, &(_, y)| m.max(y)).max(1e-9) * 1.05;
+        Scale {
+            x0,
+            xmin,
+            xmax,
+            ymax,
+        }
+    }
+
+    fn x(&self, x: f64) -> f64 {
+        let (lo, hi) = (self.xmin.ln(), self.xmax.ln());
+        self.x0 + PAD + (x.ln() - lo) / (hi - lo).max(1e-9) * (W - 1.5 * PAD)
+    }
+
+    fn y(&self, y: f64) -> f64 {
+        30.0 + (H - PAD) * (1.0 - y / self.ymax)
+    }
+}
+
 /// One panel at `x0`: axes, their end labels, and a line per mode.
 fn panel_svg(svg: &mut String, x0: f64, title: &str, value: Metric, runs: &[ModeRun]) {
     let colours = ["#d1495b", "#00798c", "#edae49"];
@@ -287,49 +325,20 @@ fn panel_svg(svg: &mut String, x0: f64, title: &str, value: Metric, runs: &[Mode
                 .filter_map(|q| value(q).map(|v| (q.vertices as f64, v)))
         })
         .collect();
-    let (xmin, xmax) = points
-        .iter()
-        .fold((f64::INFINITY, 0.0f64), |(a, b), &(x, _)| {
-            (a.min(x), b.max(x))
-        });
-    let ymax = points.iter().fold(0.0f64, |m, &(_, y)| m.max(y)).max(1e-9) * 1.05;
-    let sx = |x: f64| {
-        x0 + PAD + (x.ln() - xmin.ln()) / (xmax.ln() - xmin.ln()).max(1e-9) * (W - 1.5 * PAD)
-    };
-    let sy = |y: f64| 30.0 + (H - PAD) * (1.0 - y / ymax);
-    writeln!(svg, "<text x='{}' y='40'>{title}</text>", x0 + PAD).ok();
-    writeln!(
-        svg,
-        "<line x1='{0}' y1='{2}' x2='{1}' y2='{2}' stroke='#444'/><line x1='{0}' y1='30' x2='{0}' y2='{2}' stroke='#444'/>",
-        x0 + PAD,
-        x0 + W - PAD / 2.0,
-        sy(0.0)
-    )
-    .ok();
-    writeln!(
-        svg,
-        "<text x='{}' y='{}'>{:.0}</text><text x='{}' y='{}' text-anchor='end'>{:.0}</text>",
-        x0 + PAD,
-        sy(0.0) + 14.0,
-        xmin,
-        x0 + W - PAD / 2.0,
-        sy(0.0) + 14.0,
-        xmax
-    )
-    .ok();
-    writeln!(
-        svg,
-        "<text x='{}' y='{}' text-anchor='end'>{:.1}</text>",
-        x0 + PAD - 4.0,
-        sy(ymax / 1.05) + 4.0,
-        ymax / 1.05
-    )
-    .ok();
+    let scale = Scale::over(x0, &points);
+    axes_svg(svg, title, &scale);
     for (i, r) in runs.iter().enumerate() {
         let pts: Vec<String> = r
             .quality
             .iter()
-            .filter_map(|q| value(q).map(|v| format!("{:.1},{:.1}", sx(q.vertices as f64), sy(v))))
+            .filter_map(|q| {
+                let v = value(q)?;
+                Some(format!(
+                    "{:.1},{:.1}",
+                    scale.x(q.vertices as f64),
+                    scale.y(v)
+                ))
+            })
             .collect();
         writeln!(
             svg,
@@ -348,4 +357,36 @@ fn panel_svg(svg: &mut String, x0: f64, title: &str, value: Metric, runs: &[Mode
         )
         .ok();
     }
+}
+
+fn axes_svg(svg: &mut String, title: &str, scale: &Scale) {
+    let (x0, y0) = (scale.x0, scale.y(0.0));
+    writeln!(svg, "<text x='{}' y='40'>{title}</text>", x0 + PAD).ok();
+    writeln!(
+        svg,
+        "<line x1='{0}' y1='{2}' x2='{1}' y2='{2}' stroke='#444'/><line x1='{0}' y1='30' x2='{0}' y2='{2}' stroke='#444'/>",
+        x0 + PAD,
+        x0 + W - PAD / 2.0,
+        y0
+    )
+    .ok();
+    writeln!(
+        svg,
+        "<text x='{}' y='{}'>{:.0}</text><text x='{}' y='{}' text-anchor='end'>{:.0}</text>",
+        x0 + PAD,
+        y0 + 14.0,
+        scale.xmin,
+        x0 + W - PAD / 2.0,
+        y0 + 14.0,
+        scale.xmax
+    )
+    .ok();
+    writeln!(
+        svg,
+        "<text x='{}' y='{}' text-anchor='end'>{:.1}</text>",
+        x0 + PAD - 4.0,
+        scale.y(scale.ymax / 1.05) + 4.0,
+        scale.ymax / 1.05
+    )
+    .ok();
 }
