@@ -41,7 +41,7 @@ else
 fi
 
 # One build for every target (and the seed writer), with the same flags `run` uses.
-cargo +nightly fuzz build
+cargo +nightly fuzz build --fuzz-dir "$root/codec/fuzz"
 # Seeds from the current encoder and exporters, kept apart from the corpora.
 seeds="target/seeds"
 rm -rf "$seeds"
@@ -51,7 +51,7 @@ failed=()
 for t in "${targets[@]}"; do
     mkdir -p "corpus/$t" "$seeds/$t"
     echo "=== $t: ${secs}s"
-    if ! cargo +nightly fuzz run "$t" "corpus/$t" "$seeds/$t" -- \
+    if ! cargo +nightly fuzz run --fuzz-dir "$root/codec/fuzz" "$t" "corpus/$t" "$seeds/$t" -- \
         -max_total_time="$secs" -rss_limit_mb=2048 -timeout=10 -print_final_stats=1 2>&1 |
         tee "target/fuzz-$t.log" | grep -E '^(#[0-9]+\s+(INITED|DONE)|stat::number_of_executed_units|stat::average_exec_per_sec|stat::peak_rss_mb|==[0-9]+==|SUMMARY|Test unit written|thread .* panicked)'; then
         :

@@ -228,9 +228,20 @@ fn guards_compose_as_a_conjunction() {
     };
     let composed = bytes(&[&Slab(0, 1000), &Slab(3000, 4096)]);
     assert_eq!(composed, bytes(&[&Both]));
-    assert_ne!(composed, bytes(&[&Slab(0, 1000)]), "the second guard refuses patches");
-    assert_ne!(composed, bytes(&[&Slab(3000, 4096)]), "the first guard refuses patches");
-    assert_eq!(bytes(&[&Anything, &Anything]), encode(&mesh, &options).unwrap().bytes);
+    assert_ne!(
+        composed,
+        bytes(&[&Slab(0, 1000)]),
+        "the second guard refuses patches"
+    );
+    assert_ne!(
+        composed,
+        bytes(&[&Slab(3000, 4096)]),
+        "the first guard refuses patches"
+    );
+    assert_eq!(
+        bytes(&[&Anything, &Anything]),
+        encode(&mesh, &options).unwrap().bytes
+    );
     let d = decode(&composed, None, Limits::default()).unwrap();
     assert_eq!(d.vertex_count(), mesh.positions.len());
 }
