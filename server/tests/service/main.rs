@@ -13,6 +13,7 @@ mod quality;
 mod slow;
 mod spec;
 mod story;
+mod viewer;
 
 use harness::{Backend, TestDb};
 use std::future::Future;
