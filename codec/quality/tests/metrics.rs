@@ -438,3 +438,43 @@ fn timing_on_100k_meshes() {
     }
     println!("one 512² view of 100k triangles: {:?}", t.elapsed() / 10);
 }
+
+/// Points on a mesh's surface are at distance 0 from it; points lifted off
+/// a flat face by h are at h (up to f32 positions).
+#[test]
+fn distances_to_surface_measure_points_off_the_surface() {
+    use glam::DVec3;
+    let sphere = icosphere(3);
+    let on: Vec<DVec3> = sphere
+        .positions
+        .iter()
+        .map(|p| DVec3::from(p.map(f64::from)))
+        .collect();
+    let d = vitrine_quality::metrics::distances_to_surface(&on, &sphere);
+    assert!(
+        d.iter().all(|&x| x < 1e-6),
+        "{:?}",
+        d.iter().cloned().fold(0.0, f64::max)
+    );
+    let square = IndexedMesh {
+        positions: vec![
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [1.0, 1.0, 0.0],
+            [0.0, 1.0, 0.0],
+        ],
+        colors: None,
+        triangles: vec![[0, 1, 2], [0, 2, 3]],
+    };
+    let lifted = [
+        DVec3::new(0.25, 0.5, 0.3),
+        DVec3::new(0.9, 0.1, -0.05),
+        DVec3::new(2.0, 0.5, 0.0),
+    ];
+    let d = vitrine_quality::metrics::distances_to_surface(&lifted, &square);
+    assert!(
+        (d[0] - 0.3).abs() < 1e-9 && (d[1] - 0.05).abs() < 1e-9,
+        "{d:?}"
+    );
+    assert!((d[2] - 1.0).abs() < 1e-9, "beside the square: {}", d[2]);
+}

@@ -3,7 +3,9 @@
 //! the full-resolution scan becomes a null patch, as the cell complex's
 //! guard does. Encoder-side only: the stream format does not change.
 
-use std::collections::HashSet;
+use std::collections::HashMap;
+
+use glam::DVec3;
 
 use vitrine_codec::{CandidatePatch, Error, IndexedMesh, PatchGuard, Quantization, Result};
 
@@ -81,14 +83,35 @@ impl FeatureThreshold {
 }
 
 /// Refuses to decimate a vertex whose one-ring maximum θ on the full
-/// resolution exceeds the threshold. The encoder names a patch by its
-/// quantized centre, so the guard keeps the quantized positions of the
-/// feature vertices (with the stream's own quantization).
+/// resolution exceeds the threshold, while it is among the strongest
+/// features the current level can afford.
+///
+/// A hard guard would keep every feature vertex down to the base mesh
+/// (15 % of a scan's vertices at μ + 2σ, measured on the Stanford bunny),
+/// and the base is what every visitor waits for. Instead features are
+/// ranked by θ, and a level of n vertices protects the first `share · n` of
+/// them: all of them near full resolution, the strongest few in the coarse
+/// levels. The guard estimates n from the mean face area the encoder
+/// reports (the surface's area is nearly the same at every level).
+///
+/// The encoder names a patch by its quantized centre, so the guard keeps
+/// the quantized positions of the feature vertices (with the stream's own
+/// quantization).
 #[derive(Clone, Debug)]
 pub struct FeatureGuard {
-    features: HashSet<[i32; 3]>,
+    rank: HashMap<[i32; 3], u32>,
     threshold: f64,
+    /// Half the surface's area, in quantization units squared: a closed
+    /// mesh has about twice as many faces as vertices, so a level's vertex
+    /// count is about this over its mean face area.
+    vertices_times_face_area: f64,
+    share: f64,
 }
+
+/// The share of a level's vertices that features may hold by default: on
+/// the shared scans 0.05 halves the features' distance to the coarse levels
+/// for under 5 % more connectivity (0.1 costs 8–10 %, 0.25 costs 12–21 %).
+pub const DEFAULT_FEATURE_SHARE: f64 = 0.05;
 
 impl FeatureGuard {
     /// `quantization` must be the stream's: `Quantization::for_positions`
@@ -101,22 +124,37 @@ impl FeatureGuard {
         let theta = normal_deviation(mesh);
         let threshold = threshold.radians(&theta);
         let ring = one_ring_max(mesh, &theta);
-        let features = mesh
-            .positions
-            .iter()
-            .zip(&ring)
-            .filter(|(_, &t)| t > threshold)
-            .map(|(&p, _)| quantization.quantize(p))
+        let mut features: Vec<u32> = (0..mesh.positions.len() as u32)
+            .filter(|&v| ring[v as usize] > threshold)
             .collect();
+        features.sort_by(|&a, &b| {
+            ring[b as usize]
+                .total_cmp(&ring[a as usize])
+                .then(a.cmp(&b))
+        });
+        let mut rank = HashMap::with_capacity(features.len());
+        for (k, &v) in features.iter().enumerate() {
+            let key = quantization.quantize(mesh.positions[v as usize]);
+            rank.entry(key).or_insert(k as u32);
+        }
         FeatureGuard {
-            features,
+            rank,
             threshold,
+            vertices_times_face_area: 0.5 * quantized_area(mesh, quantization),
+            share: DEFAULT_FEATURE_SHARE,
         }
     }
 
-    /// How many distinct quantized positions the guard keeps.
+    /// The share (0–1) of a level's vertices that features may hold; 1
+    /// keeps every feature vertex of the threshold down to the base mesh.
+    pub fn with_share(mut self, share: f64) -> Self {
+        self.share = share.clamp(0.0, 1.0);
+        self
+    }
+
+    /// How many distinct quantized positions the guard may keep.
     pub fn feature_vertices(&self) -> usize {
-        self.features.len()
+        self.rank.len()
     }
 
     /// The threshold it was built with, in radians.
@@ -125,9 +163,32 @@ impl FeatureGuard {
     }
 }
 
+/// The area of the mesh with quantized positions, in quantization units squared.
+fn quantized_area(mesh: &IndexedMesh, quantization: &Quantization) -> f64 {
+    let q = |v: u32| {
+        let p = quantization.quantize(mesh.positions[v as usize]);
+        DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64)
+    };
+    mesh.triangles
+        .iter()
+        .map(|&[a, b, c]| 0.5 * (q(b) - q(a)).cross(q(c) - q(a)).length())
+        .sum()
+}
+
 impl PatchGuard for FeatureGuard {
     fn allows(&self, patch: &CandidatePatch<'_>) -> bool {
-        !self.features.contains(&patch.centre)
+        let Some(&rank) = self.rank.get(&patch.centre) else {
+            return true;
+        };
+        if self.share >= 1.0 || patch.mean_face_area <= 0.0 {
+            return false;
+        }
+        let level_vertices = self.vertices_times_face_area / patch.mean_face_area;
+        f64::from(rank) >= self.share * level_vertices
+    }
+
+    fn uses_mean_face_area(&self) -> bool {
+        true
     }
 }
 

@@ -13,4 +13,4 @@ pub mod deviation;
 mod feature_guard;
 
 pub use deviation::{border_vertices, normal_deviation, one_ring_max, VertexFaces};
-pub use feature_guard::{FeatureGuard, FeatureThreshold};
+pub use feature_guard::{FeatureGuard, FeatureThreshold, DEFAULT_FEATURE_SHARE};

@@ -113,6 +113,21 @@ impl HausdorffReference {
     }
 }
 
+/// The distance from each point to the surface of `mesh` (its triangles):
+/// how far a level strayed from chosen points of the original, such as its
+/// feature vertices.
+pub fn distances_to_surface(points: &[DVec3], mesh: &IndexedMesh) -> Vec<f64> {
+    let surface = TriangleBvh::new(triangle_corners(mesh));
+    let chunks = parallel_map(points.len().div_ceil(CHUNK), |chunk| {
+        let end = ((chunk + 1) * CHUNK).min(points.len());
+        points[chunk * CHUNK..end]
+            .iter()
+            .map(|&p| surface.distance_squared(p).sqrt())
+            .collect::<Vec<f64>>()
+    });
+    chunks.concat()
+}
+
 /// (max, mean) distance from the points to the surface in `to`.
 fn one_sided((samples, vertices): &(Vec<DVec3>, Vec<DVec3>), to: &TriangleBvh) -> (f64, f64) {
     let points: Vec<DVec3> = samples.iter().chain(vertices).copied().collect();

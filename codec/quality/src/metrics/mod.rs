@@ -25,7 +25,7 @@ mod sampling;
 pub mod views;
 
 pub use colour::{roy_colour_rmse, ColourError};
-pub use hausdorff::{hausdorff, Hausdorff, HausdorffReference};
+pub use hausdorff::{distances_to_surface, hausdorff, Hausdorff, HausdorffReference};
 pub use image_rmse::{image_rmse, image_rmse_per_view, ImageReference};
 pub use raster::{
     default_shader, render, Camera, ConstantColour, Frame, Lighting, RenderOptions, SurfaceShader,
