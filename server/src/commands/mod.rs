@@ -1,5 +1,5 @@
 //! The subcommands, one module each, holding its clap arguments and its
-//! `run`: [`Command`] is `vitrine`'s, [`DevCommand`] (feature `dev-tools`)
+//! `run`: [`Command`] is `vitrine`'s, `DevCommand` (feature `dev-tools`)
 //! the developer tools of `vitrine-dev`. The binaries only parse and call
 //! [`Command::run`].
 
