@@ -1,6 +1,6 @@
-//! Profiling aid: `cargo run --release --example decode_loop mesh.ply [decode-runs] [encode-runs]`,
+//! Profiling aid: `cargo run --release -p vitrine-mesh --example decode_loop mesh.ply [decode-runs] [encode-runs]`,
 //! or `decode_loop stream.vtr [decode-runs]` to time decoding a stream written before.
-//! Encoding runs on one core (as `vitrine bench` times it) unless
+//! Encoding runs on one core (as `vitrine-dev bench` times it) unless
 //! `VITRINE_PIPELINED=1`; `VITRINE_STREAM_OUT=path` keeps the stream (to
 //! compare two builds' bytes, or time decoders on it).
 use std::time::Instant;
