@@ -1,8 +1,10 @@
 //! `vitrine encode`: a mesh file into a progressive stream file, with the
 //! cell complex written beside it in `ccc` mode.
 
+use super::guard::GuardArgs;
 use super::ingest::CccArgs;
 use crate::ccc_files::CccFiles;
+use crate::ingest::{GuardOptions, Guards};
 use crate::source::{default_colour_mode, describe_repair, load_coloured_mesh, SourceMesh};
 use anyhow::Context;
 use clap::Args;
@@ -40,6 +42,8 @@ pub struct EncodeArgs {
     pub colour: Option<ColourMode>,
     #[command(flatten)]
     pub ccc: CccArgs,
+    #[command(flatten)]
+    pub guard: GuardArgs,
 }
 
 impl EncodeArgs {
@@ -61,12 +65,13 @@ pub fn run(args: EncodeArgs) -> anyhow::Result<()> {
         .output
         .clone()
         .unwrap_or_else(|| args.input.with_extension("vtr"));
+    let guards = args.guard.options()?;
     let source = load_coloured_mesh(&args.input)?;
     if let Some(text) = describe_repair(&source.repair) {
         eprintln!("repair: {text}");
     }
     let start = Instant::now();
-    let (encoded, mapping) = encode_with_progress(&source, &args)?;
+    let (encoded, mapping) = encode_with_progress(&source, &args, &guards)?;
     let elapsed = start.elapsed();
     std::fs::write(&output, &encoded.bytes)
         .with_context(|| format!("writing {}", output.display()))?;
@@ -90,15 +95,25 @@ pub fn run(args: EncodeArgs) -> anyhow::Result<()> {
 }
 
 /// Encodes in the colour mode asked for (by default the one the mesh's
-/// colour calls for), with a progress bar of the vertices removed so far.
+/// colour calls for) under the guards asked for, with a progress bar of
+/// the vertices removed so far.
 fn encode_with_progress(
     source: &SourceMesh,
     args: &EncodeArgs,
+    guards: &GuardOptions,
 ) -> anyhow::Result<(Encoded, Option<TextureMapping>)> {
     let (mesh, texture) = (&source.mesh, source.texture.as_ref());
     let mode = args
         .colour
         .unwrap_or_else(|| default_colour_mode(mesh, texture));
+    let options = args.options();
+    let guards = Guards::new(mesh, guards, options.quantization_bits)?;
+    if let Some(f) = guards.features() {
+        eprintln!(
+            "feature guard: threshold {:.2}°, {} feature vertices",
+            f.threshold_degrees, f.vertices
+        );
+    }
     let bar = ProgressBar::new(mesh.positions.len() as u64);
     bar.set_style(
         ProgressStyle::with_template(
@@ -112,10 +127,12 @@ fn encode_with_progress(
         texture,
         mode,
         &args.ccc.options(),
-        vitrine_codec::Encoder::new(args.options()).progress(|p| {
-            bar.set_message(p.layer.to_string());
-            bar.set_position((p.input_vertices - p.vertices) as u64);
-        }),
+        guards
+            .apply(vitrine_codec::Encoder::new(options))
+            .progress(|p| {
+                bar.set_message(p.layer.to_string());
+                bar.set_position((p.input_vertices - p.vertices) as u64);
+            }),
     )?;
     bar.finish_and_clear();
     Ok(encoded)

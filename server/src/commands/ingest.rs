@@ -1,5 +1,6 @@
 //! `vitrine ingest <mesh> --db … --slug … --title …`
 
+use super::guard::GuardArgs;
 use crate::database::open_storage;
 use crate::ingest::{
     ingest_coloured, IngestOptions, IngestReport, MeasuredQuality, ModelMeta, SourceInfo,
@@ -63,6 +64,8 @@ pub struct IngestArgs {
     pub quality_image_size: u32,
     #[command(flatten)]
     pub ccc: CccArgs,
+    #[command(flatten)]
+    pub guard: GuardArgs,
     /// Test hook: pause inside the transaction before committing.
     #[arg(long, hide = true, env = "VITRINE_TEST_PAUSE_BEFORE_COMMIT_MS")]
     pub pause_before_commit_ms: Option<u64>,
@@ -97,6 +100,7 @@ impl CccArgs {
 
 pub async fn run(args: IngestArgs) -> anyhow::Result<()> {
     super::init_tracing();
+    let options = args.options()?;
     let path = args.mesh.clone();
     let (source, info) = tokio::task::spawn_blocking(move || -> anyhow::Result<_> {
         let source = load_coloured_mesh(&path)?;
@@ -113,7 +117,7 @@ pub async fn run(args: IngestArgs) -> anyhow::Result<()> {
     })
     .await??;
     let storage = open_storage(&args.db, &ConnectOptions::default(), false).await?;
-    let (meta, options) = (args.meta(info), args.options());
+    let meta = args.meta(info);
     let slug = meta.slug.clone();
     let report = ingest_coloured(&*storage, source.mesh, source.texture, meta, &options).await?;
     print_report(&slug, &report);
@@ -137,20 +141,21 @@ impl IngestArgs {
         }
     }
 
-    fn options(&self) -> IngestOptions {
-        IngestOptions {
+    fn options(&self) -> anyhow::Result<IngestOptions> {
+        Ok(IngestOptions {
             encode: EncodeOptions {
                 quantization_bits: self.quantization_bits,
                 ..EncodeOptions::default()
             },
             colour: self.colour,
             ccc: self.ccc.options(),
+            guards: self.guard.options()?,
             quality: self.quality.then(|| QualityOptions {
                 image_size: self.quality_image_size,
                 ..QualityOptions::default()
             }),
             pause_before_commit: self.pause_before_commit_ms.map(Duration::from_millis),
-        }
+        })
     }
 }
 

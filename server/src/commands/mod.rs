@@ -5,6 +5,7 @@
 
 pub mod decode;
 pub mod encode;
+pub mod guard;
 pub mod ingest;
 pub mod inspect;
 pub mod models;

@@ -4,8 +4,11 @@
 //! [`IngestOptions::quality`], every level is measured against the original
 //! first (outside the transaction) and the curve is stored in the level rows.
 
+mod guards;
 mod mapping;
 mod store;
+
+pub use guards::{threshold_name, FeatureSummary, GuardOptions, Guards};
 
 use crate::source::{default_colour_mode, read_back, QualityReference};
 use crate::storage::{valid_slug, OnExisting, Storage, StoredModel};
@@ -66,6 +69,10 @@ pub struct IngestOptions {
     pub colour: Option<ColourMode>,
     /// The cell complex's options, in `ccc` mode.
     pub ccc: CccOptions,
+    /// Decimation guards beside the colour mode's own (the feature guard).
+    /// Only [`ingest_coloured`] and [`ingest_mesh`] build them; for
+    /// [`ingest_encoded`] they only say what the caller encoded with.
+    pub guards: GuardOptions,
     /// Measure every level against the original before storing
     /// (`vitrine_quality::stream_quality`: Hausdorff, Roy colour RMSE,
     /// 24-view image RMSE). About a second per level at 50k vertices, so off
@@ -89,6 +96,8 @@ pub struct IngestReport {
     pub ccc: Option<CccReport>,
     /// The quality curve, when it was measured.
     pub quality: Option<MeasuredQuality>,
+    /// What the feature guard kept, when it ran.
+    pub features: Option<FeatureSummary>,
 }
 
 /// Every level's quality against the original, and how it was measured.
@@ -128,58 +137,70 @@ pub async fn ingest_coloured(
     let mode = options
         .colour
         .unwrap_or_else(|| default_colour_mode(&mesh, texture.as_ref()));
-    let (encode_options, ccc) = (options.encode.clone(), options.ccc.clone());
-    let quality_options = options.quality;
-    let (encoded, mapping, encode_time, quality) = tokio::task::spawn_blocking(move || {
-        encode_and_measure(mesh, texture, mode, encode_options, &ccc, quality_options)
-    })
-    .await
-    .context("encoder task failed")??;
     let mut options = options.clone();
     options.colour = Some(mode);
+    let task_options = options.clone();
+    let encoding =
+        tokio::task::spawn_blocking(move || encode_and_measure(mesh, texture, &task_options))
+            .await
+            .context("encoder task failed")??;
     let product = Product {
-        encoded: &encoded,
-        encode_time,
-        mapping: mapping.as_ref(),
-        quality,
+        encoded: &encoding.encoded,
+        encode_time: encoding.encode_time,
+        mapping: encoding.mapping.as_ref(),
+        quality: encoding.quality,
+        features: encoding.features,
     };
     store(storage, product, meta, source, &options).await
 }
 
-/// The stream, its mapping in `ccc` mode, how long encoding took, and the
-/// quality curve when asked for.
-type Encoding = (
-    Encoded,
-    Option<TextureMapping>,
-    Duration,
-    Option<MeasuredQuality>,
-);
+/// The stream, its mapping in `ccc` mode, how long encoding took, the
+/// quality curve when asked for, and what the feature guard kept.
+struct Encoding {
+    encoded: Encoded,
+    mapping: Option<TextureMapping>,
+    encode_time: Duration,
+    quality: Option<MeasuredQuality>,
+    features: Option<FeatureSummary>,
+}
 
+/// Encodes in `options.colour` (already resolved) under the guards asked
+/// for, then measures the levels if asked.
 fn encode_and_measure(
     mesh: IndexedMesh,
     texture: Option<TexturedSurface>,
-    mode: ColourMode,
-    encode_options: EncodeOptions,
-    ccc: &CccOptions,
-    quality_options: Option<QualityOptions>,
+    options: &IngestOptions,
 ) -> anyhow::Result<Encoding> {
     let started = Instant::now();
-    let (encoded, mapping) = encode_coloured(
-        &mesh,
-        texture.as_ref(),
-        mode,
-        ccc,
-        vitrine_codec::Encoder::new(encode_options),
-    )
-    .context("encoding failed")?;
+    let mode = options.colour.unwrap_or(ColourMode::None);
+    let guards = Guards::new(&mesh, &options.guards, options.encode.quantization_bits)
+        .context("building the decimation guards")?;
+    let features = guards.features();
+    if let Some(f) = &features {
+        tracing::info!(
+            threshold_degrees = f.threshold_degrees,
+            feature_vertices = f.vertices,
+            "feature guard"
+        );
+    }
+    let encoder = guards.apply(vitrine_codec::Encoder::new(options.encode.clone()));
+    let (encoded, mapping) = encode_coloured(&mesh, texture.as_ref(), mode, &options.ccc, encoder)
+        .context("encoding failed")?;
     let encode_time = started.elapsed();
     // Before the transaction: measuring takes seconds, and a write
     // transaction should not stay open (SQLite holds its one writer lock).
-    let quality = quality_options
+    let quality = options
+        .quality
         .map(|q| measure_quality(&encoded.bytes, mapping.as_ref(), mesh, texture, &q))
         .transpose()
         .context("measuring quality")?;
-    Ok((encoded, mapping, encode_time, quality))
+    Ok(Encoding {
+        encoded,
+        mapping,
+        encode_time,
+        quality,
+        features,
+    })
 }
 
 /// Measures every level of `stream` against the original: the repaired mesh
@@ -234,6 +255,7 @@ pub async fn ingest_encoded(
         encode_time,
         mapping,
         quality: None,
+        features: None,
     };
     store(storage, product, meta, source, options).await
 }

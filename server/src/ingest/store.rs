@@ -2,14 +2,17 @@
 //! refinement batch, and the colour mapping, staged together and committed.
 
 use super::mapping::new_mapping;
-use super::{IngestOptions, IngestReport, MeasuredQuality, ModelMeta, SourceInfo};
+use super::{
+    threshold_name, FeatureSummary, IngestOptions, IngestReport, MeasuredQuality, ModelMeta,
+    SourceInfo,
+};
 use crate::storage::{LevelMetrics, NewCompression, NewLevel, NewModel, Storage, StoredModel};
 use anyhow::{bail, Context};
 use serde_json::json;
 use std::ops::Range;
 use std::time::Duration;
-use vitrine_codec::{BaseTarget, EncodeOptions, Encoded, StreamIndex};
-use vitrine_colour::ccc::{CccOptions, CccReport, TextureMapping};
+use vitrine_codec::{BaseTarget, Encoded, StreamIndex};
+use vitrine_colour::ccc::{CccReport, TextureMapping};
 use vitrine_colour::ColourMode;
 use vitrine_quality::LevelQuality;
 
@@ -20,6 +23,7 @@ pub(super) struct Product<'a> {
     pub encode_time: Duration,
     pub mapping: Option<&'a TextureMapping>,
     pub quality: Option<MeasuredQuality>,
+    pub features: Option<FeatureSummary>,
 }
 
 pub(super) async fn store(
@@ -62,6 +66,7 @@ pub(super) async fn store(
         encode_time: product.encode_time,
         ccc,
         quality: product.quality,
+        features: product.features,
     })
 }
 
@@ -105,7 +110,7 @@ fn compression(
     let level = |k: usize, range: &Range<usize>| new_level(product, index, k, range);
     NewCompression {
         codec_version: index.header.version,
-        options: encode_options_json(&options.encode, options.colour, &options.ccc).to_string(),
+        options: options_json(options).to_string(),
         stats: stats_json(product, index, ccc, source).to_string(),
         quantization_bits: index.header.quantization.bits,
         has_colour: index.header.has_colour,
@@ -153,6 +158,7 @@ fn stats_json(
         "encode_ms": product.encode_time.as_millis() as u64,
         "repair": source.repair,
         "ccc": ccc,
+        "features": product.features,
         // The curve itself is in the level rows.
         "quality": product.quality.as_ref().map(|q| json!({
             "image_size": q.options.image_size,
@@ -186,11 +192,10 @@ async fn stage_and_commit(
         .with_context(|| format!("committing {:?}", new.slug))
 }
 
-fn encode_options_json(
-    o: &EncodeOptions,
-    colour: Option<ColourMode>,
-    ccc: &CccOptions,
-) -> serde_json::Value {
+/// The options as recorded with the compression: the encoder's, the
+/// colour mode's and the guards'.
+fn options_json(options: &IngestOptions) -> serde_json::Value {
+    let (o, colour, ccc) = (&options.encode, options.colour, &options.ccc);
     let base = match o.base {
         BaseTarget::Vertices(n) => json!({ "vertices": n }),
         BaseTarget::Fraction(f) => json!({ "fraction": f }),
@@ -202,6 +207,8 @@ fn encode_options_json(
         "max_layers": o.max_layers,
         "min_layer_fraction": o.min_layer_fraction,
         "geometric_guard": o.geometric_guard,
+        "guards": options.guards.names(),
+        "feature_threshold": options.guards.features.map(threshold_name),
         "colour": colour.map(ColourMode::name),
         "ccc": (colour == Some(ColourMode::Ccc)).then(|| json!({
             "cell_size": ccc.cell_size,
