@@ -1,11 +1,10 @@
 //! `vitrine decode`: a stream file, up to a level, as a PLY, OBJ or GLB mesh.
 
-use anyhow::{bail, Context};
+use super::mesh_format::MeshFormat;
+use anyhow::Context;
 use clap::Args;
-use std::io::BufWriter;
 use std::path::PathBuf;
 use vitrine_codec::{decode, Limits};
-use vitrine_mesh::export::{write_glb, write_obj, write_ply};
 
 #[derive(Args, Debug)]
 pub struct DecodeArgs {
@@ -20,26 +19,13 @@ pub struct DecodeArgs {
 }
 
 pub fn run(args: DecodeArgs) -> anyhow::Result<()> {
+    let format = MeshFormat::from_path(&args.output)?;
     let bytes =
         std::fs::read(&args.input).with_context(|| format!("reading {}", args.input.display()))?;
     let decoder = decode(&bytes, args.level, Limits::default())
         .with_context(|| format!("decoding {}", args.input.display()))?;
     let mesh = decoder.to_mesh();
-    let file = std::fs::File::create(&args.output)
-        .with_context(|| format!("creating {}", args.output.display()))?;
-    let mut w = BufWriter::new(file);
-    match args
-        .output
-        .extension()
-        .and_then(|e| e.to_str())
-        .map(str::to_ascii_lowercase)
-        .as_deref()
-    {
-        Some("ply") => write_ply(&mesh, &mut w)?,
-        Some("obj") => write_obj(&mesh, &mut w)?,
-        Some("glb") => write_glb(&mesh, &mut w)?,
-        _ => bail!("output extension must be .ply, .obj or .glb"),
-    }
+    format.write(&mesh, &args.output)?;
     eprintln!(
         "level {} of {}: {} vertices, {} faces → {}",
         decoder.level(),

@@ -8,6 +8,7 @@ pub mod encode;
 pub mod guard;
 pub mod ingest;
 pub mod inspect;
+pub mod mesh_format;
 pub mod models;
 pub mod sample;
 pub mod serve;
