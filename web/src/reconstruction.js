@@ -9,6 +9,7 @@
 
 import { DecodeError } from './codec.js';
 import { bounds, edgeIndices, vertexNormals } from './geometry.js';
+import { normalDeviation, reliefTop } from './relief.js';
 import { retryAfterSeconds, waitToRetry } from './retry.js';
 
 /**
@@ -20,6 +21,7 @@ import { retryAfterSeconds, waitToRetry } from './retry.js';
  * @property {number} [showFrom] with `each`, post levels from this one on (a retry
  *   does not step back through levels already on screen)
  * @property {boolean} wireframe also build the edge list of each posted level
+ * @property {boolean} [relief] also compute θ (relief.js) of each posted level
  * @property {'always' | 'last'} [normals] which posted levels carry their normals:
  *   every one (the default: the renderer is on the page's main thread), or only
  *   the level this worker stops at (`upTo`), when it has nothing else to do;
@@ -48,20 +50,26 @@ import { retryAfterSeconds, waitToRetry } from './retry.js';
  * @property {Uint8Array | null} colours r, g, b of vertices firstVertex…vertices − 1
  * @property {Uint32Array} indices
  * @property {Uint32Array | null} edges
+ * @property {Float32Array | null} [relief] θ of every vertex in radians (the relief
+ *   view; null or absent when it was off)
+ * @property {number | null} [reliefTop] the top of θ's colour scale in degrees
+ *   (relief.js `reliefTop`), with `relief`
  * @property {import('./geometry.js').Bounds} baseBounds bounds of the base mesh: the
  *   camera frames these, so the view does not shift when a level or a direct
  *   load of the last level arrives
  * @property {number} received payload bytes received so far
  * @property {number} decodeMs time in the WASM decoder so far (apply + copy out)
- * @property {number} deriveMs time computing normals and edges so far
+ * @property {number} deriveMs time computing normals, edges and θ so far
  */
 
 /**
  * @typedef {{ type: 'progress', received: number }
  *   | { type: 'edges', level: number, edges: Uint32Array }
+ *   | { type: 'relief', level: number, relief: Float32Array, top: number }
  *   | { type: 'capped', level: number, status: number, reason: string | null, retryAfterS: number | null }
  *   | { type: 'error', kind: 'network' | 'decode', level: number, message: string }
  *   | { type: 'done', level: number }} StatusMessage
+ * `relief`: θ of a level posted before the relief view was switched on.
  * `capped`: the server refused the next batch (the cap fell since the
  * manifest was read); `done`: `upTo` is reached and nothing is pending.
  */
@@ -103,6 +111,9 @@ export class Reconstruction {
   #lastProgress = 0;
   /** Vertices whose positions and colours have been posted (they never change). */
   #sentVertices = 0;
+  /** The newest level posted, and the newest whose θ went with it or after it (-1: none). */
+  #postedLevel = -1;
+  #reliefLevel = -1;
   /** @type {import('./geometry.js').Bounds} */
   #baseBounds = { min: [0, 0, 0], max: [0, 0, 0] };
   /** Levels applied so far; -1 before the base mesh. */
@@ -149,6 +160,25 @@ export class Reconstruction {
       this.#deriveMs += performance.now() - t0;
       this.post({ type: 'edges', level: this.level, edges }, [edges.buffer]);
     }
+  }
+
+  /**
+   * Computes θ for every level posted from now on; switched on, also for
+   * the level last posted if its θ was never sent (the renderer keeps the θ
+   * it got, so switching off and on again costs nothing).
+   * @param {boolean} on
+   */
+  setRelief(on) {
+    this.request.relief = on;
+    if (!on || !this.#decoder || this.#postedLevel < 0 || this.#postedLevel !== this.level) return;
+    if (this.#reliefLevel === this.level) return;
+    const t0 = performance.now();
+    const { positions, indices, vertices } = this.#decoder.view();
+    const relief = normalDeviation(positions, indices, vertices);
+    const top = reliefTop(relief);
+    this.#deriveMs += performance.now() - t0;
+    this.#reliefLevel = this.level;
+    this.post({ type: 'relief', level: this.level, relief, top }, [relief.buffer]);
   }
 
   cancel() {
@@ -239,8 +269,9 @@ export class Reconstruction {
    * each pass appends the vertices it inserts), so positions and colours
    * carry only the vertices not posted before (from `firstVertex`); normals
    * and indices change everywhere and go whole. Normals (unless the
-   * renderer derives them) and edges are computed on views into the
-   * decoder's memory, so nothing is copied out except what is sent.
+   * renderer derives them), edges (wireframe) and θ (relief view) are
+   * computed on views into the decoder's memory, so nothing is copied out
+   * except what is sent.
    */
   #postLevel() {
     const decoder = /** @type {import('./codec.js').StreamDecoder} */ (this.#decoder);
@@ -250,6 +281,8 @@ export class Reconstruction {
     const derive = this.request.normals !== 'last' || view.level >= this.request.upTo;
     const normals = derive ? vertexNormals(view.positions, view.indices) : null;
     const edges = this.request.wireframe ? edgeIndices(view.indices, view.vertices) : null;
+    const relief = this.request.relief ? normalDeviation(view.positions, view.indices, view.vertices) : null;
+    const top = relief ? reliefTop(relief) : null;
     const t2 = performance.now();
     const first = Math.min(this.#sentVertices, view.vertices);
     const positions = view.positions.slice(3 * first);
@@ -257,12 +290,15 @@ export class Reconstruction {
     const indices = view.indices.slice();
     this.#sentVertices = view.vertices;
     this.#decodeMs += t1 - t0 + (performance.now() - t2);
-    if (normals || edges) this.#deriveMs += t2 - t1;
+    if (normals || edges || relief) this.#deriveMs += t2 - t1;
+    this.#postedLevel = view.level;
+    if (relief) this.#reliefLevel = view.level;
     /** @type {Transferable[]} */
     const transfer = [positions.buffer, indices.buffer];
     if (normals) transfer.push(normals.buffer);
     if (colours) transfer.push(colours.buffer);
     if (edges) transfer.push(edges.buffer);
+    if (relief) transfer.push(relief.buffer);
     this.post(
       {
         type: 'level',
@@ -276,6 +312,8 @@ export class Reconstruction {
         colours,
         indices,
         edges,
+        relief,
+        reliefTop: top,
         baseBounds: this.#baseBounds,
         received: this.#received,
         decodeMs: this.#decodeMs,

@@ -4,7 +4,7 @@
  * compiled once on the page and shared by every worker), one progressive
  * reconstruction at a time. Levels leave as transferred buffers, so the page
  * never copies or decodes anything. With a render worker (render-worker.js)
- * the 'load' command brings a MessagePort to it: levels and edges go there,
+ * the 'load' command brings a MessagePort to it: levels, edges and θ go there,
  * and the page gets each level as a notice without its buffers.
  */
 
@@ -15,6 +15,7 @@ import { Reconstruction } from './reconstruction.js';
  * @typedef {{ type: 'load', module: WebAssembly.Module, request: import('./reconstruction.js').LoadRequest, port?: MessagePort | null }
  *   | { type: 'extend', upTo: number }
  *   | { type: 'wireframe', on: boolean }
+ *   | { type: 'relief', on: boolean }
  *   | { type: 'normals', which: 'always' | 'last' }} WorkerCommand
  */
 
@@ -29,9 +30,11 @@ let job = null;
 let renderPort = null;
 /** A 'normals' command that came while the decoder was starting. @type {'always' | 'last' | null} */
 let normals = null;
+/** A 'relief' command that came while the decoder was starting. @type {boolean | null} */
+let relief = null;
 /** @type {import('./reconstruction.js').Post} */
 function post(message, transfer) {
-  if (!renderPort || (message.type !== 'level' && message.type !== 'edges')) {
+  if (!renderPort || (message.type !== 'level' && message.type !== 'edges' && message.type !== 'relief')) {
     scope.postMessage(message, transfer);
     return;
   }
@@ -59,11 +62,15 @@ scope.onmessage = async (/** @type {MessageEvent<WorkerCommand>} */ event) => {
     }
     job = new Reconstruction(instance, command.request, post);
     if (normals !== null) job.setNormals(normals);
+    if (relief !== null) job.setRelief(relief);
     void job.run();
   } else if (command.type === 'extend') {
     job?.extend(command.upTo);
   } else if (command.type === 'wireframe') {
     job?.setWireframe(command.on);
+  } else if (command.type === 'relief') {
+    relief = command.on;
+    job?.setRelief(command.on);
   } else if (command.type === 'normals') {
     normals = command.which;
     job?.setNormals(command.which);

@@ -8,6 +8,7 @@ import assert from 'node:assert/strict';
 import { readFileSync } from 'node:fs';
 import { VitrineCodec, splitStream } from '../src/codec.js';
 import { Reconstruction } from '../src/reconstruction.js';
+import { normalDeviation, reliefTop } from '../src/relief.js';
 import { fixture, wasmPath } from './support/fixtures.mjs';
 
 const sample = fixture('painted-torus');
@@ -259,4 +260,49 @@ test('wireframe: each edge of the closed torus once', async () => {
       seen.add(key);
     }
   }
+});
+
+test('relief: each level posted while it is on carries θ; switched on later, θ of the level posted follows once', async () => {
+  const cap = 2;
+  const { job, messages, codec } = await reconstruct({ upTo: cap, relief: false }, service(), has('done'));
+  for (const level of levels(messages)) assert.equal(level.relief, null, `level ${level.level} without θ`);
+  const direct = codec.decoder(parts.base);
+  for (let k = 1; k <= cap; k++) direct.apply(parts.batches[k - 1]);
+  const expected = (/** @type {number} */ k) => {
+    if (k > direct.level().level) direct.apply(parts.batches[k - 1]);
+    const { positions, indices } = direct.level();
+    return normalDeviation(positions, indices);
+  };
+  messages.length = 0;
+  job.setRelief(true);
+  const late = /** @type {Array<Extract<import('../src/reconstruction.js').WorkerMessage, { type: 'relief' }>>} */ (
+    messages.filter((m) => m.type === 'relief')
+  );
+  assert.equal(late.length, 1);
+  assert.equal(late[0].level, cap);
+  assert.deepEqual(late[0].relief, expected(cap));
+  assert.equal(late[0].top, reliefTop(late[0].relief));
+  // Already sent: switching off and on again sends nothing.
+  job.setRelief(false);
+  job.setRelief(true);
+  assert.equal(messages.filter((m) => m.type === 'relief').length, 1);
+  messages.length = 0;
+  const done = new Promise((resolve) => {
+    const post = job.post;
+    job.post = (message, transfer) => {
+      post(message, transfer);
+      if (message.type === 'done') resolve(undefined);
+    };
+  });
+  job.extend(cap + 2);
+  await done;
+  const next = levels(messages);
+  assert.deepEqual(next.map((l) => l.level), [cap + 1, cap + 2]);
+  for (const level of next) {
+    assert.deepEqual(level.relief, expected(level.level), `θ of level ${level.level}`);
+    assert.equal(level.reliefTop, reliefTop(/** @type {Float32Array} */ (level.relief)));
+  }
+  assert.equal(messages.filter((m) => m.type === 'relief').length, 0, 'no separate θ for levels that carry it');
+  direct.free();
+  job.cancel();
 });
