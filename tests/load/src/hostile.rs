@@ -57,14 +57,17 @@ fn get(path: &str, extra: &str) -> Vec<u8> {
     format!("GET {path} HTTP/1.1\r\nhost: vitrine\r\n{extra}connection: close\r\n\r\n").into_bytes()
 }
 
-pub async fn run(t: &Target) -> Result<Vec<Case>> {
-    let id = t.compression_id;
-    let last = t.last_level;
-    let mut cases = Vec::new();
-    let mut check = |name: &str, expected: &[u16], got: (Option<u16>, String), forbid: &[&str]| {
+/// The cases so far.
+#[derive(Default)]
+struct Cases(Vec<Case>);
+
+impl Cases {
+    /// Passes when the answer's status is one of `expected` and the answer
+    /// contains none of `forbid`.
+    fn check(&mut self, name: &str, expected: &[u16], got: (Option<u16>, String), forbid: &[&str]) {
         let leaked = forbid.iter().find(|f| got.1.contains(**f));
         let pass = got.0.is_some_and(|s| expected.contains(&s)) && leaked.is_none();
-        cases.push(Case {
+        self.0.push(Case {
             name: name.into(),
             expected: expected
                 .iter()
@@ -78,11 +81,34 @@ pub async fn run(t: &Target) -> Result<Vec<Case>> {
             },
             pass,
         });
-    };
+    }
+}
+
+pub async fn run(t: &Target) -> Result<Vec<Case>> {
+    let mut cases = Cases::default();
+    traversal(t, &mut cases).await?;
+    oversized(t, &mut cases).await?;
+    malformed(t, &mut cases).await?;
+    tokens(t, &mut cases).await?;
+    research_level(t, &mut cases).await?;
+    // The database is intact after all of the above.
+    cases.check(
+        "model still listed afterwards",
+        &[200],
+        raw(&t.addr, &get(&format!("/api/models/{}", t.slug), "")).await?,
+        &[],
+    );
+    if t.slow {
+        slow_clients(t, &mut cases.0).await?;
+    }
+    Ok(cases.0)
+}
+
+/// Path traversal, raw and encoded, on the API, the viewer's pages and
+/// files: no file of the machine may leak.
+async fn traversal(t: &Target, cases: &mut Cases) -> Result<()> {
     let a = t.addr.as_str();
     let secret = ["root:x:0:0", "[workspace]", "PRIVATE KEY"];
-
-    // Path traversal, raw and encoded, on the API, the viewer's pages and files.
     for path in [
         "/../../../../etc/passwd",
         "/%2e%2e/%2e%2e/%2e%2e/etc/passwd",
@@ -93,30 +119,35 @@ pub async fn run(t: &Target) -> Result<Vec<Case>> {
         "/..%5c..%5c..%5cCargo.toml",
         "/%00/etc/passwd",
     ] {
-        check(
+        cases.check(
             &format!("path traversal GET {path}"),
             &[400, 404],
             raw(a, &get(path, "")).await?,
             &secret,
         );
     }
+    Ok(())
+}
 
-    // Oversized and too many headers, oversized and streamed bodies.
+/// Oversized and too many headers, oversized and streamed bodies, another
+/// method, a garbage request line.
+async fn oversized(t: &Target, cases: &mut Cases) -> Result<()> {
+    let a = t.addr.as_str();
     let big = format!("x-big: {}\r\n", "a".repeat(64 * 1024));
-    check(
+    cases.check(
         "64 KiB header",
         &[431],
         raw(a, &get("/api/models", &big)).await?,
         &[],
     );
     let many: String = (0..100).map(|i| format!("x-h{i}: v\r\n")).collect();
-    check(
+    cases.check(
         "100 headers (limit 64)",
         &[431],
         raw(a, &get("/api/models", &many)).await?,
         &[],
     );
-    check(
+    cases.check(
         "declared 10 MB body",
         &[413],
         raw(a, &get("/api/models", "content-length: 10000000\r\n")).await?,
@@ -124,8 +155,8 @@ pub async fn run(t: &Target) -> Result<Vec<Case>> {
     );
     let mut chunked = get("/api/models", "transfer-encoding: chunked\r\n");
     chunked.extend_from_slice(b"4\r\nabcd\r\n0\r\n\r\n");
-    check("chunked body", &[413], raw(a, &chunked).await?, &[]);
-    check(
+    cases.check("chunked body", &[413], raw(a, &chunked).await?, &[]);
+    cases.check(
         "POST to the API",
         &[405],
         raw(
@@ -135,14 +166,20 @@ pub async fn run(t: &Target) -> Result<Vec<Case>> {
         .await?,
         &[],
     );
-    check(
+    cases.check(
         "garbage request line",
         &[400],
         raw(a, b"\x16\x03\x01 hello\r\n\r\n").await?,
         &[],
     );
+    Ok(())
+}
 
-    // Invalid and SQL-injection-shaped ids, slugs and parameters.
+/// Invalid and SQL-injection-shaped ids, slugs and parameters.
+async fn malformed(t: &Target, cases: &mut Cases) -> Result<()> {
+    let a = t.addr.as_str();
+    let id = t.compression_id;
+    let last = t.last_level;
     for (path, expected) in [
         ("/api/compressions/abc/base".to_string(), &[400][..]),
         ("/api/compressions/-1/base".into(), &[400]),
@@ -171,14 +208,20 @@ pub async fn run(t: &Target) -> Result<Vec<Case>> {
         ),
         ("/api/textures/1%20UNION%20SELECT%201".into(), &[400]),
     ] {
-        check(
+        cases.check(
             &format!("GET {path}"),
             expected,
             raw(a, &get(&path, "")).await?,
             &[],
         );
     }
-    check(
+    Ok(())
+}
+
+/// A token shaped like SQL injection, and another scheme than Bearer.
+async fn tokens(t: &Target, cases: &mut Cases) -> Result<()> {
+    let a = t.addr.as_str();
+    cases.check(
         "token ' OR '1'='1",
         &[401],
         raw(
@@ -191,7 +234,7 @@ pub async fn run(t: &Target) -> Result<Vec<Case>> {
         .await?,
         &[],
     );
-    check(
+    cases.check(
         "Basic auth instead of Bearer",
         &[400],
         raw(
@@ -204,9 +247,16 @@ pub async fn run(t: &Target) -> Result<Vec<Case>> {
         .await?,
         &[],
     );
+    Ok(())
+}
 
-    // Research-level access without a (valid) token.
-    check(
+/// The full-resolution level without a token, with a made-up one, and with
+/// the researcher's.
+async fn research_level(t: &Target, cases: &mut Cases) -> Result<()> {
+    let a = t.addr.as_str();
+    let id = t.compression_id;
+    let last = t.last_level;
+    cases.check(
         &format!("full-resolution batch {last} without a token"),
         &[403],
         raw(
@@ -216,7 +266,7 @@ pub async fn run(t: &Target) -> Result<Vec<Case>> {
         .await?,
         &[],
     );
-    check(
+    cases.check(
         &format!("full-resolution batch {last} with a made-up token"),
         &[401],
         raw(
@@ -230,7 +280,7 @@ pub async fn run(t: &Target) -> Result<Vec<Case>> {
         &[],
     );
     if let Some(token) = &t.token {
-        check(
+        cases.check(
             &format!("full-resolution batch {last} with the researcher token"),
             &[200],
             raw(
@@ -244,18 +294,7 @@ pub async fn run(t: &Target) -> Result<Vec<Case>> {
             &[],
         );
     }
-    // The database is intact after all of the above.
-    check(
-        "model still listed afterwards",
-        &[200],
-        raw(a, &get(&format!("/api/models/{}", t.slug), "")).await?,
-        &[],
-    );
-
-    if t.slow {
-        slow_clients(t, &mut cases).await?;
-    }
-    Ok(cases)
+    Ok(())
 }
 
 /// Slowloris: 200 connections that send headers one byte every second. The

@@ -35,6 +35,40 @@ pub struct Answer {
     pub body: Option<Vec<u8>>,
 }
 
+/// What a response head says about the body and the connection.
+struct Head {
+    status: u16,
+    retry_after_s: Option<f64>,
+    length: Option<u64>,
+    chunked: bool,
+    close: bool,
+}
+
+impl Head {
+    fn of(response: &httparse::Response) -> Head {
+        let mut head = Head {
+            status: response.code.unwrap_or(0),
+            retry_after_s: None,
+            length: None,
+            chunked: false,
+            close: false,
+        };
+        for h in response.headers.iter() {
+            let v = std::str::from_utf8(h.value).unwrap_or("").trim();
+            if h.name.eq_ignore_ascii_case("content-length") {
+                head.length = v.parse::<u64>().ok();
+            } else if h.name.eq_ignore_ascii_case("transfer-encoding") {
+                head.chunked = v.eq_ignore_ascii_case("chunked");
+            } else if h.name.eq_ignore_ascii_case("connection") {
+                head.close = v.eq_ignore_ascii_case("close");
+            } else if h.name.eq_ignore_ascii_case("retry-after") {
+                head.retry_after_s = v.parse::<f64>().ok();
+            }
+        }
+        head
+    }
+}
+
 impl Conn {
     /// `base_url` is `http://host:port`.
     pub fn new(
@@ -89,6 +123,26 @@ impl Conn {
         keep: bool,
         started: Instant,
     ) -> Result<Answer, Error> {
+        self.send(path).await?;
+        let h = self.head().await?;
+        let head = started.elapsed();
+        let keep = keep || !(200..300).contains(&h.status);
+        let mut body = keep.then(Vec::new);
+        let bytes = self.read_body(&h, &mut body).await?;
+        if h.close {
+            self.stream = None;
+        }
+        Ok(Answer {
+            status: h.status,
+            retry_after_s: h.retry_after_s,
+            head,
+            bytes,
+            body,
+        })
+    }
+
+    /// Writes the request, on a new connection when there is none.
+    async fn send(&mut self, path: &str) -> Result<(), Error> {
         if self.buf.is_empty() {
             self.buf = vec![0; BUF];
         }
@@ -107,37 +161,19 @@ impl Conn {
         if stream.write_all(request.as_bytes()).await.is_err() {
             return Err(Error::Stale);
         }
+        Ok(())
+    }
 
-        // The head.
-        let (status, retry_after_s, length, chunked, close, head_len) = loop {
+    /// Reads the response head, leaving the buffer at the body.
+    async fn head(&mut self) -> Result<Head, Error> {
+        loop {
             let mut names = [httparse::EMPTY_HEADER; 32];
             let mut response = httparse::Response::new(&mut names);
             match response.parse(&self.buf[self.start..self.end]) {
                 Ok(httparse::Status::Complete(n)) => {
-                    let mut length = None;
-                    let mut chunked = false;
-                    let mut close = false;
-                    let mut retry_after_s = None;
-                    for h in response.headers.iter() {
-                        let v = std::str::from_utf8(h.value).unwrap_or("").trim();
-                        if h.name.eq_ignore_ascii_case("content-length") {
-                            length = v.parse::<u64>().ok();
-                        } else if h.name.eq_ignore_ascii_case("transfer-encoding") {
-                            chunked = v.eq_ignore_ascii_case("chunked");
-                        } else if h.name.eq_ignore_ascii_case("connection") {
-                            close = v.eq_ignore_ascii_case("close");
-                        } else if h.name.eq_ignore_ascii_case("retry-after") {
-                            retry_after_s = v.parse::<f64>().ok();
-                        }
-                    }
-                    break (
-                        response.code.unwrap_or(0),
-                        retry_after_s,
-                        length,
-                        chunked,
-                        close,
-                        n,
-                    );
+                    let head = Head::of(&response);
+                    self.start += n;
+                    return Ok(head);
                 }
                 Ok(httparse::Status::Partial) => {
                     if self.end - self.start >= MAX_HEAD {
@@ -160,43 +196,34 @@ impl Conn {
                 }
                 Err(e) => return Err(Error::Other(format!("bad response head: {e}"))),
             }
-        };
-        let head = started.elapsed();
-        self.start += head_len;
-        let keep = keep || !(200..300).contains(&status);
-        let mut body = keep.then(Vec::new);
+        }
+    }
+
+    /// Reads the body `h` announces into `body` (when kept); returns its length.
+    async fn read_body(&mut self, h: &Head, body: &mut Option<Vec<u8>>) -> Result<u64, Error> {
         let mut bytes = 0u64;
-        if chunked {
+        if h.chunked {
             loop {
                 let size = self.chunk_size().await?;
-                self.body(size, &mut body, &mut bytes).await?;
+                self.body(size, body, &mut bytes).await?;
                 self.expect_crlf().await?;
                 if size == 0 {
                     break;
                 }
             }
-        } else if let Some(n) = length {
-            self.body(n, &mut body, &mut bytes).await?;
-        } else if status != 204 && status != 304 {
+        } else if let Some(n) = h.length {
+            self.body(n, body, &mut bytes).await?;
+        } else if h.status != 204 && h.status != 304 {
             // No length: the body runs to the end of the connection.
             loop {
-                self.body_available(&mut body, &mut bytes, usize::MAX);
+                self.body_available(body, &mut bytes, usize::MAX);
                 if self.fill().await? == 0 {
                     break;
                 }
             }
             self.stream = None;
         }
-        if close {
-            self.stream = None;
-        }
-        Ok(Answer {
-            status,
-            retry_after_s,
-            head,
-            bytes,
-            body,
-        })
+        Ok(bytes)
     }
 
     /// Reads more into the buffer (compacting it first); 0 at end of stream.

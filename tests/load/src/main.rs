@@ -10,10 +10,12 @@
 //! ```
 //! See tests/README.md and scripts/load.sh, scripts/faults.sh.
 
+mod crowd;
 mod faults;
 mod hostile;
 mod http;
 mod report;
+mod scenarios;
 mod server;
 mod sim;
 
@@ -21,9 +23,8 @@ use anyhow::{bail, Context, Result};
 use clap::{Parser, Subcommand};
 use report::{Baselines, Summary};
 use serde::{Deserialize, Serialize};
-use sim::{CrowdConfig, DecodeProfile, Pattern};
+use sim::{DecodeProfile, Pattern};
 use std::path::PathBuf;
-use std::sync::Arc;
 use std::time::Duration;
 
 #[derive(Parser)]
@@ -231,24 +232,15 @@ fn main() -> Result<()> {
     let runtime = builder.enable_all().build()?;
     runtime.block_on(async {
         match cli.command {
-            Command::Run(args) => run(args).await,
+            Command::Run(args) => scenarios::run(args).await,
             Command::Profile {
                 url,
                 slug,
                 token,
                 runs,
                 output,
-            } => {
-                let p = sim::measure_profile(&url, &slug, token.as_deref(), runs).await?;
-                std::fs::write(&output, serde_json::to_vec_pretty(&p)?)?;
-                eprintln!(
-                    "decode profile of {slug}: {:.0} ms over {} levels",
-                    p.decode_ms.iter().sum::<f64>(),
-                    p.decode_ms.len()
-                );
-                Ok(())
-            }
-            Command::Crowd(args) => crowd(args).await,
+            } => profile(&url, &slug, token.as_deref(), runs, &output).await,
+            Command::Crowd(args) => crowd::crowd(args).await,
             Command::Hostile {
                 url,
                 slug,
@@ -271,29 +263,46 @@ fn main() -> Result<()> {
                 to,
                 delay_ms,
             } => faults::proxy(&listen, &to, Duration::from_millis(delay_ms)).await,
-            Command::Plot { results, svg } => {
-                let mut r: Results = serde_json::from_slice(&std::fs::read(&results)?)?;
-                // Regroup the runs, so that a newer median rule applies.
-                let mut groups: Vec<Vec<Summary>> = Vec::new();
-                for run in &r.runs {
-                    let same = |g: &Vec<Summary>| {
-                        g[0].caps == run.caps
-                            && g[0].visitors == run.visitors
-                            && g[0].pattern == run.pattern
-                    };
-                    match groups.iter_mut().find(|g| same(g)) {
-                        Some(g) => g.push(run.clone()),
-                        None => groups.push(vec![run.clone()]),
-                    }
-                }
-                r.medians = groups.iter().map(|g| report::median_of(g)).collect();
-                let lone = lone_seconds(&r);
-                std::fs::write(&svg, report::svg(&r.medians, lone, &plot_title(&r)))?;
-                print!("{}", report::markdown(&r.medians));
-                Ok(())
-            }
+            Command::Plot { results, svg } => plot(&results, &svg),
         }
     })
+}
+
+async fn profile(
+    url: &str,
+    slug: &str,
+    token: Option<&str>,
+    runs: usize,
+    output: &std::path::Path,
+) -> Result<()> {
+    let p = sim::measure_profile(url, slug, token, runs).await?;
+    std::fs::write(output, serde_json::to_vec_pretty(&p)?)?;
+    eprintln!(
+        "decode profile of {slug}: {:.0} ms over {} levels",
+        p.decode_ms.iter().sum::<f64>(),
+        p.decode_ms.len()
+    );
+    Ok(())
+}
+
+fn plot(results: &std::path::Path, svg: &std::path::Path) -> Result<()> {
+    let mut r: Results = serde_json::from_slice(&std::fs::read(results)?)?;
+    // Regroup the runs, so that a newer median rule applies.
+    let mut groups: Vec<Vec<Summary>> = Vec::new();
+    for run in &r.runs {
+        let same = |g: &Vec<Summary>| {
+            g[0].caps == run.caps && g[0].visitors == run.visitors && g[0].pattern == run.pattern
+        };
+        match groups.iter_mut().find(|g| same(g)) {
+            Some(g) => g.push(run.clone()),
+            None => groups.push(vec![run.clone()]),
+        }
+    }
+    r.medians = groups.iter().map(|g| report::median_of(g)).collect();
+    let lone = lone_seconds(&r);
+    std::fs::write(svg, report::svg(&r.medians, lone, &plot_title(&r)))?;
+    print!("{}", report::markdown(&r.medians));
+    Ok(())
 }
 
 fn machine() -> String {
@@ -339,333 +348,15 @@ fn plot_title(r: &Results) -> String {
     )
 }
 
-async fn run(args: RunArgs) -> Result<()> {
-    std::fs::create_dir_all(&args.out)?;
-    // The token is a secret of the test database: not in the report.
-    let mut command = Vec::new();
-    let mut secret = false;
-    for a in std::env::args() {
-        command.push(if secret { "…".to_string() } else { a.clone() });
-        secret = a == "--token";
+/// Prints each failed check and fails when there is one.
+fn fail_on(violations: &[String]) -> Result<()> {
+    if violations.is_empty() {
+        return Ok(());
     }
-    let command = command.join(" ");
-    let mut machine_line = format!("before: {}", machine());
-    let start = |caps_on: bool, tag: String| {
-        let log = args.out.join(format!("serve-{tag}.log"));
-        server::Server::start(
-            &args.bin,
-            &args.db,
-            &args.listen,
-            caps_on,
-            &args.serve_args,
-            log,
-        )
-    };
-    let profile = match &args.profile {
-        Some(p) => serde_json::from_slice(&std::fs::read(p)?)?,
-        None => {
-            let s = start(true, "profile".into()).await?;
-            let p = sim::measure_profile(&s.url, &args.slug, args.mix.token.as_deref(), 2).await;
-            s.stop().await?;
-            let p = p?;
-            std::fs::write(
-                args.out.join("profile.json"),
-                serde_json::to_vec_pretty(&p)?,
-            )?;
-            p
-        }
-    };
-    eprintln!(
-        "decode profile: {} levels, {:.2} s in all (native, this machine)",
-        profile.decode_ms.len(),
-        profile.decode_ms.iter().sum::<f64>() / 1e3
-    );
-    let profile = Arc::new(profile);
-    let crowd_config = |url: &str, visitors: usize, sequential: bool| CrowdConfig {
-        base_url: url.to_owned(),
-        slug: args.slug.clone(),
-        token: args.mix.token.clone(),
-        visitors,
-        pattern: args.pattern,
-        tablet_share: args.mix.tablet_share,
-        researcher_share: args.mix.researcher_share,
-        tablet_factor: args.mix.tablet_factor,
-        request_timeout: Duration::from_secs(args.mix.request_timeout_s),
-        stay: Duration::from_secs_f64(args.mix.stay_s.max(0.0)),
-        sigterm: None,
-        sequential,
-    };
-    let mut all = Vec::new();
-    let mut medians = Vec::new();
-    let mut baselines = Vec::new();
-    let mut violations = Vec::new();
-    for caps in &args.caps {
-        let caps_on = match caps.as_str() {
-            "on" => true,
-            "off" => false,
-            other => bail!("--caps takes off and on, not {other:?}"),
-        };
-        // A lone visitor of each kind, one after another, on a fresh server.
-        let s = start(caps_on, format!("caps-{caps}-alone")).await?;
-        let alone = sim::run_crowd(crowd_config(&s.url, 1000, true), Arc::clone(&profile)).await;
-        s.stop().await?;
-        let base = Baselines::from_visitors(&alone?.visitors);
-        for (d, a, t) in &base.0 {
-            eprintln!(
-                "caps {caps}: lone {d:?}/{a:?} visitor: level {} in {:.2} s",
-                t.len().saturating_sub(1),
-                t.last().copied().unwrap_or(0.0) / 1e3
-            );
-        }
-        for &n in &args.visitors {
-            let mut runs = Vec::new();
-            for run in 1..=args.runs {
-                let s = start(caps_on, format!("caps-{caps}-{n}-{run}")).await?;
-                let cpu0 = s.cpu_seconds()?;
-                let own0 = server::own_cpu_seconds();
-                let outcome =
-                    sim::run_crowd(crowd_config(&s.url, n, false), Arc::clone(&profile)).await?;
-                let mut sum = report::summarize(&outcome, &base);
-                sum.server_cpu_s = s.cpu_seconds()? - cpu0;
-                sum.server_cpu_pct = 100.0 * sum.server_cpu_s / outcome.wall.as_secs_f64();
-                sum.server_peak_rss_mib = s.peak_rss_mib()?;
-                sum.harness_cpu_s = server::own_cpu_seconds() - own0;
-                s.stop().await?;
-                sum.caps = caps.clone();
-                sum.pattern = args.pattern.to_string();
-                sum.run = run;
-                eprintln!(
-                    "caps {caps}, {n} visitors, run {run}: p99 {:.1} ms (200/304 only {:.1}, to head {:.1}), reconstruction median {:.2} s (× {:.2} lone, p95 × {:.2}; with the admission wait × {:.2} / {:.2}), {} refused at admission (wait ≤ {:.1} s), {} load-capped ({} resumed after {} re-checks, {} still held when leaving), errors {:?}, server CPU {:.1} s, harness CPU {:.1} s, peak RSS {:.0} MiB, wall {:.1} s",
-                    sum.p99_ms, sum.p99_ok_ms, sum.head_p99_ms, sum.recon_median_s, sum.ratio_median, sum.ratio_p95,
-                    sum.ratio_wait_median, sum.ratio_wait_p95, sum.admission_refused, sum.admission_wait_max_s,
-                    sum.load_capped, sum.resumed, sum.rechecks, sum.held_at_end, sum.errors, sum.server_cpu_s, sum.harness_cpu_s, sum.server_peak_rss_mib, sum.wall_s
-                );
-                for (status, count) in &sum.errors {
-                    if status != "429" && status != "503" {
-                        violations.push(format!(
-                            "caps {caps}, {n} visitors: {count} answers {status}"
-                        ));
-                    }
-                }
-                if sum.missing_retry_after > 0 {
-                    violations.push(format!(
-                        "caps {caps}, {n} visitors: {} 429/503 without Retry-After",
-                        sum.missing_retry_after
-                    ));
-                }
-                runs.push(sum);
-            }
-            let m = report::median_of(&runs);
-            if caps_on && args.check_visitors == Some(n) {
-                if let Some(max) = args.max_p99_ms {
-                    if m.p99_ms.is_nan() || m.p99_ms > max {
-                        violations.push(format!(
-                            "caps on, {n} visitors: p99 {:.1} ms > {max} ms",
-                            m.p99_ms
-                        ));
-                    }
-                }
-                if args.check_resume && (m.load_capped == 0 || m.resumed < m.load_capped) {
-                    violations.push(format!(
-                        "caps on, {n} visitors: {} resumed of {} load-capped ({} still held when leaving)",
-                        m.resumed, m.load_capped, m.held_at_end
-                    ));
-                }
-                if let Some(max) = args.max_ratio {
-                    if m.ratio_p95.is_nan() || m.ratio_p95 > max {
-                        violations.push(format!(
-                            "caps on, {n} visitors: p95 reconstruction × {:.2} lone > × {max}",
-                            m.ratio_p95
-                        ));
-                    }
-                }
-            }
-            medians.push(m);
-            all.extend(runs);
-        }
-        baselines.push((caps.clone(), base));
+    for v in violations {
+        eprintln!("FAIL: {v}");
     }
-    machine_line.push_str(&format!("; after: {}", machine()));
-    let results = Results {
-        machine: machine_line,
-        command,
-        profile: (*profile).clone(),
-        baselines,
-        runs: all,
-        medians,
-    };
-    std::fs::write(
-        args.out.join("results.json"),
-        serde_json::to_vec_pretty(&results)?,
-    )?;
-    let table = report::markdown(&results.medians);
-    let md = format!(
-        "Machine: {}\n\nCommand: `{}`\n\n{}",
-        results.machine, results.command, table
-    );
-    std::fs::write(args.out.join("report.md"), &md)?;
-    if let Some(svg) = &args.svg {
-        let lone = lone_seconds(&results);
-        std::fs::write(
-            svg,
-            report::svg(&results.medians, lone, &plot_title(&results)),
-        )?;
-    }
-    println!("{md}");
-    if !violations.is_empty() {
-        for v in &violations {
-            eprintln!("FAIL: {v}");
-        }
-        bail!("{} check(s) failed", violations.len());
-    }
-    eprintln!("load checks passed");
-    Ok(())
-}
-
-async fn crowd(args: CrowdArgs) -> Result<()> {
-    let profile: DecodeProfile = serde_json::from_slice(
-        &std::fs::read(&args.profile).with_context(|| args.profile.display().to_string())?,
-    )?;
-    let config = CrowdConfig {
-        base_url: args.url.trim_end_matches('/').to_owned(),
-        slug: args.slug.clone(),
-        token: args.mix.token.clone(),
-        visitors: args.visitors,
-        pattern: args.pattern,
-        tablet_share: args.mix.tablet_share,
-        researcher_share: args.mix.researcher_share,
-        tablet_factor: args.mix.tablet_factor,
-        request_timeout: Duration::from_secs(args.mix.request_timeout_s),
-        stay: Duration::from_secs_f64(args.mix.stay_s.max(0.0)),
-        sigterm: args
-            .sigterm_pid
-            .map(|p| (p, Duration::from_secs_f64(args.sigterm_after_s))),
-        sequential: false,
-    };
-    let outcome = sim::run_crowd(config, Arc::new(profile)).await?;
-    let sum = report::summarize(&outcome, &Baselines::default());
-
-    // Timeline: answers by status per bucket of request start time.
-    let width = args.timeline_ms.max(1) * 1000;
-    let mut timeline: std::collections::BTreeMap<u64, std::collections::BTreeMap<String, usize>> =
-        Default::default();
-    for r in &outcome.requests {
-        let key = if r.status == 0 {
-            "no answer".to_string()
-        } else {
-            r.status.to_string()
-        };
-        *timeline
-            .entry(r.start_us / width)
-            .or_default()
-            .entry(key)
-            .or_insert(0) += 1;
-    }
-    println!("| from s | answers by status |\n|---:|---|");
-    for (b, counts) in &timeline {
-        let c: Vec<String> = counts.iter().map(|(k, v)| format!("{k}: {v}")).collect();
-        println!("| {:.1} | {} |", (*b * width) as f64 / 1e6, c.join(", "));
-    }
-    println!(
-        "\n{} visitors ({} completed, {} failed, {} refused at admission), {} requests, p50 {:.1} ms, p99 {:.1} ms, max {:.1} ms, {:.1} MB, non-2xx {:?}, max load pressure {}",
-        sum.visitors, sum.completed, sum.failed, sum.admission_refused, sum.requests, sum.p50_ms, sum.p99_ms, sum.max_ms,
-        sum.bytes as f64 / 1e6, sum.errors, sum.pressure_max
-    );
-
-    let mut violations = Vec::new();
-    let allow: Vec<u16> = args
-        .allow
-        .split(',')
-        .filter_map(|s| s.trim().parse().ok())
-        .collect();
-    let allowed = |status: u16| matches!(status, 200 | 304) || allow.contains(&status);
-    for (status, count) in &sum.errors {
-        let ok = status.parse::<u16>().is_ok_and(allowed);
-        // Around a SIGTERM, requests after the listener closed find no server.
-        let after_sigterm = args.sigterm_pid.is_some() && status == "no answer";
-        if !ok && !after_sigterm {
-            violations.push(format!("{count} answers {status}"));
-        }
-    }
-    if sum.missing_retry_after > 0 {
-        violations.push(format!(
-            "{} 429/503 answers without Retry-After",
-            sum.missing_retry_after
-        ));
-    }
-    for required in &args.require {
-        if !outcome.requests.iter().any(|r| r.status == *required) {
-            violations.push(format!("no {required} answer was seen"));
-        }
-    }
-    if let Some(after) = args.clean_after_s {
-        let from = (after * 1e6) as u64;
-        let late: Vec<_> = outcome
-            .requests
-            .iter()
-            .filter(|r| r.start_us >= from && !matches!(r.status, 200 | 304))
-            .collect();
-        println!(
-            "requests started after {after} s: {} not 200/304",
-            late.len()
-        );
-        if !late.is_empty() {
-            violations.push(format!(
-                "{} requests started after {after} s failed (first: status {})",
-                late.len(),
-                late[0].status
-            ));
-        }
-    }
-    if let Some(at) = outcome.sigterm_at {
-        // In the handler for sure: sent 200 ms before SIGTERM, not answered by then.
-        let sig = at.as_micros() as u64;
-        let in_flight: Vec<_> = outcome
-            .requests
-            .iter()
-            .filter(|r| r.start_us + 200_000 <= sig && r.start_us + r.dur_us > sig)
-            .collect();
-        // Finished: an HTTP answer, 200 or a documented refusal, not a reset.
-        let bad = in_flight
-            .iter()
-            .filter(|r| !(matches!(r.status, 200 | 304) || allow.contains(&r.status)))
-            .count();
-        let ok = in_flight.iter().filter(|r| r.status == 200).count();
-        let refused = outcome
-            .requests
-            .iter()
-            .filter(|r| r.start_us > sig && r.status == 0)
-            .count();
-        println!(
-            "SIGTERM at {:.2} s: {} requests in flight (sent ≥ 200 ms before): {} completed with 200, {} with 429/503, {} cut off; {} later requests found the server gone",
-            at.as_secs_f64(),
-            in_flight.len(),
-            ok,
-            in_flight.len() - ok - bad,
-            bad,
-            refused
-        );
-        if in_flight.is_empty() {
-            violations.push("no request was in flight at SIGTERM: nothing was shown".into());
-        }
-        if bad > 0 {
-            violations.push(format!(
-                "{bad} in-flight requests did not complete at shutdown"
-            ));
-        }
-    }
-    if let Some(path) = &args.json {
-        let v = serde_json::json!({ "summary": sum, "timeline": timeline, "requests": outcome.requests });
-        std::fs::write(path, serde_json::to_vec_pretty(&v)?)?;
-    }
-    if !violations.is_empty() {
-        for v in &violations {
-            eprintln!("FAIL: {v}");
-        }
-        bail!("{} check(s) failed", violations.len());
-    }
-    println!("crowd checks passed");
-    Ok(())
+    bail!("{} check(s) failed", violations.len());
 }
 
 async fn hostile_cmd(url: &str, slug: &str, token: Option<String>, slow: bool) -> Result<()> {

@@ -124,22 +124,72 @@ pub fn status_key(r: &Req) -> Option<String> {
 }
 
 pub fn summarize(outcome: &CrowdOutcome, baselines: &Baselines) -> Summary {
-    let lat = sorted(
-        outcome
-            .requests
-            .iter()
-            .map(|r| r.dur_us as f64 / 1e3)
-            .collect(),
-    );
+    let mut sum = Summary {
+        wall_s: outcome.wall.as_secs_f64(),
+        pressure_max: outcome.pressure_max,
+        ..requests_summary(&outcome.requests)
+    };
+    add_reconstruction(&mut sum, &outcome.visitors, baselines);
+    add_visitors(&mut sum, &outcome.visitors);
+    sum
+}
+
+/// Latencies, answers and bytes of every request.
+fn requests_summary(requests: &[Req]) -> Summary {
+    let ms = |r: &Req| r.dur_us as f64 / 1e3;
+    let lat = sorted(requests.iter().map(ms).collect());
     let heads = sorted(
-        outcome
-            .requests
+        requests
             .iter()
             .filter(|r| r.status != 0)
             .map(|r| r.head_us as f64 / 1e3)
             .collect(),
     );
-    let done: Vec<&VisitorResult> = outcome.visitors.iter().filter(|v| v.complete()).collect();
+    let ok = sorted(
+        requests
+            .iter()
+            .filter(|r| matches!(r.status, 200 | 304))
+            .map(ms)
+            .collect(),
+    );
+    let mut errors = BTreeMap::new();
+    let mut missing_retry_after = 0;
+    let mut by_kind: BTreeMap<String, Vec<f64>> = BTreeMap::new();
+    for r in requests {
+        if let Some(k) = status_key(r) {
+            *errors.entry(k).or_insert(0) += 1;
+        }
+        if matches!(r.status, 429 | 503) && !r.retry_after {
+            missing_retry_after += 1;
+        }
+        by_kind
+            .entry(format!("{:?}", r.kind).to_lowercase())
+            .or_default()
+            .push(ms(r));
+    }
+    Summary {
+        requests: requests.len(),
+        p50_ms: percentile(&lat, 50.0),
+        p95_ms: percentile(&lat, 95.0),
+        p99_ms: percentile(&lat, 99.0),
+        head_p99_ms: percentile(&heads, 99.0),
+        p99_ms_by_kind: by_kind
+            .into_iter()
+            .map(|(k, v)| (k, percentile(&sorted(v), 99.0)))
+            .collect(),
+        max_ms: lat.last().copied().unwrap_or(f64::NAN),
+        p99_ok_ms: percentile(&ok, 99.0),
+        bytes: requests.iter().map(|r| r.bytes).sum(),
+        errors,
+        missing_retry_after,
+        ..Summary::default()
+    }
+}
+
+/// Reconstruction times of the visitors who completed, alone and as a
+/// multiple of a lone visitor's time to the same level.
+fn add_reconstruction(sum: &mut Summary, visitors: &[VisitorResult], baselines: &Baselines) {
+    let done: Vec<&VisitorResult> = visitors.iter().filter(|v| v.complete()).collect();
     // Up to where refinement first stopped: a visitor resumed after a load
     // cap lifted has waited out `Retry-After`, which is the cap's price, not
     // the crowd's (counted apart below).
@@ -158,91 +208,48 @@ pub fn summarize(outcome: &CrowdOutcome, baselines: &Baselines) -> Summary {
         })
         .unzip();
     let (ratios, ratios_wait) = (sorted(ratios), sorted(ratios_wait));
-    let refused: Vec<&VisitorResult> = outcome.visitors.iter().filter(|v| v.refusals > 0).collect();
+    sum.recon_median_s = percentile(&recon, 50.0) / 1e3;
+    sum.recon_p95_s = percentile(&recon, 95.0) / 1e3;
+    sum.ratio_median = percentile(&ratios, 50.0);
+    sum.ratio_p95 = percentile(&ratios, 95.0);
+    sum.ratio_max = ratios.last().copied().unwrap_or(f64::NAN);
+    sum.ratio_wait_median = percentile(&ratios_wait, 50.0);
+    sum.ratio_wait_p95 = percentile(&ratios_wait, 95.0);
+    sum.completed = done.len();
+    sum.failed = visitors.len() - done.len();
+}
+
+/// Admission waits, levels reached and load caps, over every visitor.
+fn add_visitors(sum: &mut Summary, visitors: &[VisitorResult]) {
+    let refused: Vec<&VisitorResult> = visitors.iter().filter(|v| v.refusals > 0).collect();
     let waits = sorted(refused.iter().map(|v| v.admission_wait_ms / 1e3).collect());
-    let ok = sorted(
-        outcome
-            .requests
-            .iter()
-            .filter(|r| matches!(r.status, 200 | 304))
-            .map(|r| r.dur_us as f64 / 1e3)
-            .collect(),
-    );
     let levels = sorted(
-        outcome
-            .visitors
+        visitors
             .iter()
             .filter(|v| v.device == Some(Device::Desktop) && v.audience == Some(Audience::Public))
             .filter_map(|v| v.reached().map(f64::from))
             .collect(),
     );
-    let mut errors = BTreeMap::new();
-    let mut missing_retry_after = 0;
-    for r in &outcome.requests {
-        if let Some(k) = status_key(r) {
-            *errors.entry(k).or_insert(0) += 1;
-        }
-        if matches!(r.status, 429 | 503) && !r.retry_after {
-            missing_retry_after += 1;
-        }
-    }
     let mut load_capped_levels = BTreeMap::new();
-    for v in outcome.visitors.iter().filter(|v| v.load_capped()) {
+    for v in visitors.iter().filter(|v| v.load_capped()) {
         if let Some((l, _)) = v.first_stop() {
             *load_capped_levels.entry(l).or_insert(0) += 1;
         }
     }
-    Summary {
-        requests: outcome.requests.len(),
-        p50_ms: percentile(&lat, 50.0),
-        p95_ms: percentile(&lat, 95.0),
-        p99_ms: percentile(&lat, 99.0),
-        head_p99_ms: percentile(&heads, 99.0),
-        p99_ms_by_kind: {
-            let mut by_kind: BTreeMap<String, Vec<f64>> = BTreeMap::new();
-            for r in &outcome.requests {
-                by_kind
-                    .entry(format!("{:?}", r.kind).to_lowercase())
-                    .or_default()
-                    .push(r.dur_us as f64 / 1e3);
-            }
-            by_kind
-                .into_iter()
-                .map(|(k, v)| (k, percentile(&sorted(v), 99.0)))
-                .collect()
-        },
-        max_ms: lat.last().copied().unwrap_or(f64::NAN),
-        recon_median_s: percentile(&recon, 50.0) / 1e3,
-        recon_p95_s: percentile(&recon, 95.0) / 1e3,
-        ratio_median: percentile(&ratios, 50.0),
-        ratio_p95: percentile(&ratios, 95.0),
-        ratio_max: ratios.last().copied().unwrap_or(f64::NAN),
-        ratio_wait_median: percentile(&ratios_wait, 50.0),
-        ratio_wait_p95: percentile(&ratios_wait, 95.0),
-        admission_refused: refused.len(),
-        admission_wait_median_s: if waits.is_empty() {
-            0.0
-        } else {
-            percentile(&waits, 50.0)
-        },
-        admission_wait_max_s: waits.last().copied().unwrap_or(0.0),
-        p99_ok_ms: percentile(&ok, 99.0),
-        completed: done.len(),
-        failed: outcome.visitors.len() - done.len(),
-        public_desktop_level: percentile(&levels, 50.0),
-        load_capped: outcome.visitors.iter().filter(|v| v.load_capped()).count(),
-        load_capped_levels,
-        resumed: outcome.visitors.iter().filter(|v| v.resumed).count(),
-        held_at_end: outcome.visitors.iter().filter(|v| v.held_at_end).count(),
-        rechecks: outcome.visitors.iter().map(|v| v.rechecks as usize).sum(),
-        bytes: outcome.requests.iter().map(|r| r.bytes).sum(),
-        errors,
-        missing_retry_after,
-        wall_s: outcome.wall.as_secs_f64(),
-        pressure_max: outcome.pressure_max,
-        visitors: outcome.visitors.len(),
-        ..Summary::default()
-    }
+    sum.admission_refused = refused.len();
+    sum.admission_wait_median_s = if waits.is_empty() {
+        0.0
+    } else {
+        percentile(&waits, 50.0)
+    };
+    sum.admission_wait_max_s = waits.last().copied().unwrap_or(0.0);
+    sum.public_desktop_level = percentile(&levels, 50.0);
+    sum.load_capped = visitors.iter().filter(|v| v.load_capped()).count();
+    sum.load_capped_levels = load_capped_levels;
+    sum.resumed = visitors.iter().filter(|v| v.resumed).count();
+    sum.held_at_end = visitors.iter().filter(|v| v.held_at_end).count();
+    sum.rechecks = visitors.iter().map(|v| v.rechecks as usize).sum();
+    sum.visitors = visitors.len();
 }
 
 /// Several runs of one scenario as one row: the run with the median p99,
@@ -345,13 +352,6 @@ pub fn svg(rows: &[Summary], lone_s: Option<f64>, title: &str) -> String {
         w / 2.0,
         escape(title)
     );
-    let max_v = rows.iter().map(|r| r.visitors).max().unwrap_or(1).max(2) as f64;
-    let series = |caps: &str| -> Vec<&Summary> {
-        let mut v: Vec<&Summary> = rows.iter().filter(|r| r.caps == caps).collect();
-        v.sort_by_key(|r| r.visitors);
-        v
-    };
-    let colour = |caps: &str| if caps == "on" { "#1f77b4" } else { "#d62728" };
     let panels: [Panel; 2] = [
         (
             "full reconstruction per visitor, s (median, whisker to p95)",
@@ -367,99 +367,16 @@ pub fn svg(rows: &[Summary], lone_s: Option<f64>, title: &str) -> String {
         ),
     ];
     for (label, x0, value, goal) in panels {
-        let (px, py, pw, ph) = (x0 + 50.0, 50.0, 380.0, 300.0);
-        let ymax = rows
-            .iter()
-            .map(|r| value(r).1)
-            .chain(goal.map(|g| g.0))
-            .filter(|v| v.is_finite())
-            .fold(0.0_f64, f64::max)
-            * 1.1;
-        let ymax = if ymax > 0.0 { nice(ymax) } else { 1.0 };
-        let x = |v: f64| px + pw * (v.max(1.0).ln() / max_v.ln());
-        let y = |v: f64| py + ph - ph * (v / ymax).clamp(0.0, 1.0);
-        let _ = writeln!(
-            s,
-            r##"<rect x="{px}" y="{py}" width="{pw}" height="{ph}" fill="none" stroke="#888"/>"##
-        );
-        let _ = writeln!(
-            s,
-            r#"<text x="{}" y="{}" text-anchor="middle">{}</text>"#,
-            px + pw / 2.0,
-            py - 8.0,
-            escape(label)
-        );
-        for i in 0..=4 {
-            let v = ymax * f64::from(i) / 4.0;
-            let _ = writeln!(
-                s,
-                r##"<line x1="{px}" x2="{}" y1="{y}" y2="{y}" stroke="#eee"/><text x="{}" y="{}" text-anchor="end">{}</text>"##,
-                px + pw,
-                px - 4.0,
-                y(v) + 4.0,
-                short(v),
-                y = y(v)
-            );
-        }
-        let mut ticks: Vec<usize> = rows.iter().map(|r| r.visitors).collect();
-        ticks.sort_unstable();
-        ticks.dedup();
-        for t in ticks {
-            let _ = writeln!(
-                s,
-                r#"<text x="{}" y="{}" text-anchor="middle">{t}</text>"#,
-                x(t as f64),
-                py + ph + 16.0
-            );
-        }
-        let _ = writeln!(
-            s,
-            r#"<text x="{}" y="{}" text-anchor="middle">simultaneous visitors (log scale)</text>"#,
-            px + pw / 2.0,
-            py + ph + 34.0
-        );
+        let frame = Frame::new(rows, x0, value, goal);
+        frame.axes(&mut s, label, rows);
         if let Some((g, text)) = goal {
-            let _ = writeln!(
-                s,
-                r##"<line x1="{px}" x2="{}" y1="{y}" y2="{y}" stroke="#2ca02c" stroke-dasharray="6 4"/><text x="{}" y="{}" fill="#2ca02c" text-anchor="end">{}</text>"##,
-                px + pw,
-                px + pw - 4.0,
-                y(g) - 4.0,
-                escape(text),
-                y = y(g)
-            );
+            frame.goal(&mut s, g, text);
         }
         for caps in ["off", "on"] {
-            let pts = series(caps);
-            if pts.is_empty() {
-                continue;
-            }
-            let c = colour(caps);
-            let path: Vec<String> = pts
-                .iter()
-                .filter(|r| value(r).0.is_finite())
-                .map(|r| format!("{:.1},{:.1}", x(r.visitors as f64), y(value(r).0)))
-                .collect();
-            let _ = writeln!(
-                s,
-                r#"<polyline points="{}" fill="none" stroke="{c}" stroke-width="2"/>"#,
-                path.join(" ")
-            );
-            for r in pts {
-                let (m, hi) = value(r);
-                if !m.is_finite() {
-                    continue;
-                }
-                let cx = x(r.visitors as f64);
-                if hi.is_finite() && hi > m {
-                    let _ = writeln!(
-                        s,
-                        r#"<line x1="{cx}" x2="{cx}" y1="{}" y2="{}" stroke="{c}"/>"#,
-                        y(m),
-                        y(hi)
-                    );
-                }
-                let _ = writeln!(s, r#"<circle cx="{cx}" cy="{}" r="3.5" fill="{c}"/>"#, y(m));
+            let mut pts: Vec<&Summary> = rows.iter().filter(|r| r.caps == caps).collect();
+            pts.sort_by_key(|r| r.visitors);
+            if !pts.is_empty() {
+                frame.series(&mut s, &pts, value, colour(caps));
             }
         }
     }
@@ -478,6 +395,155 @@ pub fn svg(rows: &[Summary], lone_s: Option<f64>, title: &str) -> String {
     }
     s.push_str("</svg>\n");
     s
+}
+
+fn colour(caps: &str) -> &'static str {
+    if caps == "on" {
+        "#1f77b4"
+    } else {
+        "#d62728"
+    }
+}
+
+/// One panel's plot area: visitors on a log scale across, the value up.
+struct Frame {
+    px: f64,
+    py: f64,
+    pw: f64,
+    ph: f64,
+    ymax: f64,
+    max_v: f64,
+}
+
+impl Frame {
+    fn new(
+        rows: &[Summary],
+        x0: f64,
+        value: &dyn Fn(&Summary) -> (f64, f64),
+        goal: Option<(f64, &str)>,
+    ) -> Frame {
+        let ymax = rows
+            .iter()
+            .map(|r| value(r).1)
+            .chain(goal.map(|g| g.0))
+            .filter(|v| v.is_finite())
+            .fold(0.0_f64, f64::max)
+            * 1.1;
+        Frame {
+            px: x0 + 50.0,
+            py: 50.0,
+            pw: 380.0,
+            ph: 300.0,
+            ymax: if ymax > 0.0 { nice(ymax) } else { 1.0 },
+            max_v: rows.iter().map(|r| r.visitors).max().unwrap_or(1).max(2) as f64,
+        }
+    }
+
+    fn x(&self, v: f64) -> f64 {
+        self.px + self.pw * (v.max(1.0).ln() / self.max_v.ln())
+    }
+
+    fn y(&self, v: f64) -> f64 {
+        self.py + self.ph - self.ph * (v / self.ymax).clamp(0.0, 1.0)
+    }
+
+    /// The frame, its title, the value grid and the visitor ticks.
+    fn axes(&self, s: &mut String, label: &str, rows: &[Summary]) {
+        let (px, py, pw, ph) = (self.px, self.py, self.pw, self.ph);
+        let _ = writeln!(
+            s,
+            r##"<rect x="{px}" y="{py}" width="{pw}" height="{ph}" fill="none" stroke="#888"/>"##
+        );
+        let _ = writeln!(
+            s,
+            r#"<text x="{}" y="{}" text-anchor="middle">{}</text>"#,
+            px + pw / 2.0,
+            py - 8.0,
+            escape(label)
+        );
+        for i in 0..=4 {
+            let v = self.ymax * f64::from(i) / 4.0;
+            let _ = writeln!(
+                s,
+                r##"<line x1="{px}" x2="{}" y1="{y}" y2="{y}" stroke="#eee"/><text x="{}" y="{}" text-anchor="end">{}</text>"##,
+                px + pw,
+                px - 4.0,
+                self.y(v) + 4.0,
+                short(v),
+                y = self.y(v)
+            );
+        }
+        let mut ticks: Vec<usize> = rows.iter().map(|r| r.visitors).collect();
+        ticks.sort_unstable();
+        ticks.dedup();
+        for t in ticks {
+            let _ = writeln!(
+                s,
+                r#"<text x="{}" y="{}" text-anchor="middle">{t}</text>"#,
+                self.x(t as f64),
+                py + ph + 16.0
+            );
+        }
+        let _ = writeln!(
+            s,
+            r#"<text x="{}" y="{}" text-anchor="middle">simultaneous visitors (log scale)</text>"#,
+            px + pw / 2.0,
+            py + ph + 34.0
+        );
+    }
+
+    fn goal(&self, s: &mut String, g: f64, text: &str) {
+        let (px, pw) = (self.px, self.pw);
+        let _ = writeln!(
+            s,
+            r##"<line x1="{px}" x2="{}" y1="{y}" y2="{y}" stroke="#2ca02c" stroke-dasharray="6 4"/><text x="{}" y="{}" fill="#2ca02c" text-anchor="end">{}</text>"##,
+            px + pw,
+            px + pw - 4.0,
+            self.y(g) - 4.0,
+            escape(text),
+            y = self.y(g)
+        );
+    }
+
+    /// One caps setting's line, points and whiskers.
+    fn series(
+        &self,
+        s: &mut String,
+        pts: &[&Summary],
+        value: &dyn Fn(&Summary) -> (f64, f64),
+        c: &str,
+    ) {
+        let path: Vec<String> = pts
+            .iter()
+            .filter(|r| value(r).0.is_finite())
+            .map(|r| format!("{:.1},{:.1}", self.x(r.visitors as f64), self.y(value(r).0)))
+            .collect();
+        let _ = writeln!(
+            s,
+            r#"<polyline points="{}" fill="none" stroke="{c}" stroke-width="2"/>"#,
+            path.join(" ")
+        );
+        for r in pts {
+            let (m, hi) = value(r);
+            if !m.is_finite() {
+                continue;
+            }
+            let cx = self.x(r.visitors as f64);
+            if hi.is_finite() && hi > m {
+                let _ = writeln!(
+                    s,
+                    r#"<line x1="{cx}" x2="{cx}" y1="{}" y2="{}" stroke="{c}"/>"#,
+                    self.y(m),
+                    self.y(hi)
+                );
+            }
+            let _ = writeln!(
+                s,
+                r#"<circle cx="{cx}" cy="{}" r="3.5" fill="{c}"/>"#,
+                self.y(m)
+            );
+        }
+    }
 }
 
 fn nice(v: f64) -> f64 {

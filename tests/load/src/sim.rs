@@ -143,28 +143,31 @@ pub async fn measure_profile(
         vertices.push(level["vertices"].as_u64().unwrap_or(0) as u32);
     }
     let bytes = payloads.iter().map(|p| p.len() as u64).collect();
-    let decode_ms = tokio::task::spawn_blocking(move || -> Result<Vec<f64>> {
-        let mut best = vec![f64::INFINITY; payloads.len()];
-        for _ in 0..runs.max(1) {
-            let t = Instant::now();
-            let mut decoder =
-                vitrine_codec::Decoder::new(&payloads[0], vitrine_codec::Limits::default())?;
-            best[0] = best[0].min(t.elapsed().as_secs_f64() * 1e3);
-            for (k, batch) in payloads.iter().enumerate().skip(1) {
-                let t = Instant::now();
-                decoder.apply_batch(batch)?;
-                best[k] = best[k].min(t.elapsed().as_secs_f64() * 1e3);
-            }
-        }
-        Ok(best)
-    })
-    .await??;
+    let decode_ms = tokio::task::spawn_blocking(move || decode_times(&payloads, runs)).await??;
     Ok(DecodeProfile {
         model: slug.to_owned(),
         decode_ms,
         vertices,
         bytes,
     })
+}
+
+/// Each level's best decode time over `runs` decodes, in ms: the base mesh,
+/// then each batch applied to the level below.
+fn decode_times(payloads: &[Vec<u8>], runs: usize) -> Result<Vec<f64>> {
+    let mut best = vec![f64::INFINITY; payloads.len()];
+    for _ in 0..runs.max(1) {
+        let t = Instant::now();
+        let mut decoder =
+            vitrine_codec::Decoder::new(&payloads[0], vitrine_codec::Limits::default())?;
+        best[0] = best[0].min(t.elapsed().as_secs_f64() * 1e3);
+        for (k, batch) in payloads.iter().enumerate().skip(1) {
+            let t = Instant::now();
+            decoder.apply_batch(batch)?;
+            best[k] = best[k].min(t.elapsed().as_secs_f64() * 1e3);
+        }
+    }
+    Ok(best)
 }
 
 /// What the crowd is.
@@ -418,220 +421,321 @@ impl Visit {
         arrive: Duration,
     ) -> (VisitorResult, Vec<Req>) {
         tokio::time::sleep_until((self.epoch + arrive).into()).await;
-        let arrived = Instant::now();
-        let mut result = VisitorResult {
-            device: Some(device),
-            audience: Some(audience),
-            arrive_ms: arrived.duration_since(self.epoch).as_secs_f64() * 1e3,
-            who,
-            ..VisitorResult::default()
+        let mut page = self.open_page(who, device, audience);
+        let path = format!("/api/models/{}", self.config.slug);
+        let Some((manifest, t0)) = self.admitted(&mut page, &path).await else {
+            return (page.result, page.reqs);
         };
-        let mut reqs = Vec::with_capacity(16);
+        let last = manifest["last_level"].as_u64().unwrap_or(0) as u32;
+        let cap = manifest["cap"]["level"].as_u64().unwrap_or(0) as u32;
+        page.result.manifest_cap = Some(cap);
+        page.result.manifest_reason = manifest["cap"]["reason"].as_str().map(str::to_owned);
+        page.result.target = cap.min(last);
+        let urls = level_urls(&manifest);
+        if urls.len() <= page.result.target as usize {
+            page.result.failure = Some("manifest lists fewer levels than its cap".into());
+            return (page.result, page.reqs);
+        }
+        if self.textures(&mut page, &manifest).await && self.base(&mut page, &urls[0], t0).await {
+            self.refine_while_staying(&mut page, &path, &manifest, urls, t0)
+                .await;
+        }
+        (page.result, page.reqs)
+    }
+
+    /// A visitor arrives: a fresh page with its own connection.
+    fn open_page(&self, who: usize, device: Device, audience: Audience) -> Page {
+        let arrived = Instant::now();
         let authorization = match (audience, &self.config.token) {
             (Audience::Researcher, Some(token)) => Some(format!("Bearer {token}")),
             _ => None,
         };
-        let mut conn = Conn::new(
-            &self.config.base_url,
-            device.user_agent(),
-            authorization.as_deref(),
-            Duration::from_secs(10),
-        );
-        let fail = |result: &mut VisitorResult, f: &Fetched, what: &str| {
-            result.failure = Some(
-                f.error
-                    .clone()
-                    .unwrap_or_else(|| format!("{what}: HTTP {}", f.req.status)),
-            );
-        };
+        Page {
+            conn: Conn::new(
+                &self.config.base_url,
+                device.user_agent(),
+                authorization.as_deref(),
+                Duration::from_secs(10),
+            ),
+            result: VisitorResult {
+                device: Some(device),
+                audience: Some(audience),
+                arrive_ms: arrived.duration_since(self.epoch).as_secs_f64() * 1e3,
+                who,
+                ..VisitorResult::default()
+            },
+            reqs: Vec::with_capacity(16),
+            arrived,
+            device,
+        }
+    }
 
-        // Admission: the manifest, again after each 503 `busy` (Retry-After).
-        let path = format!("/api/models/{}", self.config.slug);
+    /// Admission: the manifest, again after each 503 `busy` (Retry-After).
+    /// Reconstruction is timed from the request that was admitted (returned
+    /// with the manifest); the wait before it is kept apart.
+    async fn admitted(&self, page: &mut Page, path: &str) -> Option<(serde_json::Value, Instant)> {
+        let who = page.result.who;
         let m = self
-            .fetch_retrying(&mut conn, Kind::Manifest, &path, true, who, &mut reqs)
+            .fetch_retrying(
+                &mut page.conn,
+                Kind::Manifest,
+                path,
+                true,
+                who,
+                &mut page.reqs,
+            )
             .await;
-        reqs.push(m.req);
-        // Reconstruction is timed from the request that was admitted; the
-        // wait before it is kept apart.
+        page.reqs.push(m.req);
         let t0 = self.epoch + Duration::from_micros(m.req.start_us);
-        result.admission_wait_ms = t0.duration_since(arrived).as_secs_f64() * 1e3;
-        result.refusals = reqs.len() as u32 - 1;
-        let manifest: serde_json::Value = match (&m.body, m.req.status) {
-            (Some(b), 200) => serde_json::from_slice(b).unwrap_or_default(),
+        page.result.admission_wait_ms = t0.duration_since(page.arrived).as_secs_f64() * 1e3;
+        page.result.refusals = page.reqs.len() as u32 - 1;
+        match (&m.body, m.req.status) {
+            (Some(b), 200) => Some((serde_json::from_slice(b).unwrap_or_default(), t0)),
             _ => {
-                fail(&mut result, &m, "manifest");
-                return (result, reqs);
+                page.fail(&m, "manifest");
+                None
             }
+        }
+    }
+
+    /// The manifest's textures, each fetched once; false when one fails.
+    async fn textures(&self, page: &mut Page, manifest: &serde_json::Value) -> bool {
+        let Some(textures) = manifest["textures"].as_array() else {
+            return true;
         };
-        let last = manifest["last_level"].as_u64().unwrap_or(0) as u32;
-        let cap = manifest["cap"]["level"].as_u64().unwrap_or(0) as u32;
-        result.manifest_cap = Some(cap);
-        result.manifest_reason = manifest["cap"]["reason"].as_str().map(str::to_owned);
-        result.target = cap.min(last);
-        let urls = level_urls(&manifest);
-        if urls.len() <= result.target as usize {
-            result.failure = Some("manifest lists fewer levels than its cap".into());
-            return (result, reqs);
-        }
-        if let Some(textures) = manifest["textures"].as_array() {
-            for t in textures {
-                let url = t["url"].as_str().unwrap_or("");
-                let f = self
-                    .fetch_retrying(&mut conn, Kind::Texture, url, false, who, &mut reqs)
-                    .await;
-                reqs.push(f.req);
-                if f.req.status != 200 {
-                    fail(&mut result, &f, "texture");
-                    return (result, reqs);
-                }
+        let who = page.result.who;
+        for t in textures {
+            let url = t["url"].as_str().unwrap_or("");
+            let f = self
+                .fetch_retrying(
+                    &mut page.conn,
+                    Kind::Texture,
+                    url,
+                    false,
+                    who,
+                    &mut page.reqs,
+                )
+                .await;
+            page.reqs.push(f.req);
+            if f.req.status != 200 {
+                page.fail(&f, "texture");
+                return false;
             }
         }
+        true
+    }
 
+    /// The base mesh, fetched and decoded: level 0 on screen.
+    async fn base(&self, page: &mut Page, url: &str, t0: Instant) -> bool {
+        let who = page.result.who;
         let base = self
-            .fetch_retrying(&mut conn, Kind::Base, &urls[0], false, who, &mut reqs)
+            .fetch_retrying(&mut page.conn, Kind::Base, url, false, who, &mut page.reqs)
             .await;
-        reqs.push(base.req);
+        page.reqs.push(base.req);
         if base.req.status != 200 {
-            fail(&mut result, &base, "base");
-            return (result, reqs);
+            page.fail(&base, "base");
+            return false;
         }
-        self.decode_wait(0, device).await;
-        result.level_ms.push(t0.elapsed().as_secs_f64() * 1e3);
+        self.decode_wait(0, page.device).await;
+        page.result.level_ms.push(t0.elapsed().as_secs_f64() * 1e3);
+        true
+    }
 
-        // Refine to the cap; while a load cap holds (it comes with
-        // `Retry-After`), read the manifest again after that wait and go on
-        // when the cap has risen, as the viewer does, for as long as the
-        // visitor stays.
-        let mut cap = ManifestCap::of(&manifest, last);
-        let mut urls = urls;
+    /// Refines to the cap; while a load cap holds (it comes with
+    /// `Retry-After`), reads the manifest again after that wait and goes on
+    /// when the cap has risen, as the viewer does, for as long as the
+    /// visitor stays.
+    async fn refine_while_staying(
+        self: &Arc<Self>,
+        page: &mut Page,
+        path: &str,
+        manifest: &serde_json::Value,
+        mut urls: Vec<String>,
+        t0: Instant,
+    ) {
+        let last = manifest["last_level"].as_u64().unwrap_or(0) as u32;
+        let mut cap = ManifestCap::of(manifest, last);
         let mut from = 1;
         loop {
-            let stop = self
-                .refine(&mut conn, &urls, from, device, t0, &mut result, &mut reqs)
-                .await;
-            let retry_after_s = match stop {
+            let retry_after_s = match self.refine(page, &urls, from, t0).await {
                 Stop::Failed => break,
                 Stop::Refused { retry_after_s } => retry_after_s,
-                Stop::AtCap if result.target < last => cap.retry_after_s,
+                Stop::AtCap if page.result.target < last => cap.retry_after_s,
                 Stop::AtCap => None,
             };
             let Some(after) = retry_after_s else { break };
-            let reached = result.reached().unwrap_or(0);
-            result.first_stop.get_or_insert(reached);
-            let wait =
-                Duration::from_secs_f64(after.max(0.0) + jitter(who, 1000 + result.rechecks));
-            if arrived.elapsed() + wait > self.config.stay {
-                result.held_at_end = true;
-                break;
-            }
-            tokio::time::sleep(wait).await;
-            result.rechecks += 1;
-            let m = self
-                .fetch_retrying(&mut conn, Kind::Manifest, &path, true, who, &mut reqs)
-                .await;
-            reqs.push(m.req);
-            // Nothing more unless the cap has risen past what is on screen.
-            from = reached as usize + 1;
-            result.target = reached;
-            let Some(manifest) = m
-                .body
-                .as_deref()
-                .filter(|_| m.req.status == 200)
-                .and_then(|b| serde_json::from_slice::<serde_json::Value>(b).ok())
-            else {
+            let reached = page.result.reached().unwrap_or(0);
+            page.result.first_stop.get_or_insert(reached);
+            let Some(manifest) = self.recheck(page, path, after).await else {
+                if page.result.held_at_end {
+                    break;
+                }
                 // No manifest this time: wait as long again (the viewer does).
+                from = reached as usize + 1;
+                page.result.target = reached;
                 cap.retry_after_s = Some(after);
                 continue;
             };
+            // Nothing more unless the cap has risen past what is on screen.
+            from = reached as usize + 1;
+            page.result.target = reached;
             let levels = level_urls(&manifest);
             cap = ManifestCap::of(&manifest, last);
             if cap.level > reached && levels.len() > cap.level as usize {
-                result.resumed = true;
-                result.target = cap.level;
+                page.result.resumed = true;
+                page.result.target = cap.level;
                 urls = levels;
             }
         }
-        (result, reqs)
     }
 
-    /// Batches `from..=result.target`, each decoded (waited for) before the
-    /// next is shown, the next one fetched meanwhile.
-    #[allow(clippy::too_many_arguments)]
+    /// The manifest again after `after` seconds (plus jitter), unless the
+    /// visitor leaves first (then `held_at_end`); `None` without a manifest.
+    async fn recheck(&self, page: &mut Page, path: &str, after: f64) -> Option<serde_json::Value> {
+        let who = page.result.who;
+        let wait =
+            Duration::from_secs_f64(after.max(0.0) + jitter(who, 1000 + page.result.rechecks));
+        if page.arrived.elapsed() + wait > self.config.stay {
+            page.result.held_at_end = true;
+            return None;
+        }
+        tokio::time::sleep(wait).await;
+        page.result.rechecks += 1;
+        let m = self
+            .fetch_retrying(
+                &mut page.conn,
+                Kind::Manifest,
+                path,
+                true,
+                who,
+                &mut page.reqs,
+            )
+            .await;
+        page.reqs.push(m.req);
+        m.body
+            .as_deref()
+            .filter(|_| m.req.status == 200)
+            .and_then(|b| serde_json::from_slice::<serde_json::Value>(b).ok())
+    }
+
+    /// Batches `from..=target`, each decoded (waited for) before the next is
+    /// shown, the next one fetched meanwhile.
     async fn refine(
         self: &Arc<Self>,
-        conn: &mut Conn,
+        page: &mut Page,
         urls: &[String],
         from: usize,
-        device: Device,
         t0: Instant,
-        result: &mut VisitorResult,
-        reqs: &mut Vec<Req>,
     ) -> Stop {
-        type Prefetch = (Fetched, Conn, Vec<Req>);
-        let who = result.who;
+        let who = page.result.who;
         let mut prefetch: Option<tokio::task::JoinHandle<Prefetch>> = None;
-        for k in from..=result.target as usize {
+        for k in from..=page.result.target as usize {
             let f = match prefetch.take() {
                 Some(handle) => match handle.await {
                     Ok((f, c, retried)) => {
-                        *conn = c;
-                        reqs.extend(retried);
+                        page.conn = c;
+                        page.reqs.extend(retried);
                         f
                     }
                     Err(e) => {
-                        result.failure = Some(format!("prefetch task: {e}"));
+                        page.result.failure = Some(format!("prefetch task: {e}"));
                         return Stop::Failed;
                     }
                 },
                 None => {
-                    self.fetch_retrying(conn, Kind::Batch, &urls[k], false, who, reqs)
-                        .await
+                    self.fetch_retrying(
+                        &mut page.conn,
+                        Kind::Batch,
+                        &urls[k],
+                        false,
+                        who,
+                        &mut page.reqs,
+                    )
+                    .await
                 }
             };
-            reqs.push(f.req);
-            if f.req.status == 403 || f.req.status == 429 {
-                let body: serde_json::Value = f
-                    .body
-                    .as_deref()
-                    .and_then(|b| serde_json::from_slice(b).ok())
-                    .unwrap_or_default();
-                if body["error"] == "level_capped" {
-                    let reason = body["reason"].as_str().map(str::to_owned);
-                    result
-                        .refused
-                        .get_or_insert((k as u32, f.req.status, reason));
-                    return Stop::Refused {
-                        retry_after_s: f.retry_after_s,
-                    };
-                }
+            page.reqs.push(f.req);
+            if let Some(stop) = page.refused_or_failed(&f, k) {
+                return stop;
             }
-            if f.req.status != 200 {
-                result.failure = Some(
-                    f.error
-                        .clone()
-                        .unwrap_or_else(|| format!("batch {k}: HTTP {}", f.req.status)),
-                );
-                return Stop::Failed;
+            if k < page.result.target as usize {
+                prefetch = Some(self.prefetch(page, urls[k + 1].clone()));
             }
-            if k < result.target as usize {
-                let visit = Arc::clone(self);
-                let url = urls[k + 1].clone();
-                let mut c = std::mem::replace(
-                    conn,
-                    Conn::new(&self.config.base_url, "", None, Duration::ZERO),
-                );
-                prefetch = Some(tokio::spawn(async move {
-                    let mut retried = Vec::new();
-                    let f = visit
-                        .fetch_retrying(&mut c, Kind::Batch, &url, false, who, &mut retried)
-                        .await;
-                    (f, c, retried)
-                }));
-            }
-            self.decode_wait(k, device).await;
-            result.level_ms.push(t0.elapsed().as_secs_f64() * 1e3);
+            self.decode_wait(k, page.device).await;
+            page.result.level_ms.push(t0.elapsed().as_secs_f64() * 1e3);
         }
         Stop::AtCap
+    }
+
+    /// Fetches `url` on the page's connection in a task of its own, while
+    /// the page decodes; the page gets its connection back with the answer.
+    fn prefetch(
+        self: &Arc<Self>,
+        page: &mut Page,
+        url: String,
+    ) -> tokio::task::JoinHandle<Prefetch> {
+        let visit = Arc::clone(self);
+        let who = page.result.who;
+        let mut c = std::mem::replace(
+            &mut page.conn,
+            Conn::new(&self.config.base_url, "", None, Duration::ZERO),
+        );
+        tokio::spawn(async move {
+            let mut retried = Vec::new();
+            let f = visit
+                .fetch_retrying(&mut c, Kind::Batch, &url, false, who, &mut retried)
+                .await;
+            (f, c, retried)
+        })
+    }
+}
+
+/// A prefetched batch: the answer, the connection it came on, the refused
+/// attempts before it.
+type Prefetch = (Fetched, Conn, Vec<Req>);
+
+/// One visitor's page: its connection, what it reached, every request sent.
+struct Page {
+    conn: Conn,
+    result: VisitorResult,
+    reqs: Vec<Req>,
+    arrived: Instant,
+    device: Device,
+}
+
+impl Page {
+    fn fail(&mut self, f: &Fetched, what: &str) {
+        self.result.failure = Some(
+            f.error
+                .clone()
+                .unwrap_or_else(|| format!("{what}: HTTP {}", f.req.status)),
+        );
+    }
+
+    /// Why refinement stops at batch `k`'s answer, if it does: a
+    /// `level_capped` refusal (403/429), or any other answer but 200.
+    fn refused_or_failed(&mut self, f: &Fetched, k: usize) -> Option<Stop> {
+        if f.req.status == 403 || f.req.status == 429 {
+            let body: serde_json::Value = f
+                .body
+                .as_deref()
+                .and_then(|b| serde_json::from_slice(b).ok())
+                .unwrap_or_default();
+            if body["error"] == "level_capped" {
+                let reason = body["reason"].as_str().map(str::to_owned);
+                self.result
+                    .refused
+                    .get_or_insert((k as u32, f.req.status, reason));
+                return Some(Stop::Refused {
+                    retry_after_s: f.retry_after_s,
+                });
+            }
+        }
+        if f.req.status != 200 {
+            self.fail(f, &format!("batch {k}"));
+            return Some(Stop::Failed);
+        }
+        None
     }
 }
 
@@ -690,47 +794,14 @@ pub async fn run_crowd(config: CrowdConfig, profile: Arc<DecodeProfile>) -> Resu
         Arc::clone(&done),
         Arc::clone(&pressure),
     ));
-    let sigterm = config.sigterm.map(|(pid, after)| {
-        tokio::spawn(async move {
-            tokio::time::sleep(after).await;
-            let at = epoch.elapsed();
-            let _ = tokio::process::Command::new("kill")
-                .args(["-TERM", &pid.to_string()])
-                .status()
-                .await;
-            at
-        })
-    });
-
-    let mut visitors = Vec::with_capacity(config.visitors);
-    let mut requests = Vec::with_capacity(config.visitors * 16);
-    if config.sequential {
-        // One visitor per (device, audience) pair present in the mix, alone.
-        let mut seen = Vec::new();
-        for i in 0..config.visitors {
-            let pair = mix(i, config.tablet_share, config.researcher_share);
-            if seen.contains(&pair) {
-                continue;
-            }
-            seen.push(pair);
-            let start = epoch.elapsed();
-            let (r, q) = Arc::clone(&visit).run(i, pair.0, pair.1, start).await;
-            visitors.push(r);
-            requests.extend(q);
-        }
+    let sigterm = config
+        .sigterm
+        .map(|(pid, after)| tokio::spawn(sigterm_after(pid, after, epoch)));
+    let (visitors, requests) = if config.sequential {
+        lone_visitors(&config, &visit, epoch).await
     } else {
-        let mut set = tokio::task::JoinSet::new();
-        for i in 0..config.visitors {
-            let (device, audience) = mix(i, config.tablet_share, config.researcher_share);
-            let arrive = config.pattern.arrival(i, config.visitors);
-            set.spawn(Arc::clone(&visit).run(i, device, audience, arrive));
-        }
-        while let Some(joined) = set.join_next().await {
-            let (r, q) = joined.context("visitor task")?;
-            visitors.push(r);
-            requests.extend(q);
-        }
-    }
+        crowd_of_visitors(&config, &visit).await?
+    };
     let wall = epoch.elapsed();
     done.store(true, Ordering::Relaxed);
     let _ = sampler.await;
@@ -745,6 +816,61 @@ pub async fn run_crowd(config: CrowdConfig, profile: Arc<DecodeProfile>) -> Resu
         pressure_max: pressure.load(Ordering::Relaxed),
         sigterm_at,
     })
+}
+
+/// Sends SIGTERM to `pid` `after` into the run; returns when, from `epoch`.
+async fn sigterm_after(pid: u32, after: Duration, epoch: Instant) -> Duration {
+    tokio::time::sleep(after).await;
+    let at = epoch.elapsed();
+    let _ = tokio::process::Command::new("kill")
+        .args(["-TERM", &pid.to_string()])
+        .status()
+        .await;
+    at
+}
+
+/// One visitor per (device, audience) pair present in the mix, alone, one
+/// after another.
+async fn lone_visitors(
+    config: &CrowdConfig,
+    visit: &Arc<Visit>,
+    epoch: Instant,
+) -> (Vec<VisitorResult>, Vec<Req>) {
+    let (mut visitors, mut requests) = (Vec::new(), Vec::new());
+    let mut seen = Vec::new();
+    for i in 0..config.visitors {
+        let pair = mix(i, config.tablet_share, config.researcher_share);
+        if seen.contains(&pair) {
+            continue;
+        }
+        seen.push(pair);
+        let start = epoch.elapsed();
+        let (r, q) = Arc::clone(visit).run(i, pair.0, pair.1, start).await;
+        visitors.push(r);
+        requests.extend(q);
+    }
+    (visitors, requests)
+}
+
+/// Every visitor at once, each arriving as the pattern says.
+async fn crowd_of_visitors(
+    config: &CrowdConfig,
+    visit: &Arc<Visit>,
+) -> Result<(Vec<VisitorResult>, Vec<Req>)> {
+    let mut visitors = Vec::with_capacity(config.visitors);
+    let mut requests = Vec::with_capacity(config.visitors * 16);
+    let mut set = tokio::task::JoinSet::new();
+    for i in 0..config.visitors {
+        let (device, audience) = mix(i, config.tablet_share, config.researcher_share);
+        let arrive = config.pattern.arrival(i, config.visitors);
+        set.spawn(Arc::clone(visit).run(i, device, audience, arrive));
+    }
+    while let Some(joined) = set.join_next().await {
+        let (r, q) = joined.context("visitor task")?;
+        visitors.push(r);
+        requests.extend(q);
+    }
+    Ok((visitors, requests))
 }
 
 /// Polls `/metrics` for the highest load pressure seen.
