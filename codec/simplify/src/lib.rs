@@ -7,10 +7,33 @@
 //! - [`FeatureGuard`]: θ as a decimation guard for the progressive encoder
 //!   (`vitrine_codec::Encoder::guard`), beside the cell complex's: a vertex
 //!   near a feature stays until the finer levels.
+//! - [`simplify`]: the standalone multiresolution (seed 004, Alg. 1, 4, 5):
+//!   edge, half-edge or triangle collapses of the vertices off the borders
+//!   and away from features, each checked (link condition, no flips), down
+//!   to an exact vertex count.
+//!
+//! ```
+//! use vitrine_simplify::{simplify, Collapse, SimplifyOptions, StopReason, Target};
+//! # let mesh = vitrine_samples::torus(48, 24, 1.0, 0.3);
+//! let options = SimplifyOptions {
+//!     collapse: Collapse::Edge,
+//!     target: Target::Fraction(0.25),
+//!     ..SimplifyOptions::default()
+//! };
+//! let out = simplify(&mesh, &options)?;
+//! assert_eq!(out.stopped, StopReason::Target);
+//! assert_eq!(out.mesh.vertex_count(), 288);
+//! # Ok::<(), vitrine_codec::Error>(())
+//! ```
 #![forbid(unsafe_code)]
 
+mod collapse;
 pub mod deviation;
 mod feature_guard;
 
+pub use collapse::{
+    simplify, simplify_with, Cleanup, Collapse, PassReport, Simplified, SimplifyOptions,
+    StopReason, Target,
+};
 pub use deviation::{border_vertices, normal_deviation, one_ring_max, VertexFaces};
 pub use feature_guard::{FeatureGuard, FeatureThreshold, DEFAULT_FEATURE_SHARE};

@@ -1,0 +1,250 @@
+//! The standalone multiresolution (seed 004, Alg. 1, 4 and 5, with the
+//! fixes in SEEDS.md): passes of edge, half-edge or triangle collapses over
+//! the vertices that are neither on a border nor near a feature, each merge
+//! checked first (link condition, flip rejection), then the seed's
+//! clean-up, until an exact vertex count.
+//!
+//! **Which θ decides.** A vertex is removable when the one-ring maximum of
+//! θ on the *full resolution* is at most τ, the threshold also fixed once
+//! from the full resolution; a merged vertex carries the largest value of
+//! the vertices it stands for. The one-ring maximum because θ alone marks
+//! the band beside a ridge and not its crest (SEEDS.md 004: a one-vertex
+//! guard erodes ridges). The full resolution's because τ is measured
+//! there: θ of a coarser mesh grows with its edge length on any curved
+//! surface, so comparing it with τ would freeze a smooth sphere after a
+//! pass or two and the target could never be met; and features are those
+//! of the scan, not of its approximation. Flip rejection, not θ, guards
+//! the coarse surface's shape. It also spares recomputing θ every pass.
+
+mod cleanup;
+mod pass;
+mod topology;
+mod working;
+
+use std::str::FromStr;
+
+use vitrine_codec::{Error, IndexedMesh, Result};
+
+use crate::FeatureThreshold;
+use pass::Pass;
+use working::WorkingMesh;
+
+/// How a pass removes vertices (seed 004, §2.2).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Collapse {
+    /// Both ends of an edge to its midpoint: −1 vertex, −2 faces.
+    #[default]
+    Edge,
+    /// One end into the other, which stays put: −1 vertex, −2 faces.
+    HalfEdge,
+    /// A face's corners to its centroid: −2 vertices, −4 faces.
+    Triangle,
+}
+
+impl FromStr for Collapse {
+    type Err = Error;
+
+    /// `edge`, `half-edge` or `triangle`.
+    fn from_str(s: &str) -> Result<Self> {
+        match s.trim() {
+            "edge" => Ok(Collapse::Edge),
+            "half-edge" => Ok(Collapse::HalfEdge),
+            "triangle" => Ok(Collapse::Triangle),
+            _ => Err(Error::Parameter(format!(
+                "collapse must be edge, half-edge or triangle, got {s:?}"
+            ))),
+        }
+    }
+}
+
+/// Where to stop.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Target {
+    /// This many vertices in the output.
+    Vertices(usize),
+    /// This fraction (0–1) of the input's used vertices, rounded.
+    Fraction(f64),
+}
+
+impl Default for Target {
+    fn default() -> Self {
+        Target::Fraction(0.5)
+    }
+}
+
+impl FromStr for Target {
+    type Err = Error;
+
+    /// A vertex count (`5000`) or a percentage (`25%`).
+    fn from_str(s: &str) -> Result<Self> {
+        let s = s.trim();
+        let target = match s.strip_suffix('%') {
+            Some(p) => p
+                .trim()
+                .parse::<f64>()
+                .ok()
+                .map(|p| Target::Fraction(p / 100.0)),
+            None => s.parse().ok().map(Target::Vertices),
+        };
+        let target = target.ok_or_else(|| {
+            Error::Parameter(format!(
+                "target must be a vertex count (5000) or a percentage (25%), got {s:?}"
+            ))
+        })?;
+        target.validate()?;
+        Ok(target)
+    }
+}
+
+impl Target {
+    fn validate(self) -> Result<()> {
+        match self {
+            Target::Fraction(f) if !(0.0..=1.0).contains(&f) => Err(Error::Parameter(format!(
+                "target fraction must be within 0–1, got {f}"
+            ))),
+            _ => Ok(()),
+        }
+    }
+
+    fn vertices(self, used: usize) -> usize {
+        match self {
+            Target::Vertices(n) => n,
+            Target::Fraction(f) => (f * used as f64).round() as usize,
+        }
+    }
+}
+
+/// Parameters of [`simplify`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct SimplifyOptions {
+    pub collapse: Collapse,
+    pub target: Target,
+    /// Where features start, in θ of the full resolution.
+    pub threshold: FeatureThreshold,
+    /// Passes at most (each one freezes the neighbours of its merges).
+    pub max_passes: usize,
+}
+
+impl Default for SimplifyOptions {
+    fn default() -> Self {
+        SimplifyOptions {
+            collapse: Collapse::Edge,
+            target: Target::default(),
+            threshold: FeatureThreshold::MeanPlusTwoSigma,
+            max_passes: 100,
+        }
+    }
+}
+
+/// Why simplification stopped.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum StopReason {
+    /// The output has exactly the target vertex count (or the input had
+    /// no more than that).
+    Target,
+    /// No removable vertex could be merged without breaking a check: the
+    /// rest are borders, features, or locked by the topology.
+    NoCandidate,
+    /// `max_passes` passes ran.
+    MaxPasses,
+}
+
+/// What the seed's clean-up (Alg. 5) found after a pass.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Cleanup {
+    /// Faces deleted for sharing their three vertices with another face.
+    pub duplicates: usize,
+    /// Valence-3 spikes whose three faces became one.
+    pub pyramids: usize,
+    /// Faces reversed for running against their neighbours.
+    pub flipped: usize,
+}
+
+/// One pass, as it ended.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct PassReport {
+    /// Vertex merges made (a full triangle collapse is two).
+    pub merges: usize,
+    /// Used vertices and live faces after the pass and its clean-up.
+    pub vertices: usize,
+    pub faces: usize,
+    pub cleanup: Cleanup,
+}
+
+/// The simplified mesh and how it came about.
+#[derive(Clone, Debug)]
+pub struct Simplified {
+    /// Compacted: unused vertices dropped, the rest in input order.
+    pub mesh: IndexedMesh,
+    /// For each output vertex, the input vertex whose slot it kept: equal
+    /// positions for every vertex that never moved (borders, features).
+    pub origin: Vec<u32>,
+    /// The passes that changed the mesh, in order.
+    pub passes: Vec<PassReport>,
+    pub stopped: StopReason,
+    /// τ in radians, from the full resolution.
+    pub threshold_radians: f64,
+}
+
+/// Simplifies `mesh` (an oriented 2-manifold, borders allowed: what
+/// `vitrine_mesh::repair::prepare` produces) down to `options.target`
+/// vertices. Deterministic: the same input and options give the same bytes.
+pub fn simplify(mesh: &IndexedMesh, options: &SimplifyOptions) -> Result<Simplified> {
+    run(mesh, options, None)
+}
+
+/// [`simplify`], calling `on_pass` after every pass with its report, the
+/// compacted mesh as it stands and each vertex's origin (compacting costs
+/// a copy of the mesh per pass).
+pub fn simplify_with(
+    mesh: &IndexedMesh,
+    options: &SimplifyOptions,
+    mut on_pass: impl FnMut(&PassReport, &IndexedMesh, &[u32]),
+) -> Result<Simplified> {
+    run(mesh, options, Some(&mut on_pass))
+}
+
+type OnPass<'a> = &'a mut dyn FnMut(&PassReport, &IndexedMesh, &[u32]);
+
+fn run(
+    mesh: &IndexedMesh,
+    options: &SimplifyOptions,
+    mut on_pass: Option<OnPass<'_>>,
+) -> Result<Simplified> {
+    options.target.validate()?;
+    let (mut working, threshold) = WorkingMesh::new(mesh, options.threshold)?;
+    let target = options.target.vertices(working.live_vertices);
+    let mut passes = Vec::new();
+    let stopped = loop {
+        if working.live_vertices <= target {
+            break StopReason::Target;
+        }
+        if passes.len() >= options.max_passes {
+            break StopReason::MaxPasses;
+        }
+        let merges = Pass::new(&mut working, options.collapse, threshold, target).run();
+        let cleanup = cleanup::clean(&mut working, threshold, target);
+        if merges == 0 && cleanup == Cleanup::default() {
+            break StopReason::NoCandidate;
+        }
+        let report = PassReport {
+            merges,
+            vertices: working.live_vertices,
+            faces: working.live_faces(),
+            cleanup,
+        };
+        if let Some(f) = on_pass.as_mut() {
+            let (mesh, origin) = working.compact();
+            f(&report, &mesh, &origin);
+        }
+        passes.push(report);
+    };
+    let (mesh, origin) = working.compact();
+    Ok(Simplified {
+        mesh,
+        origin,
+        passes,
+        stopped,
+        threshold_radians: threshold,
+    })
+}

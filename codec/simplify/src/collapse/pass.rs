@@ -1,0 +1,203 @@
+//! One decimation pass (seed 004, Alg. 4): removable vertices in ascending
+//! θ, ties by index; each merge freezes its survivor and the survivor's
+//! neighbours for the rest of the pass, so a pass touches the surface
+//! evenly, like an independent set, instead of eating one region.
+
+use super::topology::{allows, Scratch};
+use super::working::{Merge, WorkingMesh};
+use super::Collapse;
+
+pub(super) struct Pass<'a> {
+    mesh: &'a mut WorkingMesh,
+    collapse: Collapse,
+    threshold: f64,
+    target: usize,
+    frozen: Vec<bool>,
+    scratch: Scratch,
+    ring: Vec<u32>,
+}
+
+impl<'a> Pass<'a> {
+    pub fn new(
+        mesh: &'a mut WorkingMesh,
+        collapse: Collapse,
+        threshold: f64,
+        target: usize,
+    ) -> Self {
+        let frozen = vec![false; mesh.positions.len()];
+        Pass {
+            mesh,
+            collapse,
+            threshold,
+            target,
+            frozen,
+            scratch: Scratch::default(),
+            ring: Vec::new(),
+        }
+    }
+
+    /// Runs the pass; returns how many merges it made.
+    pub fn run(mut self) -> usize {
+        let mut candidates: Vec<u32> = (0..self.mesh.positions.len() as u32)
+            .filter(|&v| self.mesh.removable(v, self.threshold))
+            .collect();
+        let theta = &self.mesh.theta;
+        candidates.sort_by(|&a, &b| {
+            theta[a as usize]
+                .total_cmp(&theta[b as usize])
+                .then(a.cmp(&b))
+        });
+        let mut merges = 0;
+        for v in candidates {
+            let left = self.mesh.live_vertices.saturating_sub(self.target);
+            if left == 0 {
+                break;
+            }
+            if !self.usable(v) {
+                continue;
+            }
+            let done = match self.collapse {
+                Collapse::Edge => self.edge(v),
+                Collapse::HalfEdge => self.half_edge(v),
+                // One vertex short of the target: an edge collapse ends it exactly.
+                Collapse::Triangle if left == 1 => self.edge(v),
+                Collapse::Triangle => self.triangle(v),
+            };
+            if let Some((survivor, count)) = done {
+                merges += count;
+                self.freeze_around(survivor);
+            }
+        }
+        merges
+    }
+
+    /// Live, unfrozen and removable (a merge may have raised its θ).
+    fn usable(&self, v: u32) -> bool {
+        !self.frozen[v as usize] && self.mesh.removable(v, self.threshold)
+    }
+
+    /// Neighbours of `v` passing `keep`, shortest edge first (ties by index).
+    fn partners(&mut self, v: u32, keep: impl Fn(&Self, u32) -> bool) -> Vec<u32> {
+        self.mesh.neighbours(v, &mut self.ring);
+        let mut out: Vec<u32> = self
+            .ring
+            .iter()
+            .copied()
+            .filter(|&w| keep(self, w))
+            .collect();
+        let p = self.mesh.point(v);
+        let length = |w: u32| p.distance_squared(self.mesh.point(w));
+        out.sort_by(|&a, &b| length(a).total_cmp(&length(b)).then(a.cmp(&b)));
+        out
+    }
+
+    /// Tries each merge in turn; applies the first the checks allow and
+    /// returns its survivor.
+    fn first_allowed(&mut self, merges: impl IntoIterator<Item = Merge>) -> Option<u32> {
+        for m in merges {
+            if allows(self.mesh, &m, &mut self.scratch) {
+                self.mesh.apply(&m);
+                return Some(m.keep);
+            }
+        }
+        None
+    }
+
+    /// Both ends to the midpoint (−1 vertex, −2 faces); both must be removable.
+    fn edge(&mut self, v: u32) -> Option<(u32, usize)> {
+        let partners = self.partners(v, |s, w| s.usable(w));
+        let merges: Vec<Merge> = partners.iter().map(|&w| self.midpoint(v, w)).collect();
+        Some((self.first_allowed(merges)?, 1))
+    }
+
+    /// `v` into a neighbour, which stays where it is (it may be a border
+    /// or feature vertex: it does not move).
+    fn half_edge(&mut self, v: u32) -> Option<(u32, usize)> {
+        let partners = self.partners(v, |s, w| !s.frozen[w as usize]);
+        let merges: Vec<Merge> = partners
+            .iter()
+            .map(|&w| Merge {
+                keep: w,
+                gone: v,
+                to: self.mesh.positions[w as usize],
+                colour: self.mesh.colour(w),
+            })
+            .collect();
+        Some((self.first_allowed(merges)?, 1))
+    }
+
+    /// A face's three corners to its centroid (−2 vertices, −4 faces), as
+    /// two checked merges; smallest face first (ties by index). When the
+    /// second merge is refused the first stands on its own (−1 vertex).
+    fn triangle(&mut self, v: u32) -> Option<(u32, usize)> {
+        let mut faces: Vec<(f64, u32)> = self.mesh.faces_of[v as usize]
+            .iter()
+            .filter(|&&f| {
+                let t = self.mesh.triangles[f as usize];
+                t.iter().all(|&w| self.usable(w))
+            })
+            .map(|&f| (self.area(f), f))
+            .collect();
+        faces.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+        for (_, f) in faces {
+            let t = self.mesh.triangles[f as usize];
+            let others: Vec<u32> = t.iter().copied().filter(|&w| w != v).collect();
+            let (to, colour) = self.centroid(&t);
+            let merge = |gone| Merge {
+                keep: v,
+                gone,
+                to,
+                colour,
+            };
+            if self.first_allowed([merge(others[0])]).is_none() {
+                continue;
+            }
+            let second = self.first_allowed([merge(others[1])]).is_some();
+            return Some((v, 1 + usize::from(second)));
+        }
+        None
+    }
+
+    fn midpoint(&self, a: u32, b: u32) -> Merge {
+        let to = ((self.mesh.point(a) + self.mesh.point(b)) * 0.5)
+            .as_vec3()
+            .to_array();
+        let colour = self
+            .mesh
+            .colour(a)
+            .zip(self.mesh.colour(b))
+            .map(|(p, q)| [0, 1, 2].map(|k| (p[k] + q[k]) / 2.0));
+        Merge {
+            keep: a,
+            gone: b,
+            to,
+            colour,
+        }
+    }
+
+    fn centroid(&self, t: &[u32; 3]) -> ([f32; 3], Option<[f32; 3]>) {
+        let to = (t.iter().map(|&w| self.mesh.point(w)).sum::<glam::DVec3>() / 3.0)
+            .as_vec3()
+            .to_array();
+        let colour = self
+            .mesh
+            .colours
+            .as_ref()
+            .map(|c| [0, 1, 2].map(|k| t.iter().map(|&w| c[w as usize][k]).sum::<f32>() / 3.0));
+        (to, colour)
+    }
+
+    fn area(&self, f: u32) -> f64 {
+        let p = self.mesh.triangles[f as usize].map(|w| self.mesh.point(w));
+        super::topology::normal(&p).length()
+    }
+
+    /// Freezes a merge's survivor and its ring for the rest of the pass.
+    fn freeze_around(&mut self, survivor: u32) {
+        self.frozen[survivor as usize] = true;
+        self.mesh.neighbours(survivor, &mut self.ring);
+        for &w in &self.ring {
+            self.frozen[w as usize] = true;
+        }
+    }
+}
