@@ -12,6 +12,7 @@ pub mod mesh_format;
 pub mod models;
 pub mod sample;
 pub mod serve;
+pub mod simplify;
 pub mod token;
 
 #[cfg(feature = "dev-tools")]
@@ -42,6 +43,8 @@ pub enum Command {
     Inspect(inspect::InspectArgs),
     /// Write a generated sample mesh (torus, sphere, plate) as PLY.
     Sample(sample::SampleArgs),
+    /// Simplify a mesh to a vertex count and write PLY, OBJ or GLB, with a report.
+    Simplify(simplify::SimplifyArgs),
 }
 
 impl Command {
@@ -55,6 +58,7 @@ impl Command {
             Command::Decode(args) => decode::run(args),
             Command::Inspect(args) => inspect::run(args),
             Command::Sample(args) => sample::run(args),
+            Command::Simplify(args) => simplify::run(args),
         }
     }
 }

@@ -1,0 +1,252 @@
+//! `vitrine simplify`: a mesh file down to a vertex count, by one of the
+//! simplifiers (`--method`), written as PLY, OBJ or GLB, with one report for
+//! every method: sizes, symmetric Hausdorff distance to the input, passes,
+//! why it stopped, time (`--json` for benchmarks).
+
+use super::mesh_format::MeshFormat;
+use crate::source::{describe_repair, load_coloured_mesh};
+use clap::{Args, ValueEnum};
+use serde::Serialize;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+use vitrine_codec::IndexedMesh;
+use vitrine_colour::vertex_colours_from_texture;
+use vitrine_quality::metrics::hausdorff;
+use vitrine_simplify::{simplify, Collapse, FeatureThreshold, SimplifyOptions, StopReason, Target};
+
+/// A simplifier.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum Method {
+    /// Collapses of the vertices off the borders and away from sharp
+    /// features (average normal deviation θ, seed 004), each checked for
+    /// the link condition and flips, to an exact vertex count.
+    NormalDeviation,
+}
+
+impl Method {
+    /// As `--method` spells it.
+    pub fn name(self) -> &'static str {
+        match self {
+            Method::NormalDeviation => "normal-deviation",
+        }
+    }
+}
+
+/// How `normal-deviation` removes vertices.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum CollapseKind {
+    /// Both ends of an edge to its midpoint.
+    Edge,
+    /// One end of an edge into the other, which stays put.
+    HalfEdge,
+    /// A face's three corners to its centroid.
+    Triangle,
+}
+
+#[derive(Args, Debug)]
+pub struct SimplifyArgs {
+    /// Input mesh: .ply, .obj, .off, .gltf or .glb.
+    pub input: PathBuf,
+    /// Output mesh; the extension picks the format: .ply, .obj or .glb.
+    #[arg(short, long)]
+    pub output: PathBuf,
+    /// The simplifier.
+    #[arg(long, value_enum)]
+    pub method: Method,
+    #[command(flatten)]
+    pub target: TargetArgs,
+    /// normal-deviation: how a pass removes vertices.
+    #[arg(long, value_enum, default_value_t = CollapseKind::Edge)]
+    pub collapse: CollapseKind,
+    /// normal-deviation: where a feature starts: `mean+2sigma` of θ, an
+    /// angle in degrees (`12` or `12deg`) or a percentile (`p95`).
+    #[arg(long, value_name = "mean+2sigma|DEG|pP", default_value = "mean+2sigma")]
+    pub feature_threshold: FeatureThreshold,
+    /// Area samples per mesh for the Hausdorff distance (plus every vertex).
+    #[arg(long, default_value_t = 200_000)]
+    pub hausdorff_samples: usize,
+    /// Print the report as JSON on stdout instead of text.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// Where to stop: one of the two.
+#[derive(Args, Debug)]
+#[group(required = true, multiple = false)]
+pub struct TargetArgs {
+    /// Vertices in the output.
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..))]
+    pub target_vertices: Option<u64>,
+    /// Fraction of the input's vertices in the output, within (0, 1].
+    #[arg(long, value_name = "F", value_parser = parse_fraction)]
+    pub target_fraction: Option<f64>,
+}
+
+impl TargetArgs {
+    fn target(&self) -> Target {
+        match (self.target_vertices, self.target_fraction) {
+            (Some(n), _) => Target::Vertices(n as usize),
+            (None, Some(f)) => Target::Fraction(f),
+            // clap's group requires one of them.
+            (None, None) => unreachable!("no target"),
+        }
+    }
+}
+
+fn parse_fraction(s: &str) -> Result<f64, String> {
+    match s.parse::<f64>() {
+        Ok(f) if f > 0.0 && f <= 1.0 => Ok(f),
+        _ => Err(format!("must be a number within (0, 1], got {s:?}")),
+    }
+}
+
+/// The report every method gives.
+#[derive(Clone, Debug, Serialize)]
+pub struct SimplifyReport {
+    pub method: &'static str,
+    pub input: Counts,
+    pub output: Counts,
+    /// Symmetric Hausdorff distance between input and output over the
+    /// input's bounding-box diagonal.
+    pub hausdorff: f64,
+    pub hausdorff_samples: usize,
+    pub passes: usize,
+    /// `target` (reached exactly), `no-candidate` (nothing more could be
+    /// removed) or `max-passes`.
+    pub stopped: &'static str,
+    /// Simplification alone, not loading, writing or measuring.
+    pub seconds: f64,
+    /// normal-deviation's parameters.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub collapse: Option<&'static str>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub feature_threshold_degrees: Option<f64>,
+}
+
+#[derive(Clone, Copy, Debug, Serialize)]
+pub struct Counts {
+    pub vertices: usize,
+    pub faces: usize,
+}
+
+impl Counts {
+    fn of(mesh: &IndexedMesh) -> Counts {
+        Counts {
+            vertices: mesh.vertex_count(),
+            faces: mesh.face_count(),
+        }
+    }
+}
+
+/// What a method made, before it is measured.
+struct Outcome {
+    mesh: IndexedMesh,
+    passes: usize,
+    stopped: &'static str,
+    collapse: Option<&'static str>,
+    feature_threshold_degrees: Option<f64>,
+}
+
+pub fn run(args: SimplifyArgs) -> anyhow::Result<()> {
+    let format = MeshFormat::from_path(&args.output)?;
+    let input = load(&args.input)?;
+    let started = Instant::now();
+    let outcome = match args.method {
+        Method::NormalDeviation => normal_deviation(&input, &args)?,
+    };
+    let seconds = started.elapsed().as_secs_f64();
+    format.write(&outcome.mesh, &args.output)?;
+    let report = measure(&input, outcome, &args, seconds);
+    if args.json {
+        println!("{}", serde_json::to_string_pretty(&report)?);
+    } else {
+        print_report(&report, &args.output);
+    }
+    Ok(())
+}
+
+/// The mesh as the other commands read it, repaired; a texture is sampled
+/// at the vertices, since the simplified mesh keeps per-vertex colour only.
+fn load(path: &Path) -> anyhow::Result<IndexedMesh> {
+    let source = load_coloured_mesh(path)?;
+    if let Some(text) = describe_repair(&source.repair) {
+        eprintln!("repair: {text}");
+    }
+    let mut mesh = source.mesh;
+    if let Some(t) = &source.texture {
+        eprintln!("texture: sampled at the vertices (the output has per-vertex colour)");
+        mesh.colors = Some(vertex_colours_from_texture(&mesh, t));
+    }
+    Ok(mesh)
+}
+
+fn normal_deviation(mesh: &IndexedMesh, args: &SimplifyArgs) -> anyhow::Result<Outcome> {
+    let (collapse, name) = match args.collapse {
+        CollapseKind::Edge => (Collapse::Edge, "edge"),
+        CollapseKind::HalfEdge => (Collapse::HalfEdge, "half-edge"),
+        CollapseKind::Triangle => (Collapse::Triangle, "triangle"),
+    };
+    let options = SimplifyOptions {
+        collapse,
+        target: args.target.target(),
+        threshold: args.feature_threshold,
+        ..SimplifyOptions::default()
+    };
+    let out = simplify(mesh, &options)?;
+    Ok(Outcome {
+        mesh: out.mesh,
+        passes: out.passes.len(),
+        stopped: match out.stopped {
+            StopReason::Target => "target",
+            StopReason::NoCandidate => "no-candidate",
+            StopReason::MaxPasses => "max-passes",
+        },
+        collapse: Some(name),
+        feature_threshold_degrees: Some(out.threshold_radians.to_degrees()),
+    })
+}
+
+fn measure(
+    input: &IndexedMesh,
+    outcome: Outcome,
+    args: &SimplifyArgs,
+    seconds: f64,
+) -> SimplifyReport {
+    let distance = hausdorff(input, &outcome.mesh, args.hausdorff_samples);
+    SimplifyReport {
+        method: args.method.name(),
+        input: Counts::of(input),
+        output: Counts::of(&outcome.mesh),
+        hausdorff: distance.relative(),
+        hausdorff_samples: args.hausdorff_samples,
+        passes: outcome.passes,
+        stopped: outcome.stopped,
+        seconds,
+        collapse: outcome.collapse,
+        feature_threshold_degrees: outcome.feature_threshold_degrees,
+    }
+}
+
+fn print_report(r: &SimplifyReport, output: &Path) {
+    println!(
+        "{}: {} vertices, {} faces → {} vertices, {} faces in {:.2} s",
+        output.display(),
+        r.input.vertices,
+        r.input.faces,
+        r.output.vertices,
+        r.output.faces,
+        r.seconds,
+    );
+    let parameters = match (r.collapse, r.feature_threshold_degrees) {
+        (Some(c), Some(t)) => format!(" ({c} collapses, feature threshold {t:.2}°)"),
+        _ => String::new(),
+    };
+    println!(
+        "{}{parameters}: {} passes, stopped: {}",
+        r.method, r.passes, r.stopped
+    );
+    println!(
+        "Hausdorff/diagonal {:.6} ({} samples per mesh)",
+        r.hausdorff, r.hausdorff_samples
+    );
+}
