@@ -1,0 +1,263 @@
+//! `vitrine encode --guard features` and `vitrine simplify` as a user runs
+//! them: the built binary on a generated sample written to a temporary
+//! folder, its files checked with the library.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+use vitrine_codec::{decode, EncodeOptions, Encoder, IndexedMesh, Limits, Quantization};
+use vitrine_mesh::import::{import_path, ImportOptions};
+use vitrine_mesh::repair::{check_manifold, prepare, RepairOptions};
+use vitrine_simplify::{FeatureGuard, FeatureThreshold};
+
+fn vitrine(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_vitrine"))
+        .args(args)
+        .env("RUST_BACKTRACE", "0")
+        .output()
+        .expect("vitrine runs")
+}
+
+/// Runs `vitrine` and returns its stdout and stderr; it must succeed.
+fn succeeds(args: &[&str]) -> (String, String) {
+    let out = vitrine(args);
+    let (stdout, stderr) = (
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    );
+    assert!(out.status.success(), "vitrine {args:?} failed: {stderr}");
+    (stdout, stderr)
+}
+
+/// Runs `vitrine` and returns its stderr; it must fail.
+fn fails(args: &[&str]) -> String {
+    let out = vitrine(args);
+    assert!(!out.status.success(), "vitrine {args:?} succeeded");
+    String::from_utf8_lossy(&out.stderr).into_owned()
+}
+
+/// The genus-3 plate (5504 vertices, sharp edges for the feature guard) as
+/// a PLY file in `dir`.
+fn plate(dir: &Path) -> PathBuf {
+    let path = dir.join("plate.ply");
+    let mesh = vitrine_samples::plate_with_tunnels(3, 9);
+    let file = std::fs::File::create(&path).unwrap();
+    vitrine_mesh::export::write_ply(&mesh, &mut std::io::BufWriter::new(file)).unwrap();
+    path
+}
+
+fn read(path: &Path) -> IndexedMesh {
+    import_path(path, &ImportOptions::default()).expect("reads back")
+}
+
+/// The file as the commands see it: imported and repaired.
+fn repaired(path: &Path) -> IndexedMesh {
+    prepare(read(path), &RepairOptions::default()).unwrap().0
+}
+
+fn text(path: &Path) -> &str {
+    path.to_str().expect("a UTF-8 temporary path")
+}
+
+#[test]
+fn encode_without_a_guard_is_the_plain_stream() {
+    let dir = tempfile::tempdir().unwrap();
+    let (input, output) = (plate(dir.path()), dir.path().join("plain.vtr"));
+    succeeds(&["encode", text(&input), "-o", text(&output)]);
+    let plain = vitrine_codec::encode(&repaired(&input), &EncodeOptions::default()).unwrap();
+    assert!(std::fs::read(&output).unwrap() == plain.bytes);
+}
+
+#[test]
+fn encode_with_the_feature_guard_is_guarded_and_lossless() {
+    let dir = tempfile::tempdir().unwrap();
+    let (input, output) = (plate(dir.path()), dir.path().join("guarded.vtr"));
+    let (_, stderr) = succeeds(&[
+        "encode",
+        text(&input),
+        "--guard",
+        "features",
+        "-o",
+        text(&output),
+    ]);
+    assert!(stderr.contains("feature guard: threshold"), "{stderr}");
+    let bytes = std::fs::read(&output).unwrap();
+    let mesh = repaired(&input);
+    let options = EncodeOptions::default();
+    let plain = vitrine_codec::encode(&mesh, &options).unwrap();
+    assert!(
+        bytes != plain.bytes,
+        "the guard changed nothing on the plate"
+    );
+
+    let q = Quantization::for_positions(&mesh.positions, options.quantization_bits).unwrap();
+    let guard = FeatureGuard::new(&mesh, &q, FeatureThreshold::MeanPlusTwoSigma);
+    let expected = Encoder::new(options).guard(&guard).encode(&mesh).unwrap();
+    assert!(bytes == expected.bytes, "not the library's guarded stream");
+    let decoder = decode(&bytes, None, Limits::default()).unwrap();
+    assert_eq!(decoder.to_mesh().vertex_count(), mesh.vertex_count());
+    let mismatch =
+        vitrine_samples::final_level_mismatch(&mesh, 12, &decoder, &expected.vertex_order);
+    assert_eq!(mismatch, None);
+
+    let decoded = dir.path().join("decoded.ply");
+    succeeds(&["decode", text(&output), "-o", text(&decoded)]);
+    assert_eq!(read(&decoded).vertex_count(), mesh.vertex_count());
+}
+
+#[test]
+fn a_feature_threshold_needs_the_feature_guard() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = plate(dir.path());
+    let out = dir.path().join("x.vtr");
+    let stderr = fails(&[
+        "encode",
+        text(&input),
+        "--feature-threshold",
+        "20",
+        "-o",
+        text(&out),
+    ]);
+    assert!(
+        stderr.contains("--feature-threshold needs --guard features"),
+        "{stderr}"
+    );
+    let stderr = fails(&[
+        "encode",
+        text(&input),
+        "--guard",
+        "features",
+        "--feature-threshold",
+        "sharp",
+    ]);
+    assert!(stderr.contains("feature threshold must be"), "{stderr}");
+    assert!(!out.exists());
+}
+
+#[test]
+fn ingest_records_the_feature_guard_in_the_compression_options() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = plate(dir.path());
+    let db = format!("sqlite:{}", text(&dir.path().join("vitrine.db")));
+    let (_, log) = succeeds(&[
+        "ingest",
+        text(&input),
+        "--db",
+        &db,
+        "--slug",
+        "plate",
+        "--title",
+        "Plate",
+        "--guard",
+        "features",
+        "--feature-threshold",
+        "p90",
+    ]);
+    assert!(log.contains("feature guard"), "{log}");
+    let options: serde_json::Value = serde_json::from_str(&stored_options(&db)).unwrap();
+    assert_eq!(options["guards"], serde_json::json!(["features"]));
+    assert_eq!(options["feature_threshold"], "p90");
+}
+
+/// The options JSON of the one compression in the database at `url`.
+fn stored_options(url: &str) -> String {
+    let runtime = tokio::runtime::Runtime::new().unwrap();
+    runtime.block_on(async {
+        let pool = sqlx::SqlitePool::connect(url).await.unwrap();
+        sqlx::query_scalar("SELECT options FROM compression")
+            .fetch_one(&pool)
+            .await
+            .unwrap()
+    })
+}
+
+#[test]
+fn simplify_reaches_the_target_vertex_count_with_every_collapse() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = plate(dir.path());
+    for (collapse, file) in [
+        ("edge", "e.ply"),
+        ("half-edge", "h.obj"),
+        ("triangle", "t.glb"),
+    ] {
+        let output = dir.path().join(file);
+        let (stdout, _) = succeeds(&[
+            "simplify",
+            text(&input),
+            "--method",
+            "normal-deviation",
+            "--collapse",
+            collapse,
+            "--target-vertices",
+            "1001",
+            "--hausdorff-samples",
+            "20000",
+            "-o",
+            text(&output),
+        ]);
+        assert!(stdout.contains("→ 1001 vertices"), "{collapse}: {stdout}");
+        let mesh = read(&output);
+        assert_eq!(mesh.vertex_count(), 1001, "{collapse}");
+        check_manifold(&mesh).unwrap_or_else(|e| panic!("{collapse}: {e}"));
+    }
+}
+
+#[test]
+fn simplify_reports_as_json() {
+    let dir = tempfile::tempdir().unwrap();
+    let (input, output) = (plate(dir.path()), dir.path().join("quarter.ply"));
+    let (stdout, _) = succeeds(&[
+        "simplify",
+        text(&input),
+        "--method",
+        "normal-deviation",
+        "--target-fraction",
+        "0.25",
+        "--hausdorff-samples",
+        "20000",
+        "--json",
+        "-o",
+        text(&output),
+    ]);
+    let report: serde_json::Value = serde_json::from_str(&stdout).expect("JSON on stdout");
+    assert_eq!(report["method"], "normal-deviation");
+    assert_eq!(report["collapse"], "edge");
+    assert_eq!(report["input"]["vertices"], 5504);
+    assert_eq!(report["output"]["vertices"], 1376);
+    assert_eq!(report["stopped"], "target");
+    assert!(report["passes"].as_u64().unwrap() > 0);
+    let hausdorff = report["hausdorff"].as_f64().unwrap();
+    assert!(hausdorff > 0.0 && hausdorff < 0.1, "{hausdorff}");
+    assert!(report["seconds"].as_f64().unwrap() >= 0.0);
+    assert_eq!(read(&output).vertex_count(), 1376);
+}
+
+#[test]
+fn simplify_refuses_bad_arguments() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = plate(dir.path());
+    let ply = dir.path().join("out.ply");
+    let simplify = |rest: &[&str], output: &Path| {
+        let mut args = vec!["simplify", text(&input), "--method", "normal-deviation"];
+        args.extend_from_slice(rest);
+        args.extend_from_slice(&["-o", text(output)]);
+        fails(&args)
+    };
+    let both = simplify(
+        &["--target-vertices", "100", "--target-fraction", "0.5"],
+        &ply,
+    );
+    assert!(both.contains("cannot be used with"), "{both}");
+    let neither = simplify(&[], &ply);
+    assert!(neither.contains("--target-vertices"), "{neither}");
+    for fraction in ["0", "1.5", "-0.2", "half"] {
+        let e = simplify(&[&format!("--target-fraction={fraction}")], &ply);
+        assert!(
+            e.contains("must be a number within (0, 1]"),
+            "{fraction}: {e}"
+        );
+    }
+    let stl = dir.path().join("out.stl");
+    let e = simplify(&["--target-fraction", "0.5"], &stl);
+    assert!(e.contains("must end in .ply, .obj or .glb"), "{e}");
+    assert!(!ply.exists() && !stl.exists());
+}
