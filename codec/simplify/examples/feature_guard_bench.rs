@@ -93,7 +93,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let options = EncodeOptions::default();
         let t = Instant::now();
         let q = Quantization::for_positions(&mesh.positions, options.quantization_bits)?;
-        let guard = FeatureGuard::new(&mesh, &q, FeatureThreshold::MeanPlusTwoSigma).with_share(share);
+        let guard =
+            FeatureGuard::new(&mesh, &q, FeatureThreshold::MeanPlusTwoSigma).with_share(share);
         let build = t.elapsed().as_secs_f64();
         let theta = normal_deviation(&mesh);
         let cut = FeatureThreshold::Percentile(95.0).radians(&theta);
