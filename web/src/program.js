@@ -1,26 +1,31 @@
 // @ts-check
 /**
  * The renderer's one shader program: its GLSL (lighting from shading.js, the
- * CCC colour lookup from ccc.js), its uniforms, and the two textures the
+ * CCC colour lookup from ccc.js, the relief view's θ ramp from relief.js),
+ * its uniforms, and the two textures the
  * CCC lookup samples (the cell texture on unit 0, the colour texture on
  * unit 1). renderer.js decides when each is made and bound.
  */
 
 import { GLSL_CCC, cccUniforms } from './ccc.js';
+import { GLSL_RELIEF } from './relief.js';
 import { GLSL_SHADE, WIRE_ALPHA, WIRE_COLOUR } from './shading.js';
 
 export const VERTEX_SHADER = `#version 300 es
 layout(location = 0) in vec3 a_position;
 layout(location = 1) in vec3 a_normal;
 layout(location = 2) in vec3 a_colour;
+layout(location = 3) in float a_theta;
 uniform mat4 u_view;
 uniform mat4 u_viewProjection;
 out vec3 v_normal;
 out vec3 v_colour;
 out vec3 v_world;
+out float v_theta;
 void main() {
   v_normal = mat3(u_view) * a_normal;
   v_colour = a_colour;
+  v_theta = a_theta;
   v_world = a_position;
   gl_Position = u_viewProjection * vec4(a_position, 1.0);
 }`;
@@ -30,11 +35,15 @@ precision highp float;
 in vec3 v_normal;
 in vec3 v_colour;
 in vec3 v_world;
+in float v_theta;
 uniform bool u_wire;
 uniform bool u_ccc;
+uniform bool u_relief;
+uniform float u_reliefTop;
 out vec4 o_colour;
 ${GLSL_SHADE}
 ${GLSL_CCC}
+${GLSL_RELIEF}
 void main() {
   if (u_wire) {
     o_colour = vec4(${WIRE_COLOUR.join(', ')}, ${WIRE_ALPHA});
@@ -44,6 +53,11 @@ void main() {
   vec3 n = dot(v_normal, v_normal) > 0.0 ? normalize(v_normal) : vec3(0.0, 0.0, 1.0);
   // Scans have holes: the inside is lit like the outside.
   if (!gl_FrontFacing) n = -n;
+  // The relief view: θ (radians) on the ramp from 0 to the level's scale top, under a head-light.
+  if (u_relief) {
+    o_colour = vec4(reliefShade(n, v_theta / u_reliefTop), 1.0);
+    return;
+  }
   // Colour from the cell complex (the same texture at every level) or per vertex.
   vec3 albedo = u_ccc ? cccColour(v_world) : v_colour;
   o_colour = vec4(shade(n, albedo), 1.0);
@@ -78,7 +92,7 @@ export function createProgram(gl) {
   }
   /** @type {Uniforms} */
   const uniforms = {};
-  const names = ['u_view', 'u_viewProjection', 'u_wire', 'u_ccc', 'u_cells', 'u_atlas'];
+  const names = ['u_view', 'u_viewProjection', 'u_wire', 'u_ccc', 'u_relief', 'u_reliefTop', 'u_cells', 'u_atlas'];
   for (const name of [...names, ...Object.keys(cccUniforms(PLACEHOLDER, { width: 1, height: 1 }))]) {
     uniforms[name] = gl.getUniformLocation(program, name);
   }
@@ -171,6 +185,18 @@ export function bindCcc(gl, u, ccc) {
   gl.uniform1i(u.u_tilesPerRow, values.u_tilesPerRow);
   gl.uniform2fv(u.u_atlasScale, values.u_atlasScale);
   gl.uniform3fv(u.u_fallback, values.u_fallback);
+}
+
+/**
+ * The relief view's switch and scale: on with the top of the θ scale in
+ * degrees (θ at or above it takes the ramp's last colour), off when null.
+ * @param {WebGL2RenderingContext} gl
+ * @param {Uniforms} u
+ * @param {number | null} topDegrees
+ */
+export function bindRelief(gl, u, topDegrees) {
+  gl.uniform1i(u.u_relief, topDegrees === null ? 0 : 1);
+  if (topDegrees !== null) gl.uniform1f(u.u_reliefTop, (topDegrees * Math.PI) / 180);
 }
 
 /** Parameters that only name the uniforms (their values are not used). */

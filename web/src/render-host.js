@@ -21,8 +21,9 @@ import { Renderer } from './renderer.js';
  * @typedef {object} RenderHooks
  * @property {(level: { level: number, vertices: number, normalsMs: number }) => void} onSwap a level is
  *   complete on the GPU (normalsMs: the renderer's time deriving normals so far)
- * @property {(frame: { level: number | null, colourResolution: AtlasResolution | null, at: number }) => void} onFrame
- *   a frame was drawn: the level and colour texture in it, at (performance.now() of this page)
+ * @property {(frame: { level: number | null, colourResolution: AtlasResolution | null, reliefTop: number | null, at: number }) => void} onFrame
+ *   a frame was drawn: the level and colour texture in it, the top of its θ scale in degrees
+ *   (null: not in the relief view), at (performance.now() of this page)
  * @property {(bounds: import('./geometry.js').Bounds) => import('./camera.js').OrbitCamera} camera
  *   the viewer's camera, made from the base mesh's bounds by whoever needs it first
  */
@@ -37,6 +38,7 @@ import { Renderer } from './renderer.js';
  * @property {AtlasResolution | null} colourResolution
  * @property {number} maxTextureSize
  * @property {(on: boolean) => void} setWireframe
+ * @property {(on: boolean) => void} setRelief colour by θ (relief.js) where the level has it
  * @property {() => void} requestFrame
  * @property {(mapping: import('./renderer.js').ColourMapping | null) => void} setColourMapping
  * @property {(source: ImageBitmap, resolution: AtlasResolution) => void} setColourAtlas
@@ -97,6 +99,7 @@ class MainRenderer {
         hooks.onFrame({
           level: this.renderer.current?.source.level ?? null,
           colourResolution: this.renderer.colourResolution,
+          reliefTop: this.renderer.reliefTop,
           at: performance.now(),
         }),
     });
@@ -145,6 +148,8 @@ class MainRenderer {
         this.renderer.show(message);
       } else if (message.type === 'edges') {
         this.renderer.addEdges(message.level, message.edges);
+      } else if (message.type === 'relief') {
+        this.renderer.addRelief(message.level, message.relief, message.top);
       }
     };
   }
@@ -152,6 +157,11 @@ class MainRenderer {
   /** @param {boolean} on */
   setWireframe(on) {
     this.renderer.setWireframe(on);
+  }
+
+  /** @param {boolean} on */
+  setRelief(on) {
+    this.renderer.setRelief(on);
   }
 
   requestFrame() {
@@ -292,6 +302,7 @@ class WorkerRenderer {
         this.hooks.onFrame({
           level: message.level,
           colourResolution: message.colourResolution,
+          reliefTop: message.reliefTop,
           at: message.at - performance.timeOrigin,
         });
         break;
@@ -315,6 +326,11 @@ class WorkerRenderer {
   /** @param {boolean} on */
   setWireframe(on) {
     this.worker.postMessage({ type: 'wireframe', on });
+  }
+
+  /** @param {boolean} on */
+  setRelief(on) {
+    this.worker.postMessage({ type: 'relief', on });
   }
 
   /** The camera may have moved: the worker draws with the page's camera state. */

@@ -8,7 +8,7 @@
  *
  * Levels come straight from the decode worker through a MessagePort
  * (transferred buffers; the page never sees them). The page sends the
- * camera, the canvas size, the wireframe switch and the colour textures;
+ * camera, the canvas size, the wireframe and relief switches and the colour textures;
  * this worker answers with what was drawn (render-host.js mirrors it).
  *
  * On start it tries a WebGL2 context on a small OffscreenCanvas of its own
@@ -27,6 +27,7 @@ import { Renderer } from './renderer.js';
  *   | { type: 'size', width: number, height: number }
  *   | { type: 'camera', state: import('./camera.js').OrbitState | null }
  *   | { type: 'wireframe', on: boolean }
+ *   | { type: 'relief', on: boolean }
  *   | { type: 'colourMapping', mapping: import('./renderer.js').ColourMapping | null }
  *   | { type: 'colourAtlas', source: ImageBitmap, resolution: import('./renderer.js').AtlasResolution }
  *   | { type: 'capture', id: number } | { type: 'finish', id: number }
@@ -39,7 +40,8 @@ import { Renderer } from './renderer.js';
  *   | { type: 'started', maxTextureSize: number }
  *   | { type: 'failed', message: string }
  *   | { type: 'swap', level: number, vertices: number, normalsMs: number }
- *   | { type: 'frame', level: number | null, colourResolution: import('./renderer.js').AtlasResolution | null, at: number }
+ *   | { type: 'frame', level: number | null, colourResolution: import('./renderer.js').AtlasResolution | null,
+ *       reliefTop: number | null, at: number }
  *   | { type: 'status', lost: boolean, settled: boolean, edges: boolean, frames: number }
  *   | { type: 'captured', id: number, width: number, height: number, rgba: Uint8Array }
  *   | { type: 'finished', id: number, at: number }} RenderReport
@@ -104,6 +106,8 @@ function fromDecoder(message) {
     renderer.show(message);
   } else if (message.type === 'edges') {
     renderer.addEdges(message.level, message.edges);
+  } else if (message.type === 'relief') {
+    renderer.addRelief(message.level, message.relief, message.top);
   }
   sendStatus();
 }
@@ -119,14 +123,16 @@ function start(canvas, width, height) {
       {
         onSwap: (level) => report({ type: 'swap', level: level.level, vertices: level.vertices, normalsMs: renderer?.normalsMs ?? 0 }),
         onFrame: () => {
-          // The page wants each level's and colour texture's first frame,
-          // not every frame of an orbit: one small message per change.
+          // The page wants each level's, colour texture's and relief
+          // scale's first frame, not every frame of an orbit: one small
+          // message per change.
           const level = renderer?.current?.source.level ?? null;
           const colourResolution = renderer?.colourResolution ?? null;
-          const key = `${level} ${colourResolution}`;
+          const reliefTop = renderer?.reliefTop ?? null;
+          const key = `${level} ${colourResolution} ${reliefTop}`;
           if (key === lastFrame) return;
           lastFrame = key;
-          report({ type: 'frame', level, colourResolution, at: epochNow() });
+          report({ type: 'frame', level, colourResolution, reliefTop, at: epochNow() });
         },
         onTick: sendStatus,
       },
@@ -169,6 +175,9 @@ scope.onmessage = (event) => {
       break;
     case 'wireframe':
       renderer?.setWireframe(command.on);
+      break;
+    case 'relief':
+      renderer?.setRelief(command.on);
       break;
     case 'colourMapping':
       renderer?.setColourMapping(command.mapping);

@@ -30,9 +30,18 @@
 
 import { multiply } from './camera.js';
 import { NormalsTask, deriveNormals } from './normals-task.js';
-import { bindCcc, createAtlasTexture, createCellTexture, createProgram } from './program.js';
+import { bindCcc, bindRelief, createAtlasTexture, createCellTexture, createProgram } from './program.js';
 import { BACKGROUND, CLAY } from './shading.js';
-import { VertexStore, addEdgeBuffer, allocateMesh, emptyMesh, releaseMesh, uploadMesh } from './vertex-store.js';
+import {
+  VertexStore,
+  addEdgeBuffer,
+  addReliefBuffer,
+  allocateMesh,
+  emptyMesh,
+  releaseMesh,
+  reliefReady,
+  uploadMesh,
+} from './vertex-store.js';
 
 const UPLOAD_BUDGET_MS = 6;
 const UPLOAD_CHUNK_BYTES = 256 << 10;
@@ -76,6 +85,15 @@ export class Renderer {
   /** @type {GpuMesh | null} */
   pending = null;
   wireframe = false;
+  /** The relief view: colour by θ where the level on screen has it. */
+  relief = false;
+  /**
+   * The top (degrees) of the θ scale in the last frame drawn, null when
+   * that frame was not in the relief view (off, or the level's θ not yet
+   * on the GPU).
+   * @type {number | null}
+   */
+  reliefTop = null;
   lost = false;
   frames = 0;
   /** Milliseconds spent deriving normals of levels that came without them. */
@@ -212,6 +230,31 @@ export class Renderer {
         if (!this.lost) addEdgeBuffer(this.gl, mesh, edges);
       }
     }
+    this.requestFrame();
+  }
+
+  /**
+   * θ computed after the level was sent (relief view switched on).
+   * @param {number} level
+   * @param {Float32Array} relief
+   * @param {number} top degrees
+   */
+  addRelief(level, relief, top) {
+    for (const mesh of [this.pending, this.current]) {
+      if (mesh && mesh.source.level === level && !mesh.source.relief) {
+        mesh.source.relief = relief;
+        mesh.source.reliefTop = top;
+        if (!this.lost && mesh.vao) addReliefBuffer(this.gl, mesh, relief);
+      }
+    }
+    // A level waiting for the first one to be on screen gets its buffer when it is allocated.
+    if (this.#next?.level === level && !this.#next.relief) Object.assign(this.#next, { relief, reliefTop: top });
+    this.requestFrame();
+  }
+
+  /** @param {boolean} on */
+  setRelief(on) {
+    this.relief = on;
     this.requestFrame();
   }
 
@@ -422,6 +465,7 @@ export class Renderer {
     gl.viewport(0, 0, this.canvas.width, this.canvas.height);
     gl.clear(gl.COLOR_BUFFER_BIT | gl.DEPTH_BUFFER_BIT);
     const mesh = this.current;
+    this.reliefTop = null;
     if (!mesh || !this.camera || !this.#program) return;
     const view = this.camera.view();
     const projection = this.camera.projection(this.canvas.width / Math.max(1, this.canvas.height));
@@ -438,6 +482,10 @@ export class Renderer {
     }
     gl.uniform1i(this.#uniforms.u_wire, 0);
     this.#bindColour();
+    const top = mesh.source.reliefTop;
+    const relief = this.relief && typeof top === 'number' && reliefReady(mesh) ? top : null;
+    bindRelief(gl, this.#uniforms, relief);
+    this.reliefTop = relief;
     gl.drawElements(gl.TRIANGLES, mesh.source.indices.length, gl.UNSIGNED_INT, 0);
     gl.disable(gl.POLYGON_OFFSET_FILL);
     if (wire && mesh.source.edges) {

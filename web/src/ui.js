@@ -3,10 +3,12 @@
  * The viewer's chrome inside a shadow root (so a museum site's CSS cannot
  * reach it): canvas sized to device pixels, progress line, cap notice, error
  * overlay with retry, title panel (with the quality chart when the model's
- * curve was measured), and the reset / wireframe / fullscreen buttons.
+ * curve was measured), the reset / wireframe / relief / fullscreen buttons,
+ * and the relief view's legend.
  */
 
 import { describeLevel, renderQualityChart } from './quality-chart.js';
+import { SCALE_PERCENTILE, formatDegrees, rampGradient, reliefTicks } from './relief.js';
 
 /** Device pixels per CSS pixel, capped: beyond 2 a tablet pays 2.25× the fill for little gain. */
 const MAX_PIXEL_RATIO = 2;
@@ -23,7 +25,8 @@ canvas:focus-visible { box-shadow: inset 0 0 0 2px #88c0d0; }
 .panel h1 { font-size: 16px; margin: 0; font-weight: 600; }
 .panel p { margin: 4px 0 0; color: #cfd5de; }
 .panel:empty, [hidden] { display: none !important; }
-.tools { position: absolute; top: 10px; right: 10px; display: flex; gap: 6px; }
+.tools { position: absolute; top: 10px; right: 10px; display: flex; flex-wrap: wrap; justify-content: flex-end;
+  gap: 6px; max-width: calc(100% - 20px); }
 button { font: inherit; color: inherit; background: rgba(20, 22, 26, 0.72); border: 1px solid #4c566a;
   border-radius: 6px; min-height: 36px; padding: 4px 12px; cursor: pointer; }
 button:hover { background: rgba(59, 66, 82, 0.9); }
@@ -47,6 +50,18 @@ button[aria-pressed="true"] { background: #5e81ac; border-color: #81a1c1; }
 .quality svg { display: block; width: 100%; max-width: 260px; height: auto; margin-top: 4px; }
 .quality p { font-size: 12px; }
 @media (max-width: 480px), (max-height: 360px) { .quality { display: none; } }
+/* Phones: narrower buttons, and the title panel under them rather than beside. */
+@media (max-width: 480px) {
+  button { padding: 4px 8px; }
+  .panel { top: 56px; max-width: calc(100% - 20px); }
+}
+.legend { width: min(280px, 100%); font-size: 12px; }
+.legend-title { color: #cfd5de; }
+.legend-ramp { height: 10px; margin: 5px 7px 2px; border-radius: 2px; background: ${rampGradient()}; }
+.legend-ticks { position: relative; height: 1.4em; margin: 0 7px; font-variant-numeric: tabular-nums; }
+.legend-ticks span { position: absolute; top: 0; transform: translateX(-50%); white-space: nowrap; }
+.legend-ticks span:first-child { transform: translateX(-7px); }
+.legend-ticks span:last-child { transform: translateX(calc(-100% + 7px)); }
 :host([chrome="minimal"]) .panel p { display: none; }
 :host([chrome="minimal"]) .quality { display: none; }
 :host([chrome="minimal"]) button.optional { display: none; }
@@ -55,6 +70,7 @@ button[aria-pressed="true"] { background: #5e81ac; border-color: #81a1c1; }
 export class ViewerUi {
   onReset = () => {};
   onWireframe = () => {};
+  onRelief = () => {};
   onRetry = () => {};
   onResize = () => {};
   /** The quality curve the chart shows. @type {ReadonlyArray<import('./quality-chart.js').QualityPoint> | null} */
@@ -76,9 +92,16 @@ export class ViewerUi {
   <div class="tools">
     <button data-action="reset" title="Reset view (R)">Reset</button>
     <button data-action="wireframe" title="Wireframe (W)" aria-pressed="false" class="optional">Wireframe</button>
+    <button data-action="relief" title="Relief: colour by average normal deviation θ (erosion, tool marks)"
+      aria-pressed="false" class="optional">Relief</button>
     <button data-action="fullscreen" title="Fullscreen (F)">Fullscreen</button>
   </div>
   <div class="status">
+    <div class="legend pill" role="group" aria-label="Relief legend" hidden>
+      <div class="legend-title"></div>
+      <div class="legend-ramp" aria-hidden="true"></div>
+      <div class="legend-ticks"></div>
+    </div>
     <div class="notice pill" role="status" hidden></div>
     <div class="colour pill" hidden></div>
     <div class="progress pill" aria-live="polite">Loading…</div>
@@ -96,6 +119,8 @@ export class ViewerUi {
     this.bar = $('.bar');
     this.error = $('.error');
     this.wireButton = $('[data-action="wireframe"]');
+    this.reliefButton = $('[data-action="relief"]');
+    this.legend = $('.legend');
     this.quality = document.createElement('details');
     this.quality.className = 'quality';
     this.quality.open = true;
@@ -103,6 +128,7 @@ export class ViewerUi {
     this.quality.innerHTML = '<summary>Quality per level</summary><div class="chart"></div><p></p>';
     $('[data-action="reset"]').onclick = () => this.onReset();
     this.wireButton.onclick = () => this.onWireframe();
+    this.reliefButton.onclick = () => this.onRelief();
     $('[data-action="fullscreen"]').onclick = () => this.toggleFullscreen();
     $('[data-action="retry"]').onclick = () => this.onRetry();
     this.#watchSize();
@@ -186,6 +212,7 @@ export class ViewerUi {
    */
   setProgress(state) {
     this.#setColour(state);
+    this.#setLegend(state);
     this.#drawQuality(state.shownLevel);
     if (state.shownLevel < 0) {
       this.#write(this.progress, `Loading… ${formatBytes(state.received)} received`);
@@ -237,6 +264,45 @@ export class ViewerUi {
 
   #colourKey = '';
 
+  /**
+   * The relief view's legend: the ramp with its ticks in degrees, for the
+   * scale of the level on screen; hidden while the view is off.
+   * @param {import('./viewer.js').ViewerState} state
+   */
+  #setLegend(state) {
+    const key = state.relief ? String(state.reliefTop) : 'off';
+    if (key === this.#legendKey) return;
+    this.#legendKey = key;
+    this.legend.hidden = !state.relief;
+    if (!state.relief) return;
+    const top = state.reliefTop;
+    const title = /** @type {HTMLElement} */ (this.legend.querySelector('.legend-title'));
+    const ramp = /** @type {HTMLElement} */ (this.legend.querySelector('.legend-ramp'));
+    const ticks = /** @type {HTMLElement} */ (this.legend.querySelector('.legend-ticks'));
+    ramp.hidden = top === null;
+    ticks.replaceChildren();
+    if (top === null) {
+      this.legend.setAttribute('aria-label', 'Relief legend');
+      title.textContent = 'Relief: computing the normal deviation θ…';
+      return;
+    }
+    const percentile = Math.round(100 * SCALE_PERCENTILE);
+    title.textContent = `Normal deviation θ (top: ${percentile}th percentile)`;
+    this.legend.setAttribute(
+      'aria-label',
+      `Relief legend: normal deviation θ from 0° (dark purple) to ${formatDegrees(top)} or more (yellow), ` +
+        `the ${percentile}th percentile of this level`,
+    );
+    for (const value of reliefTicks(top)) {
+      const span = document.createElement('span');
+      span.textContent = value === top ? `≥ ${formatDegrees(value)}` : formatDegrees(value);
+      span.style.left = `${(100 * value) / top}%`;
+      ticks.append(span);
+    }
+  }
+
+  #legendKey = '';
+
   /** @param {string | null} text */
   showNotice(text) {
     this.notice.hidden = text === null;
@@ -252,6 +318,11 @@ export class ViewerUi {
   /** @param {boolean} on */
   setWireframe(on) {
     this.wireButton.setAttribute('aria-pressed', String(on));
+  }
+
+  /** @param {boolean} on */
+  setRelief(on) {
+    this.reliefButton.setAttribute('aria-pressed', String(on));
   }
 
   toggleFullscreen() {

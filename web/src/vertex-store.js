@@ -18,8 +18,8 @@ import { normalJob } from './normals-task.js';
 /** @typedef {{ target: number, buffer: WebGLBuffer, data: ArrayBufferView, offset: number }} Upload */
 
 /**
- * One level on the GPU: its own normals, indices and edges; positions and
- * colours from the shared vertex store.
+ * One level on the GPU: its own normals, indices, edges and θ (the relief
+ * view); positions and colours from the shared vertex store.
  * @typedef {object} GpuMesh
  * @property {LevelMessage} source
  * @property {WebGLVertexArrayObject} vao
@@ -27,6 +27,7 @@ import { normalJob } from './normals-task.js';
  * @property {WebGLBuffer} indexBuffer
  * @property {WebGLBuffer | null} edgeBuffer
  * @property {WebGLBuffer | null} normalBuffer
+ * @property {WebGLBuffer | null} reliefBuffer θ per vertex (attribute 3), when the level has it
  * @property {import('./normals-task.js').NormalJob | null} normalJob normals still to derive before they are uploaded
  * @property {Upload[]} uploads
  */
@@ -185,6 +186,14 @@ export function allocateMesh(gl, store, level) {
   } else {
     gl.disableVertexAttribArray(2);
   }
+  let reliefBuffer = null;
+  if (level.relief) {
+    reliefBuffer = buffer(gl.ARRAY_BUFFER, level.relief);
+    gl.enableVertexAttribArray(3);
+    gl.vertexAttribPointer(3, 1, gl.FLOAT, false, 0, 0);
+  } else {
+    gl.disableVertexAttribArray(3);
+  }
   const indexBuffer = buffer(gl.ELEMENT_ARRAY_BUFFER, level.indices);
   gl.bindVertexArray(null);
   let edgeBuffer = null;
@@ -192,7 +201,7 @@ export function allocateMesh(gl, store, level) {
     edgeBuffer = buffer(gl.ELEMENT_ARRAY_BUFFER, level.edges);
     buffers.pop();
   }
-  return { source: level, vao, buffers, indexBuffer, edgeBuffer, normalBuffer, normalJob: job, uploads };
+  return { source: level, vao, buffers, indexBuffer, edgeBuffer, normalBuffer, reliefBuffer, normalJob: job, uploads };
 }
 
 /**
@@ -202,7 +211,16 @@ export function allocateMesh(gl, store, level) {
  */
 export function emptyMesh() {
   const none = /** @type {any} */ (null);
-  return { vao: none, buffers: [], indexBuffer: none, edgeBuffer: null, normalBuffer: null, normalJob: null, uploads: [] };
+  return {
+    vao: none,
+    buffers: [],
+    indexBuffer: none,
+    edgeBuffer: null,
+    normalBuffer: null,
+    reliefBuffer: null,
+    normalJob: null,
+    uploads: [],
+  };
 }
 
 /**
@@ -218,6 +236,35 @@ export function addEdgeBuffer(gl, mesh, edges) {
   gl.bindBuffer(gl.ELEMENT_ARRAY_BUFFER, mesh.edgeBuffer);
   gl.bufferData(gl.ELEMENT_ARRAY_BUFFER, edges.byteLength, gl.STATIC_DRAW);
   mesh.uploads.push({ target: gl.ELEMENT_ARRAY_BUFFER, buffer: mesh.edgeBuffer, data: edges, offset: 0 });
+}
+
+/**
+ * θ that came after the level (relief view switched on): a buffer for it
+ * on attribute 3 of the level's vertex array, queued for upload.
+ * @param {WebGL2RenderingContext} gl
+ * @param {GpuMesh} mesh
+ * @param {Float32Array} relief
+ */
+export function addReliefBuffer(gl, mesh, relief) {
+  const buffer = /** @type {WebGLBuffer} */ (gl.createBuffer());
+  gl.bindVertexArray(mesh.vao);
+  gl.bindBuffer(gl.ARRAY_BUFFER, buffer);
+  gl.bufferData(gl.ARRAY_BUFFER, relief.byteLength, gl.STATIC_DRAW);
+  gl.enableVertexAttribArray(3);
+  gl.vertexAttribPointer(3, 1, gl.FLOAT, false, 0, 0);
+  gl.bindVertexArray(null);
+  mesh.reliefBuffer = buffer;
+  mesh.buffers.push(buffer);
+  mesh.uploads.push({ target: gl.ARRAY_BUFFER, buffer, data: relief, offset: 0 });
+}
+
+/**
+ * Whether a mesh's θ is on the GPU (its buffer made and fully uploaded).
+ * @param {GpuMesh} mesh
+ */
+export function reliefReady(mesh) {
+  const buffer = mesh.reliefBuffer;
+  return Boolean(buffer) && !mesh.uploads.some((upload) => upload.buffer === buffer);
 }
 
 /**

@@ -56,7 +56,7 @@ import { retryAfterSeconds, waitToRetry } from './retry.js';
  * @property {number} vertices of the level on screen
  * @property {number} received payload bytes
  * @property {number} decodeMs time inside the WASM decoder
- * @property {number} deriveMs time computing normals and edges in the decode worker
+ * @property {number} deriveMs time computing normals, edges and θ in the decode worker
  * @property {number} normalsMs time the renderer spent deriving normals (levels sent without them)
  * @property {number | null} firstFrameMs performance.now() of the first frame with a mesh
  * @property {Record<number, number>} shownAtMs performance.now() when each level was first drawn
@@ -67,6 +67,9 @@ import { retryAfterSeconds, waitToRetry } from './retry.js';
  * @property {Partial<Record<'requested' | 'low' | 'full', number>>} colourAtMs performance.now()
  *   when the textures were requested and when each colour texture was first drawn
  * @property {string | null} colourError why the CCC colour could not be shown (the model stays visible)
+ * @property {boolean} relief the relief view is switched on
+ * @property {number | null} reliefTop the top of the θ scale on screen in degrees (relief.js
+ *   `reliefTop`); null while the picture is not in the relief view (off, or θ still on its way)
  */
 
 /** @type {Map<string, Promise<WebAssembly.Module>>} */
@@ -119,6 +122,8 @@ export class Viewer {
     colour: 'none',
     colourAtMs: {},
     colourError: null,
+    relief: false,
+    reliefTop: null,
   };
   /** @type {Manifest | null} */
   manifest = null;
@@ -142,6 +147,7 @@ export class Viewer {
   /** @type {ReturnType<typeof setTimeout> | null} */
   #retry = null;
   #wireframe = false;
+  #relief = false;
   /** Bumped by stop(), so a start() still waiting for the network gives up. */
   #attempt = 0;
   /** The CCC colour textures: fetched after the first frame, kept across retries. */
@@ -170,6 +176,7 @@ export class Viewer {
     });
     ui.onReset = () => this.resetView();
     ui.onWireframe = () => this.setWireframe(!this.#wireframe);
+    ui.onRelief = () => this.setRelief(!this.#relief);
     ui.onRetry = () => this.start();
     ui.onResize = () => this.renderer?.requestFrame();
   }
@@ -207,6 +214,8 @@ export class Viewer {
       // Normals are derived by the renderer when it has a thread of its own;
       // the main thread's fallback gets them from the decode worker.
       if (renderer.thread === 'main') worker.postMessage({ type: 'normals', which: 'always' });
+      // Switched on before the renderer was ready.
+      if (this.#relief) renderer.setRelief(true);
       renderer.attach(levels);
     } catch (error) {
       if (attempt === this.#attempt) this.#fail(error instanceof Error ? error.message : String(error));
@@ -232,6 +241,21 @@ export class Viewer {
     this.ui.setWireframe(on);
     this.renderer?.setWireframe(on);
     this.#worker?.postMessage({ type: 'wireframe', on });
+  }
+
+  /**
+   * The relief view: each vertex coloured by its average normal deviation θ
+   * (relief.js), computed by the decode worker for the level on screen and
+   * every level after it while the view is on; the legend shows the scale
+   * of the level drawn.
+   * @param {boolean} on
+   */
+  setRelief(on) {
+    this.#relief = on;
+    this.ui.setRelief(on);
+    this.renderer?.setRelief(on);
+    this.#worker?.postMessage({ type: 'relief', on });
+    this.#set({ relief: on });
   }
 
   /**
@@ -263,6 +287,7 @@ export class Viewer {
       show: this.options.level === null ? 'each' : 'last',
       showFrom: Math.min(this.state.shownLevel + 1, target),
       wireframe: this.#wireframe,
+      relief: this.#relief,
       // A render worker derives the normals of the levels before the last
       // that it draws (see start(): if the renderer turns out to be on the
       // main thread, the decode worker is told to send them all).
@@ -348,8 +373,9 @@ export class Viewer {
     else this.#set({ status: 'complete' });
   }
 
-  /** @param {{ level: number | null, colourResolution: 'low' | 'full' | null, at: number }} frame */
+  /** @param {{ level: number | null, colourResolution: 'low' | 'full' | null, reliefTop: number | null, at: number }} frame */
   #framed(frame) {
+    if (frame.reliefTop !== this.state.reliefTop) this.#set({ reliefTop: frame.reliefTop });
     const resolution = frame.colourResolution;
     if (resolution && !(resolution in this.state.colourAtMs)) {
       this.state.colourAtMs[resolution] = frame.at;
