@@ -5,6 +5,30 @@ use crate::IndexedMesh;
 use std::collections::HashMap;
 use std::f32::consts::TAU;
 
+/// An open `n × n` grid of unit squares in z = 0, each split in two
+/// (a flat surface with a border of `4n` vertices).
+pub fn grid(n: u32) -> IndexedMesh {
+    let mut positions = Vec::new();
+    for j in 0..=n {
+        for i in 0..=n {
+            positions.push([i as f32, j as f32, 0.0]);
+        }
+    }
+    let id = |i: u32, j: u32| j * (n + 1) + i;
+    let mut triangles = Vec::new();
+    for j in 0..n {
+        for i in 0..n {
+            triangles.push([id(i, j), id(i + 1, j), id(i + 1, j + 1)]);
+            triangles.push([id(i, j), id(i + 1, j + 1), id(i, j + 1)]);
+        }
+    }
+    IndexedMesh {
+        positions,
+        colors: None,
+        triangles,
+    }
+}
+
 /// A torus of `rings × sides` vertices (genus 1, valence 6 everywhere).
 pub fn torus(rings: u32, sides: u32, major: f32, minor: f32) -> IndexedMesh {
     let mut positions = Vec::with_capacity((rings * sides) as usize);

@@ -156,29 +156,7 @@ pub fn one_ring_max(mesh: &IndexedMesh, theta: &[f64]) -> Vec<f64> {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    /// An `n × n` grid of squares in z = 0, each split in two.
-    fn grid(n: u32) -> IndexedMesh {
-        let mut positions = Vec::new();
-        for j in 0..=n {
-            for i in 0..=n {
-                positions.push([i as f32, j as f32, 0.0]);
-            }
-        }
-        let id = |i: u32, j: u32| j * (n + 1) + i;
-        let mut triangles = Vec::new();
-        for j in 0..n {
-            for i in 0..n {
-                triangles.push([id(i, j), id(i + 1, j), id(i + 1, j + 1)]);
-                triangles.push([id(i, j), id(i + 1, j + 1), id(i, j + 1)]);
-            }
-        }
-        IndexedMesh {
-            positions,
-            colors: None,
-            triangles,
-        }
-    }
+    use vitrine_samples::grid;
 
     #[test]
     fn a_plane_has_no_deviation() {

@@ -10,36 +10,15 @@ use std::collections::HashSet;
 use surface::{corners, Surface};
 use vitrine_codec::{Error, IndexedMesh};
 use vitrine_mesh::repair::check_manifold;
-use vitrine_samples::{add_noise, icosphere, merge, paint, plate_with_tunnels, punch_holes, torus};
+use vitrine_samples::{
+    add_noise, grid, icosphere, merge, paint, plate_with_tunnels, punch_holes, torus,
+};
 use vitrine_simplify::{
     border_vertices, simplify, simplify_with, Cleanup, Collapse, FeatureThreshold, SimplifyOptions,
     StopReason, Target,
 };
 
 const VARIANTS: [Collapse; 3] = [Collapse::Edge, Collapse::HalfEdge, Collapse::Triangle];
-
-/// An `n × n` grid of squares in z = 0, each split in two.
-fn grid(n: u32) -> IndexedMesh {
-    let mut positions = Vec::new();
-    for j in 0..=n {
-        for i in 0..=n {
-            positions.push([i as f32, j as f32, 0.0]);
-        }
-    }
-    let id = |i: u32, j: u32| j * (n + 1) + i;
-    let mut triangles = Vec::new();
-    for j in 0..n {
-        for i in 0..n {
-            triangles.push([id(i, j), id(i + 1, j), id(i + 1, j + 1)]);
-            triangles.push([id(i, j), id(i + 1, j + 1), id(i, j + 1)]);
-        }
-    }
-    IndexedMesh {
-        positions,
-        colors: None,
-        triangles,
-    }
-}
 
 fn holed_grid() -> IndexedMesh {
     punch_holes(&grid(40), &[[10.0, 12.0, 0.0], [28.0, 26.0, 0.0]], 4.5)
