@@ -1,7 +1,7 @@
 //! Operations routes: liveness, readiness, metrics, the OpenAPI description.
 
 use super::error::{AppError, ErrorBody, ErrorCode};
-use super::{metrics, routes, AppState};
+use super::{metrics, AppState};
 use axum::extract::State;
 use axum::http::{header, HeaderValue, StatusCode};
 use axum::response::{IntoResponse, Response};
@@ -103,23 +103,6 @@ pub async fn prometheus(State(state): State<AppState>) -> Response {
     (
         [(header::CONTENT_TYPE, content_type)],
         metrics::render(&state),
-    )
-        .into_response()
-}
-
-/// This description, generated from the routes' own types (OpenAPI 3.1).
-#[utoipa::path(
-    get,
-    path = "/api/openapi.json",
-    responses((status = 200, description = "OpenAPI 3.1", body = Object))
-)]
-pub async fn openapi() -> Response {
-    (
-        [(
-            header::CONTENT_TYPE,
-            HeaderValue::from_static("application/json"),
-        )],
-        routes::openapi_json(),
     )
         .into_response()
 }

@@ -1,0 +1,118 @@
+//! The normal-deviation simplifier (each collapse variant) at 10 % and 2 %
+//! of the faces, beside a quadric-error peer on the very same repaired mesh:
+//! symmetric Hausdorff over the bounding-box diagonal, and time.
+//!
+//!     pip install fast-simplification plyfile numpy
+//!     cargo run --release -p vitrine-simplify --example simplify_bench -- \
+//!         [--peer scripts/peer_quadric.py] MESH…
+
+use std::process::Command;
+use std::time::Instant;
+
+use vitrine_codec::IndexedMesh;
+use vitrine_mesh::export::write_ply;
+use vitrine_mesh::import::{import_path, ImportOptions};
+use vitrine_mesh::repair::{prepare, RepairOptions};
+use vitrine_quality::metrics::hausdorff;
+use vitrine_simplify::{simplify, Collapse, SimplifyOptions, StopReason, Target};
+
+const FRACTIONS: [f64; 2] = [0.10, 0.02];
+const SAMPLES: usize = 200_000;
+
+/// One simplifier's result: faces, Hausdorff over the diagonal, seconds, how it stopped.
+fn ours(mesh: &IndexedMesh, collapse: Collapse, fraction: f64) -> (usize, f64, f64, &'static str) {
+    let options = SimplifyOptions {
+        collapse,
+        target: Target::Fraction(fraction),
+        ..SimplifyOptions::default()
+    };
+    let t = Instant::now();
+    let out = simplify(mesh, &options).expect("simplifies");
+    let seconds = t.elapsed().as_secs_f64();
+    let stopped = match out.stopped {
+        StopReason::Target => "target",
+        StopReason::NoCandidate => "no candidate",
+        StopReason::MaxPasses => "max passes",
+    };
+    let h = hausdorff(mesh, &out.mesh, SAMPLES).relative();
+    (out.mesh.triangles.len(), h, seconds, stopped)
+}
+
+/// The peer on `mesh` (written to a temporary PLY), read back and measured.
+fn peer(
+    script: &str,
+    mesh: &IndexedMesh,
+    fraction: f64,
+) -> Result<(usize, f64, f64), Box<dyn std::error::Error>> {
+    let dir = std::env::temp_dir().join(format!("vitrine-peer-{}", std::process::id()));
+    std::fs::create_dir_all(&dir)?;
+    let (input, output) = (dir.join("in.ply"), dir.join("out.ply"));
+    let geometry = IndexedMesh {
+        colors: None,
+        ..mesh.clone()
+    };
+    write_ply(
+        &geometry,
+        &mut std::io::BufWriter::new(std::fs::File::create(&input)?),
+    )?;
+    let run = Command::new("python3")
+        .arg(script)
+        .arg(&input)
+        .arg(&output)
+        .arg(fraction.to_string())
+        .output()?;
+    if !run.status.success() {
+        return Err(String::from_utf8_lossy(&run.stderr).into_owned().into());
+    }
+    let ms: f64 = String::from_utf8_lossy(&run.stdout).trim().parse()?;
+    let simplified = import_path(&output, &ImportOptions::default())?;
+    let h = hausdorff(mesh, &simplified, SAMPLES).relative();
+    std::fs::remove_dir_all(&dir)?;
+    Ok((simplified.triangles.len(), h, ms / 1000.0))
+}
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let mut paths: Vec<String> = std::env::args().skip(1).collect();
+    let mut script = None;
+    if paths.first().is_some_and(|a| a == "--peer") && paths.len() > 1 {
+        script = Some(paths[1].clone());
+        paths.drain(..2);
+    }
+    println!(
+        "| scan | faces | kept | edge: faces, H/diag, s | half-edge | triangle | quadric peer |"
+    );
+    println!("|---|---:|---:|---|---|---|---|");
+    for path in &paths {
+        let mesh = import_path(path.as_ref(), &ImportOptions::default())?;
+        let (mesh, _) = prepare(mesh, &RepairOptions::default())?;
+        let name = std::path::Path::new(path)
+            .file_name()
+            .and_then(|n| n.to_str())
+            .unwrap_or(path);
+        for fraction in FRACTIONS {
+            let mut row = format!(
+                "| {name} | {} | {:.0} % |",
+                mesh.triangles.len(),
+                100.0 * fraction
+            );
+            for collapse in [Collapse::Edge, Collapse::HalfEdge, Collapse::Triangle] {
+                let (faces, h, s, stopped) = ours(&mesh, collapse, fraction);
+                let note = if stopped == "target" {
+                    String::new()
+                } else {
+                    format!(" ({stopped})")
+                };
+                row += &format!(" {faces}, {h:.5}, {s:.2}{note} |");
+            }
+            match &script {
+                Some(script) => {
+                    let (faces, h, s) = peer(script, &mesh, fraction)?;
+                    row += &format!(" {faces}, {h:.5}, {s:.2} |");
+                }
+                None => row += " – |",
+            }
+            println!("{row}");
+        }
+    }
+    Ok(())
+}
