@@ -23,7 +23,7 @@ if [ -f "$mask" ]; then
     $vitrine ingest "$mask" --db "sqlite:$db" --slug bali-mask --policy open --colour ccc \
         --title "Bali mask" --description "Badisches Landesmuseum, CC BY-SA 4.0; photographic texture through a cubic cell complex."
 fi
-$vitrine ingest data/plate.ply --db "sqlite:$db" --slug tunnel-plate --policy open \
-    --title "Tunnel plate" --description "A genus-3 plate with sharp edges and tunnels."
+$vitrine ingest data/plate.ply --db "sqlite:$db" --slug tunnel-plate --policy open --guard features \
+    --title "Tunnel plate" --description "A genus-3 plate with sharp edges and tunnels, kept sharp in the coarse levels by the feature guard; try Relief."
 echo "Vitrine: open http://127.0.0.1:${PORT:-8080}/"
 exec $vitrine serve --db "sqlite:$db" --listen "127.0.0.1:${PORT:-8080}" --web-dir web/dist
