@@ -8,7 +8,7 @@ bash scripts/setup.sh
 cargo fmt --all -- --check
 cargo clippy --workspace --all-targets -- -D warnings
 cargo clippy -p vitrine --no-deps --all-targets --features dev-tools -- -D warnings # vitrine-dev's tools
-bash scripts/check-layout.sh # wasm32 core, crate and module DAGs, priors
+bash scripts/check-layout.sh # wasm32 core, crate and module DAGs
 bash scripts/build.sh
 cargo test --workspace
 cargo test -p vitrine --features dev-tools --lib # the tools' unit tests (bench's Draco peer)

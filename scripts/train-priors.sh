@@ -6,6 +6,13 @@
 #
 #   scripts/train-priors.sh          rewrite table.rs
 #   scripts/train-priors.sh --check  fail unless training gives table.rs byte for byte
+#
+# The committed table was trained by the encoder of commit 5a347ad (stream
+# format 3). Later encoders (the locality order, the traversal changes of
+# format 4) take other decimation decisions on the dragon, so `--check`
+# fails today (checked 1 Dec 2026: most decimating contexts differ by a few
+# counts): the tables stay as they are because they are part of the stream
+# format, and retraining belongs with the next format version.
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 table="$root/codec/core/src/priors/table.rs"
@@ -22,7 +29,7 @@ if [ "${1:-}" = --check ]; then
     if cmp -s "$work/table.rs" "$table"; then
         echo "table.rs is what training gives, byte for byte"
     else
-        diff "$table" "$work/table.rs" | head -20 >&2
+        diff "$table" "$work/table.rs" | head -20 >&2 || true
         echo "table.rs differs from what training gives" >&2
         exit 1
     fi

