@@ -2,18 +2,22 @@
 /**
  * The pages `vitrine serve` maps to one index.html: the gallery at `/`, a
  * model page at `/m/{slug}` (viewer, description, embed snippets) and the
- * bare viewer at `/embed/{slug}` for iframes. `?device=`, `?token=`,
+ * bare viewer at `/embed/{slug}` for iframes, and the quality study at
+ * `/study/{slug}?invitation=…` (study/page.js). `?device=`, `?token=`,
  * `?level=` and `?offscreen=off` on a page's URL are passed to the viewer.
  */
 
 import './element.js';
+import { fetchResults } from './study/api.js';
+import { StudyPage } from './study/page.js';
 
 const main = /** @type {HTMLElement} */ (document.getElementById('app'));
 const params = new URLSearchParams(location.search);
-const route = location.pathname.match(/^\/(m|embed)\/([a-z0-9-]+)\/?$/);
+const route = location.pathname.match(/^\/(m|embed|study)\/([a-z0-9-]+)\/?$/);
 
 if (!route) void gallery();
 else if (route[1] === 'm') modelPage(route[2]);
+else if (route[1] === 'study') void new StudyPage(main, route[2], params).start();
 else embedPage(route[2]);
 
 /**
@@ -84,6 +88,12 @@ function modelPage(slug) {
       snippet('Or the viewer element, styled by your page:', element),
     ]),
   );
+  // The quality study's answers, when the model has a study (404: none, nothing shown).
+  void fetchResults(slug)
+    .then((results) => {
+      if (results) /** @type {any} */ (viewer).viewer?.ui.setStudy(results.levels);
+    })
+    .catch(() => {});
   viewer.addEventListener('vitrine-level', () => {
     const title = /** @type {any} */ (viewer).viewer?.manifest?.title;
     if (title) document.title = `${title} · Vitrine`;

@@ -8,6 +8,7 @@
  * - wheel: zoom;
  * - keys (when the canvas has focus): arrows rotate, shift + arrows pan,
  *   + / - zoom, R reset, W wireframe, F fullscreen.
+ * While `locked` (the quality study's questions) all of it is ignored.
  */
 
 const KEY_STEP_PX = 40;
@@ -21,7 +22,11 @@ const WHEEL_ZOOM_PER_PX = 0.0015;
  * @property {() => void} reset
  * @property {() => void} toggleWireframe
  * @property {() => void} toggleFullscreen
+ * @property {(kind: Interaction) => void} [interacted] the visitor moved the camera (every move; the
+ *   study's log coalesces them)
  */
+
+/** @typedef {'orbit' | 'pan' | 'zoom' | 'pinch' | 'key'} Interaction */
 
 export class OrbitControls {
   /** @type {Map<number, { x: number, y: number }>} */
@@ -29,6 +34,20 @@ export class OrbitControls {
   /** @type {{ distance: number, x: number, y: number } | null} */
   #pinch = null;
   #panning = false;
+  /** Input is ignored (pointer, wheel, keys); a drag in progress ends. */
+  #locked = false;
+
+  get locked() {
+    return this.#locked;
+  }
+
+  set locked(on) {
+    this.#locked = on;
+    if (on) {
+      this.#pointers.clear();
+      this.#pinch = null;
+    }
+  }
 
   /**
    * @param {HTMLCanvasElement} canvas
@@ -51,6 +70,7 @@ export class OrbitControls {
 
   /** @param {PointerEvent} e */
   #down(e) {
+    if (this.#locked) return;
     this.canvas.focus({ preventScroll: true });
     // Capture can fail for synthetic events; moves still arrive on the canvas.
     try {
@@ -66,7 +86,9 @@ export class OrbitControls {
   #move(e) {
     const last = this.#pointers.get(e.pointerId);
     const camera = this.actions.camera();
-    if (!last || !camera) return;
+    if (!last || !camera || this.#locked) return;
+    /** @type {Interaction} */
+    let kind = this.#panning ? 'pan' : 'orbit';
     const height = this.canvas.clientHeight || 1;
     if (this.#pointers.size === 1) {
       const dx = e.clientX - last.x;
@@ -80,8 +102,10 @@ export class OrbitControls {
       if (now.distance > 0 && this.#pinch.distance > 0) camera.zoom(this.#pinch.distance / now.distance);
       camera.pan(now.x - this.#pinch.x, now.y - this.#pinch.y, height);
       this.#pinch = now;
+      kind = 'pinch';
     }
     this.actions.changed();
+    this.actions.interacted?.(kind);
   }
 
   /** @param {PointerEvent} e */
@@ -99,16 +123,21 @@ export class OrbitControls {
   /** @param {WheelEvent} e */
   #wheel(e) {
     const camera = this.actions.camera();
+    if (this.#locked) {
+      e.preventDefault();
+      return;
+    }
     if (!camera) return;
     e.preventDefault();
     const pixels = e.deltaMode === 1 ? e.deltaY * 16 : e.deltaMode === 2 ? e.deltaY * 400 : e.deltaY;
     camera.zoom(Math.exp(pixels * WHEEL_ZOOM_PER_PX));
     this.actions.changed();
+    this.actions.interacted?.('zoom');
   }
 
   /** @param {KeyboardEvent} e */
   #key(e) {
-    if (e.ctrlKey || e.metaKey || e.altKey) return;
+    if (e.ctrlKey || e.metaKey || e.altKey || this.#locked) return;
     const camera = this.actions.camera();
     const height = this.canvas.clientHeight || 1;
     const arrows = { ArrowLeft: [-1, 0], ArrowRight: [1, 0], ArrowUp: [0, -1], ArrowDown: [0, 1] };
@@ -136,5 +165,6 @@ export class OrbitControls {
     }
     e.preventDefault();
     this.actions.changed();
+    this.actions.interacted?.('key');
   }
 }

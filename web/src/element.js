@@ -8,7 +8,10 @@
  * (`full` or `minimal`), `device` (`phone`, `tablet`, `desktop`: overrides
  * the server's guess), `level` (stop at this level; for comparisons),
  * `offscreen="off"` (draw on the main thread even where a worker could:
- * comparisons and tests of the fallback). The
+ * comparisons and tests of the fallback), `hold` (show and decode up to this
+ * level until `element.viewer.prefetch()` / `display()` say otherwise: the
+ * quality study), `background` (`#rrggbb`: the canvas's colour; the study's
+ * black). `chrome="none"` draws the model and nothing else. The
  * worker and the decoder are loaded from beside this script, so the element
  * works on another origin (the service answers CORS).
  */
@@ -30,6 +33,18 @@ export function manifestUrl(src, base) {
   return url.href;
 }
 
+/**
+ * `#rrggbb` as 0–1 components (as shading.js gives BACKGROUND), or undefined.
+ * @param {string | null} value
+ * @returns {[number, number, number] | undefined}
+ */
+export function parseColour(value) {
+  const match = value?.match(/^#([0-9a-f]{2})([0-9a-f]{2})([0-9a-f]{2})$/i);
+  if (!match) return undefined;
+  const [r, g, b] = [1, 2, 3].map((i) => parseInt(match[i], 16) / 255);
+  return [r, g, b];
+}
+
 export class VitrineViewerElement extends HTMLElement {
   /** @type {Viewer | null} */
   viewer = null;
@@ -49,6 +64,7 @@ export class VitrineViewerElement extends HTMLElement {
       if (value) query.set(key, value);
     }
     const level = this.getAttribute('level');
+    const hold = this.getAttribute('hold');
     this.viewer = new Viewer(ui, {
       manifestUrl: manifestUrl(src, document.baseURI),
       query,
@@ -57,11 +73,14 @@ export class VitrineViewerElement extends HTMLElement {
       wasmUrl: new URL('./vitrine_wasm.wasm', import.meta.url).href,
       renderWorkerUrl: new URL('./render-worker.js', import.meta.url).href,
       offscreen: this.getAttribute('offscreen') !== 'off',
+      hold: hold === null || hold === '' ? null : Number(hold),
+      background: parseColour(this.getAttribute('background')),
     });
     void this.viewer.start();
   }
 
   disconnectedCallback() {
+    this.viewer?.stopTurntable();
     this.viewer?.stop();
     this.viewer = null;
   }

@@ -7,7 +7,10 @@
  * (the two errors can differ by a hundredfold, and each falls by orders of
  * magnitude as a scan refines): the Lindstrom–Turk image RMSE over 24 views
  * and, when the model has colour, Roy's colour RMSE. A marker stands at the
- * level on screen.
+ * level on screen. When the model has a quality study with answers
+ * (`GET /api/study/{slug}/results`), a bar at each level shows the share of
+ * participants who found that level's quality sufficient (0–100 % of the
+ * plot's height).
  *
  * Pure functions of the data (no DOM), so Node tests them and the viewer's
  * panel inserts the string into its shadow root. Every number is formatted
@@ -28,6 +31,12 @@
  * @typedef {object} ChartOptions
  * @property {number} [width] of the viewBox (default 260)
  * @property {number} [height] of the viewBox (default 130)
+ * @property {ReadonlyArray<StudyLevel> | null} [study] the study's answers per level
+ */
+
+/**
+ * One level's answers in the quality study (Q2 "Is this quality sufficient?").
+ * @typedef {{ level: number, answers: number, sufficient: number }} StudyLevel
  */
 
 /**
@@ -47,6 +56,8 @@
  *   the level on screen, when it is on the curve
  * @property {Array<{ x: number, label: string }>} xTicks
  * @property {Array<{ y: number, label: string }>} yTicks
+ * @property {Array<{ level: number, x: number, y: number, share: number, answers: number }>} study
+ *   a bar per level with answers: from y down to the plot's bottom, share = sufficient / answers
  */
 
 /** @type {ReadonlyArray<{ key: SeriesKey, label: string, colour: string }>} */
@@ -145,7 +156,27 @@ export function layoutQualityChart(quality, level, options = {}) {
   /** @type {ChartLayout['yTicks']} */
   const yTicks = [];
   for (let e = yLo; e <= yHi; e++) yTicks.push({ y: y(10 ** e), label: `${+(10 ** e).toFixed(Math.max(0, -e))}` });
-  return { width, height, plot, series, marker, xTicks, yTicks };
+  const byLevel = new Map(points.map((p) => [p.level, p]));
+  const study = (options.study ?? [])
+    .filter((l) => byLevel.has(l.level) && finite(l.answers) && l.answers > 0 && finite(l.sufficient))
+    .map((l) => {
+      const share = Math.max(0, Math.min(1, l.sufficient / l.answers));
+      const vertices = /** @type {QualityPoint} */ (byLevel.get(l.level)).vertices;
+      return { level: l.level, x: x(vertices), y: plot.bottom - share * (plot.bottom - plot.top), share, answers: l.answers };
+    });
+  return { width, height, plot, series, marker, xTicks, yTicks, study };
+}
+
+/**
+ * The study's line for a level: how many found it sufficient.
+ * @param {ReadonlyArray<StudyLevel> | null | undefined} study
+ * @param {number} level
+ * @returns {string} empty without answers at that level
+ */
+export function describeStudyLevel(study, level) {
+  const l = study?.find((s) => s.level === level);
+  if (!l || !(l.answers > 0)) return '';
+  return `sufficient for ${l.sufficient} of ${l.answers} (${Math.round((100 * l.sufficient) / l.answers)} %) in the quality study`;
 }
 
 /** @param {number} v */
@@ -160,15 +191,31 @@ const f = (v) => `${+v.toFixed(1)}`;
 export function renderQualityChart(quality, level, options = {}) {
   const layout = layoutQualityChart(quality, level, options);
   if (!layout) return '';
-  const { width, height, plot, series, marker, xTicks, yTicks } = layout;
+  const { width, height, plot, series, marker, xTicks, yTicks, study } = layout;
   const parts = [
     `<svg xmlns="http://www.w3.org/2000/svg" class="quality-chart" viewBox="0 0 ${width} ${height}" ` +
-      `width="${width}" height="${height}" role="img" aria-label="${describeChart(quality)}" ` +
+      `width="${width}" height="${height}" role="img" aria-label="${describeChart(quality)}${
+        study.length > 0 ? '; bars: share of study participants who found each level sufficient' : ''
+      }" ` +
       `font-family="system-ui, sans-serif" font-size="10">`,
     `<g class="axes" stroke="#4c566a" stroke-width="1">` +
       `<line x1="${plot.left}" y1="${plot.bottom}" x2="${plot.right}" y2="${plot.bottom}"/>` +
       `<line x1="${plot.left}" y1="${plot.top}" x2="${plot.left}" y2="${plot.bottom}"/></g>`,
   ];
+  if (study.length > 0) {
+    // Behind the lines: the share of "sufficient" answers per level.
+    parts.push('<g class="study" fill="#a3be8c" fill-opacity="0.35">');
+    for (const b of study) {
+      parts.push(
+        `<rect data-study-level="${b.level}" data-share="${+b.share.toFixed(3)}" x="${f(b.x - 3)}" y="${f(b.y)}" ` +
+          `width="6" height="${f(plot.bottom - b.y)}"/>`,
+      );
+    }
+    parts.push(
+      `</g><g class="legend"><rect x="${plot.right - 62}" y="2" width="6" height="8" fill="#a3be8c" fill-opacity="0.6"/>` +
+        `<text x="${plot.right - 53}" y="10" fill="#cfd5de">sufficient %</text></g>`,
+    );
+  }
   for (const t of xTicks) {
     parts.push(
       `<text class="x-tick" x="${f(t.x)}" y="${height - 4}" text-anchor="middle" fill="#cfd5de">${t.label}</text>`,

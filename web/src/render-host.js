@@ -21,6 +21,7 @@ import { Renderer } from './renderer.js';
  * @typedef {object} RenderHooks
  * @property {(level: { level: number, vertices: number, normalsMs: number }) => void} onSwap a level is
  *   complete on the GPU (normalsMs: the renderer's time deriving normals so far)
+ * @property {(level: number) => void} onHeld a level above the hold is complete on the GPU, off screen
  * @property {(frame: { level: number | null, colourResolution: AtlasResolution | null, reliefTop: number | null, at: number }) => void} onFrame
  *   a frame was drawn: the level and colour texture in it, the top of its θ scale in degrees
  *   (null: not in the relief view), at (performance.now() of this page)
@@ -39,6 +40,8 @@ import { Renderer } from './renderer.js';
  * @property {number} maxTextureSize
  * @property {(on: boolean) => void} setWireframe
  * @property {(on: boolean) => void} setRelief colour by θ (relief.js) where the level has it
+ * @property {(level: number | null) => void} setHold show levels up to this one only (null: all);
+ *   those above are uploaded and wait off screen (renderer.js `hold`)
  * @property {() => void} requestFrame
  * @property {(mapping: import('./renderer.js').ColourMapping | null) => void} setColourMapping
  * @property {(source: ImageBitmap, resolution: AtlasResolution) => void} setColourAtlas
@@ -64,7 +67,7 @@ export function canTransfer(canvas) {
  * worker reports WebGL2, else on the main thread.
  * @param {HTMLCanvasElement} canvas
  * @param {RenderHooks} hooks
- * @param {{ offscreen: boolean, createWorker: () => Promise<Worker> }} options
+ * @param {{ offscreen: boolean, createWorker: () => Promise<Worker>, background?: [number, number, number] }} options
  * @returns {Promise<RenderHost>}
  */
 export async function openRenderer(canvas, hooks, options) {
@@ -76,11 +79,11 @@ export async function openRenderer(canvas, hooks, options) {
         worker.onerror = () => resolve(false);
       });
       performance.mark(`vitrine:render-worker-${ready ? 'ready' : 'without-webgl2'}`);
-      if (ready) return WorkerRenderer.start(canvas, worker, hooks);
+      if (ready) return WorkerRenderer.start(canvas, worker, hooks, options.background);
       worker.terminate();
     }
   }
-  return new MainRenderer(canvas, hooks);
+  return new MainRenderer(canvas, hooks, options.background);
 }
 
 /** The fallback: the renderer on the page's own canvas. */
@@ -90,11 +93,13 @@ class MainRenderer {
   /**
    * @param {HTMLCanvasElement} canvas
    * @param {RenderHooks} hooks
+   * @param {[number, number, number]} [background]
    */
-  constructor(canvas, hooks) {
+  constructor(canvas, hooks, background) {
     this.hooks = hooks;
     this.renderer = new Renderer(canvas, null, {
       onSwap: (level) => hooks.onSwap({ level: level.level, vertices: level.vertices, normalsMs: this.renderer.normalsMs }),
+      onHeld: (level) => hooks.onHeld(level.level),
       onFrame: () =>
         hooks.onFrame({
           level: this.renderer.current?.source.level ?? null,
@@ -102,7 +107,7 @@ class MainRenderer {
           reliefTop: this.renderer.reliefTop,
           at: performance.now(),
         }),
-    });
+    }, { background });
   }
 
   get camera() {
@@ -162,6 +167,11 @@ class MainRenderer {
   /** @param {boolean} on */
   setRelief(on) {
     this.renderer.setRelief(on);
+  }
+
+  /** @param {number | null} level */
+  setHold(level) {
+    this.renderer.setHold(level);
   }
 
   requestFrame() {
@@ -234,9 +244,10 @@ class WorkerRenderer {
    * @param {HTMLCanvasElement} canvas
    * @param {Worker} worker
    * @param {RenderHooks} hooks
+   * @param {[number, number, number]} [background]
    * @returns {Promise<RenderHost>}
    */
-  static start(canvas, worker, hooks) {
+  static start(canvas, worker, hooks, background) {
     const host = new WorkerRenderer(canvas, worker, hooks);
     const { width, height } = canvas;
     const offscreen = canvas.transferControlToOffscreen();
@@ -256,7 +267,7 @@ class WorkerRenderer {
         }
       };
       worker.onerror = (event) => reject(new Error(`the render worker failed: ${event.message}`));
-      worker.postMessage({ type: 'canvas', canvas: offscreen, width, height }, [offscreen]);
+      worker.postMessage({ type: 'canvas', canvas: offscreen, width, height, background }, [offscreen]);
     });
   }
 
@@ -297,6 +308,9 @@ class WorkerRenderer {
       case 'swap':
         this.hooks.onSwap(message);
         break;
+      case 'held':
+        this.hooks.onHeld(message.level);
+        break;
       case 'frame':
         this.colourResolution = message.colourResolution;
         this.hooks.onFrame({
@@ -331,6 +345,11 @@ class WorkerRenderer {
   /** @param {boolean} on */
   setRelief(on) {
     this.worker.postMessage({ type: 'relief', on });
+  }
+
+  /** @param {number | null} level */
+  setHold(level) {
+    this.worker.postMessage({ type: 'hold', level });
   }
 
   /** The camera may have moved: the worker draws with the page's camera state. */

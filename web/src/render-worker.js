@@ -22,12 +22,13 @@ import { Renderer } from './renderer.js';
 
 /**
  * Commands from the page.
- * @typedef {{ type: 'canvas', canvas: OffscreenCanvas, width: number, height: number }
+ * @typedef {{ type: 'canvas', canvas: OffscreenCanvas, width: number, height: number, background?: [number, number, number] }
  *   | { type: 'source', port: MessagePort }
  *   | { type: 'size', width: number, height: number }
  *   | { type: 'camera', state: import('./camera.js').OrbitState | null }
  *   | { type: 'wireframe', on: boolean }
  *   | { type: 'relief', on: boolean }
+ *   | { type: 'hold', level: number | null }
  *   | { type: 'colourMapping', mapping: import('./renderer.js').ColourMapping | null }
  *   | { type: 'colourAtlas', source: ImageBitmap, resolution: import('./renderer.js').AtlasResolution }
  *   | { type: 'capture', id: number } | { type: 'finish', id: number }
@@ -40,6 +41,7 @@ import { Renderer } from './renderer.js';
  *   | { type: 'started', maxTextureSize: number }
  *   | { type: 'failed', message: string }
  *   | { type: 'swap', level: number, vertices: number, normalsMs: number }
+ *   | { type: 'held', level: number }
  *   | { type: 'frame', level: number | null, colourResolution: import('./renderer.js').AtlasResolution | null,
  *       reliefTop: number | null, at: number }
  *   | { type: 'status', lost: boolean, settled: boolean, edges: boolean, frames: number }
@@ -112,8 +114,11 @@ function fromDecoder(message) {
   sendStatus();
 }
 
-/** @param {OffscreenCanvas} canvas @param {number} width @param {number} height */
-function start(canvas, width, height) {
+/**
+ * @param {OffscreenCanvas} canvas @param {number} width @param {number} height
+ * @param {[number, number, number] | undefined} background
+ */
+function start(canvas, width, height, background) {
   canvas.width = width;
   canvas.height = height;
   try {
@@ -122,6 +127,7 @@ function start(canvas, width, height) {
       null,
       {
         onSwap: (level) => report({ type: 'swap', level: level.level, vertices: level.vertices, normalsMs: renderer?.normalsMs ?? 0 }),
+        onHeld: (level) => report({ type: 'held', level: level.level }),
         onFrame: () => {
           // The page wants each level's, colour texture's and relief
           // scale's first frame, not every frame of an orbit: one small
@@ -136,7 +142,7 @@ function start(canvas, width, height) {
         },
         onTick: sendStatus,
       },
-      WORKER_UPLOAD,
+      { ...WORKER_UPLOAD, background },
     );
   } catch (error) {
     report({ type: 'failed', message: error instanceof Error ? error.message : String(error) });
@@ -152,7 +158,7 @@ scope.onmessage = (event) => {
   const command = event.data;
   switch (command.type) {
     case 'canvas':
-      start(command.canvas, command.width, command.height);
+      start(command.canvas, command.width, command.height, command.background);
       break;
     case 'source':
       // A new decode worker (a retry): the old one's port is closed, so nothing late arrives from it.
@@ -178,6 +184,9 @@ scope.onmessage = (event) => {
       break;
     case 'relief':
       renderer?.setRelief(command.on);
+      break;
+    case 'hold':
+      renderer?.setHold(command.level);
       break;
     case 'colourMapping':
       renderer?.setColourMapping(command.mapping);

@@ -63,6 +63,7 @@ const cancelFrame = typeof cancelAnimationFrame === 'function' ? (id) => cancelA
  * @typedef {object} RendererOptions
  * @property {number} [uploadBudgetMs] bufferSubData per frame (default 6 ms)
  * @property {number} [uploadChunkBytes] bytes per bufferSubData (default 256 KB)
+ * @property {[number, number, number]} [background] clear colour, 0–1 components (default shading.js BACKGROUND)
  */
 
 /** @typedef {HTMLCanvasElement | OffscreenCanvas} AnyCanvas */
@@ -98,6 +99,16 @@ export class Renderer {
   frames = 0;
   /** Milliseconds spent deriving normals of levels that came without them. */
   normalsMs = 0;
+  /**
+   * The highest level put on screen (null: every level, as it completes).
+   * A level above it is still uploaded, then waits complete as `pending`
+   * (reported by onHeld) until the hold rises to it: the quality study
+   * decodes m_b while m_a stays on screen, and swaps when it chooses.
+   * @type {number | null}
+   */
+  hold = null;
+  /** The pending level is complete on the GPU and held back. */
+  #parked = false;
   /** @type {number | null} */
   #raf = null;
   #dirty = false;
@@ -124,8 +135,10 @@ export class Renderer {
   /**
    * @param {AnyCanvas} canvas
    * @param {import('./camera.js').OrbitCamera | null} camera
-   * @param {{ onSwap?: (level: LevelMessage) => void, onFrame?: () => void, onTick?: () => void }} hooks
+   * @param {{ onSwap?: (level: LevelMessage) => void, onHeld?: (level: LevelMessage) => void, onFrame?: () => void,
+   *   onTick?: () => void }} hooks
    *   onSwap: a level is complete on the GPU and replaces the previous one;
+   *   onHeld: a level above the hold is complete on the GPU and waits off screen;
    *   onFrame: a frame was drawn; onTick: after every animation frame's work
    * @param {RendererOptions} [options]
    */
@@ -135,6 +148,7 @@ export class Renderer {
     this.hooks = hooks;
     this.uploadBudgetMs = options.uploadBudgetMs ?? UPLOAD_BUDGET_MS;
     this.uploadChunkBytes = options.uploadChunkBytes ?? UPLOAD_CHUNK_BYTES;
+    this.background = options.background ?? BACKGROUND;
     const gl = /** @type {WebGL2RenderingContext | null} */ (
       canvas.getContext('webgl2', { antialias: true, powerPreference: 'high-performance' })
     );
@@ -177,7 +191,7 @@ export class Renderer {
     this.#program = program;
     this.#uniforms = uniforms;
     gl.enable(gl.DEPTH_TEST);
-    gl.clearColor(BACKGROUND[0], BACKGROUND[1], BACKGROUND[2], 1);
+    gl.clearColor(this.background[0], this.background[1], this.background[2], 1);
   }
 
   #restore() {
@@ -188,10 +202,14 @@ export class Renderer {
     this.#store.lose();
     this.#init();
     this.#uploadColour();
-    const newest = this.#next ?? this.pending?.source ?? this.current?.source;
+    const shown = this.current?.source;
+    const newest = this.#next ?? this.pending?.source ?? shown;
     this.#next = null;
     this.current = null;
     this.pending = null;
+    this.#parked = false;
+    // A held level goes back behind the one that was on screen.
+    if (shown && newest && newest !== shown && this.#holds(newest.level)) this.show(shown);
     if (newest) this.show(newest);
     this.requestFrame();
   }
@@ -215,7 +233,22 @@ export class Renderer {
     }
     if (this.pending) this.#release(this.pending);
     this.pending = this.#allocate(level);
+    this.#parked = false;
     this.#schedule();
+  }
+
+  /**
+   * Shows levels up to `level` only (null: all); raising it swaps in a held level.
+   * @param {number | null} level
+   */
+  setHold(level) {
+    this.hold = level;
+    if (this.#parked && this.pending && !this.#holds(this.pending.source.level)) this.#schedule();
+  }
+
+  /** @param {number} level */
+  #holds(level) {
+    return this.hold !== null && level > this.hold;
   }
 
   /**
@@ -353,17 +386,16 @@ export class Renderer {
     const pending = this.pending;
     const start = performance.now();
     const inBudget = () => performance.now() - start < this.uploadBudgetMs;
-    if (pending && caughtUp) {
+    if (pending && this.#parked) {
+      if (!this.#holds(pending.source.level)) this.#swap(pending);
+    } else if (pending && caughtUp) {
       issued = true;
       if (this.#upload(pending, pending.source.vertices, inBudget)) {
-        if (this.current) this.#release(this.current);
-        this.current = pending;
-        this.pending = null;
-        this.#dirty = true;
-        this.hooks.onSwap?.(pending.source);
-        if (this.#next) {
-          this.pending = this.#allocate(this.#next);
-          this.#next = null;
+        if (!this.#holds(pending.source.level)) {
+          this.#swap(pending);
+        } else {
+          this.#parked = true;
+          this.hooks.onHeld?.(pending.source);
         }
       }
     } else if (this.current?.uploads.length && caughtUp) {
@@ -382,8 +414,22 @@ export class Renderer {
       this.#fence = gl.fenceSync(gl.SYNC_GPU_COMMANDS_COMPLETE, 0);
       gl.flush();
     }
-    if (this.pending || this.current?.uploads.length) this.#schedule();
+    if ((this.pending && !this.#parked) || this.current?.uploads.length) this.#schedule();
     this.hooks.onTick?.();
+  }
+
+  /** @param {GpuMesh} pending complete on the GPU: it replaces the level on screen */
+  #swap(pending) {
+    if (this.current) this.#release(this.current);
+    this.current = pending;
+    this.pending = null;
+    this.#parked = false;
+    this.#dirty = true;
+    this.hooks.onSwap?.(pending.source);
+    if (this.#next) {
+      this.pending = this.#allocate(this.#next);
+      this.#next = null;
+    }
   }
 
   /**

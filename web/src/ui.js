@@ -7,7 +7,7 @@
  * and the relief view's legend.
  */
 
-import { describeLevel, renderQualityChart } from './quality-chart.js';
+import { describeLevel, describeStudyLevel, renderQualityChart } from './quality-chart.js';
 import { SCALE_PERCENTILE, formatDegrees, rampGradient, reliefTicks } from './relief.js';
 
 /** Device pixels per CSS pixel, capped: beyond 2 a tablet pays 2.25× the fill for little gain. */
@@ -65,6 +65,7 @@ button[aria-pressed="true"] { background: #5e81ac; border-color: #81a1c1; }
 :host([chrome="minimal"]) .panel p { display: none; }
 :host([chrome="minimal"]) .quality { display: none; }
 :host([chrome="minimal"]) button.optional { display: none; }
+:host([chrome="none"]) :is(.panel, .tools, .status, .bar) { display: none !important; }
 `;
 
 export class ViewerUi {
@@ -78,6 +79,8 @@ export class ViewerUi {
   /** Level the chart's marker was drawn at (`null`: redraw). @type {number | null} */
   #chartLevel = null;
   #shownLevel = -1;
+  /** The quality study's answers per level, when the model has one. @type {ReadonlyArray<import('./quality-chart.js').StudyLevel> | null} */
+  #study = null;
 
   /**
    * @param {HTMLElement} host
@@ -190,17 +193,27 @@ export class ViewerUi {
     this.#drawQuality(this.#shownLevel);
   }
 
+  /**
+   * The quality study's share of "sufficient" per level (null: no study).
+   * @param {ReadonlyArray<import('./quality-chart.js').StudyLevel> | null} levels
+   */
+  setStudy(levels) {
+    this.#study = levels && levels.length > 0 ? levels : null;
+    this.#chartLevel = null;
+    this.#drawQuality(this.#shownLevel);
+  }
+
   /** @param {number} level on screen; the chart is redrawn only when it changes */
   #drawQuality(level) {
     this.#shownLevel = level;
     if (this.#chartLevel === level) return;
     this.#chartLevel = level;
-    const svg = this.#curve ? renderQualityChart(this.#curve, level) : '';
+    const svg = this.#curve ? renderQualityChart(this.#curve, level, { study: this.#study }) : '';
     this.quality.hidden = svg === '';
     /** @type {HTMLElement} */ (this.quality.querySelector('.chart')).innerHTML = svg;
-    /** @type {HTMLElement} */ (this.quality.querySelector('p')).textContent = this.#curve
-      ? describeLevel(this.#curve, level)
-      : '';
+    const line = this.#curve ? describeLevel(this.#curve, level) : '';
+    const study = line ? describeStudyLevel(this.#study, level) : '';
+    /** @type {HTMLElement} */ (this.quality.querySelector('p')).textContent = study ? `${line} · ${study}` : line;
   }
 
   /**

@@ -22,6 +22,9 @@ import { retryAfterSeconds, waitToRetry } from './retry.js';
  * @property {string} renderWorkerUrl absolute URL of the bundled render worker
  * @property {boolean} offscreen draw in the render worker when the browser can
  *   (false: always on the main thread)
+ * @property {number | null} [hold] show and decode up to this level only, until
+ *   {@link Viewer#prefetch} and {@link Viewer#display} say otherwise (the quality study)
+ * @property {[number, number, number]} [background] the canvas's clear colour (0–1 components)
  */
 
 /**
@@ -51,6 +54,7 @@ import { retryAfterSeconds, waitToRetry } from './retry.js';
  * @property {'loading' | 'refining' | 'complete' | 'capped' | 'error'} status
  * @property {number} shownLevel level on screen (-1: none yet)
  * @property {number} decodedLevel newest level the worker sent
+ * @property {number} readyLevel newest level complete on the GPU (on screen or held off it)
  * @property {number} targetLevel level the viewer is heading for (cap or `level` option)
  * @property {number} lastLevel
  * @property {number} vertices of the level on screen
@@ -109,6 +113,7 @@ export class Viewer {
     status: 'loading',
     shownLevel: -1,
     decodedLevel: -1,
+    readyLevel: -1,
     targetLevel: 0,
     lastLevel: 0,
     vertices: 0,
@@ -157,6 +162,17 @@ export class Viewer {
     url: (path) => this.#apiUrl(path),
     set: (patch) => this.#set(patch),
   });
+  /** Highest level decoded (null: up to the cap), and highest put on screen (null: each as it comes). */
+  /** @type {number | null} */
+  #decodeTo = null;
+  /** @type {number | null} */
+  #hold = null;
+  /** @type {Array<{ level: number, resolve: () => void }>} */
+  #readyWaiters = [];
+  /** @type {Array<{ level: number, resolve: (at: number) => void }>} */
+  #shownWaiters = [];
+  /** The turntable's animation frame, while it turns. @type {number | null} */
+  #turning = null;
   /** The cap in force: from the manifest, or from a batch the server refused. */
   #cap = { level: 0, reason: /** @type {string | null} */ (null), retryAfterS: /** @type {number | null} */ (null) };
 
@@ -167,12 +183,15 @@ export class Viewer {
   constructor(ui, options) {
     this.ui = ui;
     this.options = options;
+    this.#decodeTo = options.hold ?? null;
+    this.#hold = options.hold ?? null;
     this.controls = new OrbitControls(ui.canvas, {
       camera: () => this.camera,
       changed: () => this.renderer?.requestFrame(),
       reset: () => this.resetView(),
       toggleWireframe: () => this.setWireframe(!this.#wireframe),
       toggleFullscreen: () => ui.toggleFullscreen(),
+      interacted: (kind) => this.#emit('vitrine-interaction', { kind }),
     });
     ui.onReset = () => this.resetView();
     ui.onWireframe = () => this.setWireframe(!this.#wireframe);
@@ -216,6 +235,7 @@ export class Viewer {
       if (renderer.thread === 'main') worker.postMessage({ type: 'normals', which: 'always' });
       // Switched on before the renderer was ready.
       if (this.#relief) renderer.setRelief(true);
+      if (this.#hold !== null) renderer.setHold(this.#hold);
       renderer.attach(levels);
     } catch (error) {
       if (attempt === this.#attempt) this.#fail(error instanceof Error ? error.message : String(error));
@@ -233,6 +253,114 @@ export class Viewer {
   resetView() {
     this.camera?.reset();
     this.renderer?.requestFrame();
+  }
+
+  /**
+   * Decodes up to `level` (within the cap) without showing more than the
+   * hold allows: the quality study's m_b, made ready while m_a is on screen.
+   * @param {number} level
+   */
+  prefetch(level) {
+    this.#decodeTo = Math.max(this.#decodeTo ?? level, level);
+    if (!this.manifest) return;
+    const target = this.#target(this.#cap.level);
+    if (target <= this.state.targetLevel) return;
+    this.#set({ targetLevel: target, status: 'refining' });
+    this.#worker?.postMessage({ type: 'extend', upTo: target });
+  }
+
+  /**
+   * Shows levels up to `level` only (null: each as it arrives, the
+   * default); a level above it is decoded (see prefetch) and waits on the
+   * GPU until the hold rises to it, then swaps in at the next frame.
+   * @param {number | null} level
+   */
+  display(level) {
+    this.#hold = level;
+    if (level !== null) this.prefetch(level);
+    this.renderer?.setHold(level);
+  }
+
+  /**
+   * Resolves once `level` (or a later one) is complete on the GPU, on
+   * screen or held off it.
+   * @param {number} level
+   * @returns {Promise<void>}
+   */
+  whenReady(level) {
+    if (this.state.readyLevel >= level) return Promise.resolve();
+    return new Promise((resolve) => this.#readyWaiters.push({ level, resolve }));
+  }
+
+  /**
+   * Resolves with performance.now() of the first frame that drew `level` (or a later one).
+   * @param {number} level
+   * @returns {Promise<number>}
+   */
+  whenShown(level) {
+    const drawn = Object.keys(this.state.shownAtMs).map(Number).filter((l) => l >= level);
+    if (drawn.length > 0) return Promise.resolve(this.state.shownAtMs[Math.min(...drawn)]);
+    return new Promise((resolve) => this.#shownWaiters.push({ level, resolve }));
+  }
+
+  /**
+   * Locks or unlocks the visitor's control of the camera (pointer, wheel and
+   * keys on the canvas are ignored while locked).
+   * @param {boolean} on
+   */
+  setLocked(on) {
+    this.controls.locked = on;
+  }
+
+  /**
+   * The turntable: from the home view, the camera orbits once about the
+   * vertical axis in `periodMs`, with the visitor's controls locked; resolves
+   * when the turn is complete (or stopTurntable()).
+   * @param {number} [periodMs]
+   * @returns {Promise<void>}
+   */
+  turntable(periodMs = 12_000) {
+    this.stopTurntable();
+    const wasLocked = this.controls.locked;
+    this.setLocked(true);
+    return new Promise((resolve) => {
+      /** @type {number | null} */
+      let start = null;
+      let yaw = 0;
+      this.#endTurn = () => {
+        this.#endTurn = null;
+        if (this.#turning !== null) cancelAnimationFrame(this.#turning);
+        this.#turning = null;
+        this.setLocked(wasLocked);
+        resolve();
+      };
+      const frame = (/** @type {number} */ now) => {
+        const camera = this.camera;
+        if (camera && start === null && this.state.shownLevel >= 0) {
+          camera.reset();
+          start = now;
+          yaw = camera.state.yaw;
+        }
+        if (camera && start !== null) {
+          const t = Math.min(1, (now - start) / periodMs);
+          camera.state.yaw = yaw + 2 * Math.PI * t;
+          this.renderer?.requestFrame();
+          if (t >= 1) {
+            this.#endTurn?.();
+            return;
+          }
+        }
+        this.#turning = requestAnimationFrame(frame);
+      };
+      this.#turning = requestAnimationFrame(frame);
+    });
+  }
+
+  /** @type {(() => void) | null} */
+  #endTurn = null;
+
+  stopTurntable() {
+    this.#endTurn?.();
   }
 
   /** @param {boolean} on */
@@ -309,10 +437,15 @@ export class Viewer {
       this.ui.canvas,
       {
         onSwap: (level) => this.#shown(level),
+        onHeld: (level) => this.#ready(level),
         onFrame: (frame) => this.#framed(frame),
         camera: (bounds) => (this.camera ??= new OrbitCamera(bounds)),
       },
-      { offscreen: this.options.offscreen, createWorker: () => this.#createWorker(this.options.renderWorkerUrl) },
+      {
+        offscreen: this.options.offscreen,
+        createWorker: () => this.#createWorker(this.options.renderWorkerUrl),
+        background: this.options.background,
+      },
     ).then(
       (renderer) => (this.renderer = renderer),
       (error) => {
@@ -325,7 +458,25 @@ export class Viewer {
 
   /** @param {number} cap */
   #target(cap) {
-    return this.options.level === null ? cap : Math.min(cap, this.options.level);
+    const limit = this.options.level ?? this.#decodeTo;
+    return limit === null ? cap : Math.min(cap, limit);
+  }
+
+  /** @param {number} level complete on the GPU (held off screen, or swapped in) */
+  #ready(level) {
+    if (level <= this.state.readyLevel) return;
+    this.#set({ readyLevel: level });
+    const due = this.#readyWaiters.filter((w) => w.level <= level);
+    this.#readyWaiters = this.#readyWaiters.filter((w) => w.level > level);
+    for (const w of due) w.resolve();
+  }
+
+  /**
+   * @param {string} type
+   * @param {object} detail
+   */
+  #emit(type, detail) {
+    this.ui.root.dispatchEvent(new CustomEvent(type, { detail, bubbles: true, composed: true }));
   }
 
   /** @param {import('./reconstruction.js').PageMessage} message */
@@ -367,6 +518,7 @@ export class Viewer {
   /** @param {{ level: number, vertices: number, normalsMs: number }} level */
   #shown(level) {
     this.#set({ shownLevel: level.level, vertices: level.vertices, normalsMs: level.normalsMs });
+    this.#ready(level.level);
     if (level.level < this.state.targetLevel || this.state.status !== 'refining') return;
     const last = /** @type {Manifest} */ (this.manifest).last_level;
     if (this.#cap.level < Math.min(last, this.options.level ?? last)) this.#announceCap();
@@ -387,6 +539,9 @@ export class Viewer {
     // Visible in DevTools and traces; the benchmark reads them.
     performance.mark(`vitrine:level-${level}`);
     this.state.shownAtMs[level] = now;
+    const due = this.#shownWaiters.filter((w) => w.level <= level);
+    this.#shownWaiters = this.#shownWaiters.filter((w) => w.level > level);
+    for (const w of due) w.resolve(now);
     const first = this.state.firstFrameMs === null;
     this.state.firstFrameMs ??= now;
     // The colour textures wait for the first frame of the base mesh.

@@ -136,3 +136,27 @@ test('axes: the ends and powers of ten of the vertex counts; whole decades of er
   assert.equal(ys[3], layout.plot.top);
   assert.equal(describeLevel(curve, 3), 'Level 3: image RMSE 12.2 · colour RMSE 15.9 · Hausdorff 0.80 % of the diagonal');
 });
+
+test('a quality study adds a bar per level with answers: the share of "sufficient"', async () => {
+  const { describeStudyLevel } = await import('../src/quality-chart.js');
+  const study = [
+    { level: 1, answers: 4, sufficient: 0 },
+    { level: 3, answers: 4, sufficient: 2 },
+    { level: 5, answers: 4, sufficient: 4 },
+    { level: 9, answers: 4, sufficient: 4 },
+  ];
+  const layout = layoutQualityChart(curve, 3, { study });
+  assert.ok(layout);
+  assert.deepEqual(layout.study.map((b) => [b.level, b.share]), [[1, 0], [3, 0.5], [5, 1]], 'levels off the curve are left out');
+  const full = layout.study[2];
+  assert.equal(full.y, layout.plot.top, '100 % reaches the top of the plot');
+  assert.equal(layout.study[0].y, layout.plot.bottom);
+  const svg = renderQualityChart(curve, 3, { study });
+  assert.equal((svg.match(/data-study-level=/g) ?? []).length, 3);
+  assert.match(svg, /data-study-level="3" data-share="0.5"/);
+  assert.match(svg, /sufficient %/);
+  assert.equal(renderQualityChart(curve, 3).includes('data-study-level'), false, 'no study, no bars');
+  assert.equal(describeStudyLevel(study, 3), 'sufficient for 2 of 4 (50 %) in the quality study');
+  assert.equal(describeStudyLevel(study, 2), '');
+  assert.equal(describeStudyLevel(null, 3), '');
+});

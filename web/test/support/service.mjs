@@ -27,7 +27,7 @@ export const webDist = join(root, 'web', 'dist');
 
 /**
  * @param {{ models: ModelSpec[], serveArgs?: string[] }} options
- * @returns {Promise<{ url: string, dir: string, stop: () => Promise<void> }>}
+ * @returns {Promise<{ url: string, dir: string, db: string, stop: () => Promise<void> }>}
  */
 export async function startService({ models, serveArgs = [] }) {
   if (!existsSync(vitrine)) throw new Error(`build the CLI first: cargo build --release -p vitrine (${vitrine})`);
@@ -73,5 +73,35 @@ export async function startService({ models, serveArgs = [] }) {
     }
     rmSync(dir, { recursive: true, force: true });
   };
-  return { url, dir, stop };
+  return { url, dir, db, stop };
+}
+
+/**
+ * A quality study of an ingested model (`vitrine study create`) and its
+ * invitation links (`vitrine study invite`, one per line).
+ * @param {{ url: string, db: string }} service
+ * @param {{ slug: string, seconds?: number, from?: number, to?: number, count?: number }} study
+ * @returns {string[]} the links
+ */
+export function createStudy(service, { slug, seconds = 0.4, from, to, count = 1 }) {
+  const create = ['study', 'create', '--db', service.db, '--slug', slug, '--seconds', String(seconds)];
+  if (from !== undefined) create.push('--from', String(from));
+  if (to !== undefined) create.push('--to', String(to));
+  execFileSync(vitrine, create, { stdio: 'pipe' });
+  return inviteToStudy(service, { slug, count });
+}
+
+/**
+ * More invitation links to an open study.
+ * @param {{ url: string, db: string }} service
+ * @param {{ slug: string, count?: number }} study
+ * @returns {string[]}
+ */
+export function inviteToStudy(service, { slug, count = 1 }) {
+  const invite = ['study', 'invite', '--db', service.db, '--slug', slug, '--count', String(count), '--base-url', service.url];
+  const out = execFileSync(vitrine, invite, { stdio: ['ignore', 'pipe', 'pipe'], encoding: 'utf8' });
+  return out
+    .split('\n')
+    .map((line) => line.trim())
+    .filter((line) => /^https?:\/\//.test(line));
 }
