@@ -29,6 +29,7 @@ pub mod ingest;
 pub mod service;
 mod source;
 pub mod storage;
+pub mod study;
 
 pub use commands::ingest::{run as run_ingest, IngestArgs};
 pub use commands::models::models_table;

@@ -13,6 +13,7 @@ pub mod models;
 pub mod sample;
 pub mod serve;
 pub mod simplify;
+pub mod study;
 pub mod token;
 
 #[cfg(feature = "dev-tools")]
@@ -45,6 +46,8 @@ pub enum Command {
     Sample(sample::SampleArgs),
     /// Simplify a mesh to a vertex count and write PLY, OBJ or GLB, with a report.
     Simplify(simplify::SimplifyArgs),
+    /// The quality study: invitations, answers, and the level cap they set.
+    Study(study::StudyArgs),
 }
 
 impl Command {
@@ -59,6 +62,7 @@ impl Command {
             Command::Inspect(args) => inspect::run(args),
             Command::Sample(args) => sample::run(args),
             Command::Simplify(args) => simplify::run(args),
+            Command::Study(args) => block_on(study::run(args)),
         }
     }
 }

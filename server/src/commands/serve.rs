@@ -99,7 +99,7 @@ pub struct ServeArgs {
     /// Requests handled at once; more are shed with 503.
     #[arg(long, env = "VITRINE_MAX_CONCURRENCY", default_value_t = 1024)]
     pub max_concurrency: usize,
-    #[arg(long, env = "VITRINE_MAX_BODY_BYTES", default_value_t = 16 * 1024)]
+    #[arg(long, env = "VITRINE_MAX_BODY_BYTES", default_value_t = 64 * 1024)]
     pub max_body_bytes: usize,
     #[arg(long, env = "VITRINE_MAX_HEADER_BYTES", default_value_t = 16 * 1024)]
     pub max_header_bytes: usize,

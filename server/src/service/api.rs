@@ -45,8 +45,7 @@ pub async fn visible_models(
     // visitor could open them (the start-up log names them).
     for m in all.iter().filter(|m| m.servable()) {
         // Tokens are checked only when a restricted model is in the list.
-        if m.public_access || state.visitor(hints, &m.slug).await?.audience == Audience::Researcher
-        {
+        if m.public_access || state.visitor(hints, &m.slug).await?.audience != Audience::Public {
             visible.push(m.clone());
         }
     }

@@ -15,6 +15,10 @@ use utoipa::ToSchema;
 pub enum Audience {
     Public,
     Researcher,
+    /// A participant of the model version's quality study, by invitation:
+    /// every level, whatever the policy, device or load (a study must show
+    /// m_n, and its sessions are few).
+    Study,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, ToSchema)]
@@ -121,6 +125,7 @@ pub fn audience_cap(record: &ModelRecord, audience: Audience) -> u32 {
     let last = record.batch_count();
     let policy = &record.policy;
     match audience {
+        Audience::Study => last,
         Audience::Researcher if policy.token_full_resolution => last,
         Audience::Researcher => last.saturating_sub(1),
         Audience::Public => {
@@ -161,8 +166,14 @@ pub fn level_cap(
     rules: &CapRules,
 ) -> LevelCap {
     let a = audience_cap(record, audience);
-    let d = device_cap(record, device, rules);
-    let l = load_cap(record, pressure, rules);
+    let (d, l) = if audience == Audience::Study {
+        (a, a)
+    } else {
+        (
+            device_cap(record, device, rules),
+            load_cap(record, pressure, rules),
+        )
+    };
     let level = a.min(d).min(l);
     // A lasting reason first: the viewer should not retry what load relief
     // would not change.

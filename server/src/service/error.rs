@@ -47,6 +47,19 @@ pub enum AppError {
          ingest it again (vitrine ingest) to show it"
     )]
     StaleFormat { slug: String, stored: u8, reads: u8 },
+    /// No study is open to this visitor: none runs, or the invitation is
+    /// missing, unknown or expired.
+    #[error("{0}")]
+    StudyClosed(String),
+    /// The request contradicts what is stored (an answer given differently).
+    #[error("{0}")]
+    Conflict(String),
+    /// Well-formed, but not acceptable (a value out of range, too early).
+    #[error("{0}")]
+    Unprocessable(String),
+    /// This session has used its requests.
+    #[error("{0}")]
+    TooManyRequests(String),
     #[error("internal error: {0}")]
     Internal(String),
 }
@@ -84,6 +97,10 @@ impl AppError {
             AppError::Timeout => StatusCode::GATEWAY_TIMEOUT,
             // The stored state conflicts with this build; nothing a client can retry.
             AppError::StaleFormat { .. } => StatusCode::CONFLICT,
+            AppError::StudyClosed(_) => StatusCode::FORBIDDEN,
+            AppError::Conflict(_) => StatusCode::CONFLICT,
+            AppError::Unprocessable(_) => StatusCode::UNPROCESSABLE_ENTITY,
+            AppError::TooManyRequests(_) => StatusCode::TOO_MANY_REQUESTS,
         }
     }
 
@@ -100,6 +117,10 @@ impl AppError {
             AppError::Busy { .. } => ErrorCode::Busy,
             AppError::Timeout => ErrorCode::Timeout,
             AppError::StaleFormat { .. } => ErrorCode::StaleFormat,
+            AppError::StudyClosed(_) => ErrorCode::StudyClosed,
+            AppError::Conflict(_) => ErrorCode::Conflict,
+            AppError::Unprocessable(_) => ErrorCode::Unprocessable,
+            AppError::TooManyRequests(_) => ErrorCode::TooManyRequests,
         }
     }
 
@@ -157,6 +178,10 @@ pub enum ErrorCode {
     Overloaded,
     Busy,
     StaleFormat,
+    StudyClosed,
+    Conflict,
+    Unprocessable,
+    TooManyRequests,
     Timeout,
     Internal,
 }

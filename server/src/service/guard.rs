@@ -97,7 +97,7 @@ pub fn describe_refusals(description: &mut OpenApi) {
     let refusals = [
         (
             "413",
-            "Request body too large: no route takes one (`payload_too_large`)",
+            "Request body over the limit (`payload_too_large`)",
             false,
         ),
         (
@@ -117,7 +117,10 @@ pub fn describe_refusals(description: &mut OpenApi) {
         ),
     ];
     for item in description.paths.paths.values_mut() {
-        for operation in [&mut item.get, &mut item.head].into_iter().flatten() {
+        for operation in [&mut item.get, &mut item.head, &mut item.post, &mut item.put]
+            .into_iter()
+            .flatten()
+        {
             for (status, text, retry_after) in refusals {
                 let mut response = ResponseBuilder::new().description(text).content(
                     "application/json",

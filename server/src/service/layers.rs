@@ -34,7 +34,8 @@ impl Default for RequestLimits {
         RequestLimits {
             timeout: Duration::from_secs(10),
             max_concurrency: 1024,
-            max_body_bytes: 16 * 1024,
+            // The study's view batches are the largest bodies (200 events).
+            max_body_bytes: 64 * 1024,
             shed_retry_after: Duration::from_secs(2),
         }
     }

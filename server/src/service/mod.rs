@@ -19,6 +19,7 @@ mod ops;
 mod payload;
 mod routes;
 mod servable;
+mod study;
 mod visitor;
 mod web;
 
@@ -76,6 +77,8 @@ pub struct Visitor {
     pub device: DeviceClass,
     pub device_explicit: bool,
     pub grant: Option<TokenGrant>,
+    /// The model version whose study invited this visitor.
+    pub study_model: Option<i64>,
 }
 
 /// Shared by every request.
@@ -176,6 +179,25 @@ impl AppState {
 
     /// Checks the token, if any, and decides the audience for model `slug`.
     pub async fn visitor(&self, hints: &VisitorHints, slug: &str) -> Result<Visitor, AppError> {
+        if let Some(token) = hints
+            .token
+            .as_deref()
+            .filter(|t| crate::study::is_invitation(t))
+        {
+            let invitation = study::live_invitation(self, token).await?;
+            let invited = invitation.study.slug == slug;
+            return Ok(Visitor {
+                audience: if invited {
+                    Audience::Study
+                } else {
+                    Audience::Public
+                },
+                device: hints.device,
+                device_explicit: hints.device_explicit,
+                grant: None,
+                study_model: invited.then_some(invitation.study.model_id),
+            });
+        }
         let grant = match &hints.token {
             None => None,
             Some(token) => {
@@ -203,6 +225,7 @@ impl AppState {
             device: hints.device,
             device_explicit: hints.device_explicit,
             grant,
+            study_model: None,
         })
     }
 

@@ -269,7 +269,7 @@ pub async fn texture(
     };
     let entry = entry.ok_or(AppError::NotFound("texture"))?;
     let visitor = state.visitor(&hints, &entry.model_slug).await?;
-    if !entry.public_access && visitor.audience != Audience::Researcher {
+    if !entry.public_access && visitor.audience == Audience::Public {
         return Err(AppError::NotFound("texture"));
     }
     let etag = etag(&entry.sha256);

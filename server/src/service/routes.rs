@@ -4,7 +4,7 @@
 
 use super::error::AppError;
 use super::web::{self, Viewer};
-use super::{api, guard, ops, payload, AppState, ServiceConfig};
+use super::{api, guard, ops, payload, study, AppState, ServiceConfig};
 use axum::http::{header, HeaderValue};
 use axum::response::{IntoResponse, Response};
 use axum::routing::any;
@@ -30,7 +30,7 @@ use utoipa_axum::routes;
             the model's good-enough level as server load rises, rises again when it falls). A \
             batch above the cap is refused with 403 (reason `audience` or `device`) or 429 with \
             `Retry-After` (reason `load`).\n\nEvery route may also answer 413 \
-            (`payload_too_large`: no route takes a body), 431 (request headers over the limit), \
+            (`payload_too_large`: a body over 64 KiB; only the study's routes take one), 431 (request headers over the limit), \
             500 (`internal`), 503 (`overloaded`: the concurrency limit is full; `Retry-After`) \
             and 504 (`timeout`). Any other path under `/api/` answers 404 (`not_found`)."
     ),
@@ -77,6 +77,12 @@ fn list(viewer: Option<&Viewer>) -> OpenApiRouter<AppState> {
         .routes(routes!(payload::base))
         .routes(routes!(payload::batch))
         .routes(routes!(payload::texture))
+        .routes(routes!(study::info))
+        .routes(routes!(study::start, study::plan))
+        .routes(routes!(study::answer))
+        .routes(routes!(study::views))
+        .routes(routes!(study::finish))
+        .routes(routes!(study::results))
         // Never the viewer's files. Not described: OpenAPI has no template
         // for "any path below".
         .route(
@@ -94,6 +100,10 @@ fn list(viewer: Option<&Viewer>) -> OpenApiRouter<AppState> {
         ))
         .routes(web::or_viewer(
             routes!(web::embed_page),
+            viewer.map(Viewer::index),
+        ))
+        .routes(web::or_viewer(
+            routes!(web::study_page),
             viewer.map(Viewer::index),
         ))
 }

@@ -75,8 +75,14 @@ impl ServableModel {
         record: Arc<ModelRecord>,
         hints: &VisitorHints,
     ) -> Result<ServableModel, AppError> {
-        let visitor = state.visitor(hints, &record.slug).await?;
-        if !(record.policy.public_access || visitor.audience == Audience::Researcher) {
+        let mut visitor = state.visitor(hints, &record.slug).await?;
+        if visitor.audience == Audience::Study && visitor.study_model != Some(record.model_id) {
+            // The study was of an earlier version: its invitation opens nothing now.
+            visitor.audience = Audience::Public;
+        }
+        if !(record.policy.public_access
+            || matches!(visitor.audience, Audience::Researcher | Audience::Study))
+        {
             return Err(AppError::NotFound("model"));
         }
         if !record.servable() {

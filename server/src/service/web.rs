@@ -5,9 +5,11 @@
 
 use super::api::visible_models;
 use super::error::{AppError, ErrorBody};
-use super::servable::{ServableModel, SlugParam};
+use super::servable::{PathParams, ServableModel, SlugParam};
+use super::study::StudySlug;
 use super::visitor::{HintQuery, VisitorHints};
 use super::AppState;
+use crate::storage::valid_slug;
 use axum::extract::{Request, State};
 use axum::http::{header, HeaderValue};
 use axum::response::{Html, IntoResponse, Response};
@@ -130,6 +132,32 @@ pub async fn model_page(model: ServableModel) -> Response {
 )]
 pub async fn embed_page(model: ServableModel) -> Response {
     built_in_page(model)
+}
+
+/// Quality study page (the viewer's index.html; the invitation is in its
+/// `?invitation=`). Without the viewer's build, a page that says so.
+#[utoipa::path(
+    get,
+    path = "/study/{slug}",
+    params(StudySlug),
+    responses(
+        (status = 200, description = "HTML", body = String, content_type = "text/html"),
+        (status = 400, description = "Malformed slug", body = ErrorBody),
+    )
+)]
+pub async fn study_page(
+    PathParams(StudySlug { slug }): PathParams<StudySlug>,
+) -> Result<Response, AppError> {
+    if !valid_slug(&slug) {
+        return Err(AppError::BadRequest(format!(
+            "{slug:?} is not a model slug"
+        )));
+    }
+    Ok(page(
+        "Quality study",
+        "<h1>Quality study</h1>\n<p>The study needs the viewer, which is not installed on this \
+         server.</p>",
+    ))
 }
 
 fn built_in_page(ServableModel { record, .. }: ServableModel) -> Response {

@@ -11,10 +11,15 @@ mod postgres;
 mod sql;
 mod sqlite;
 mod stage;
+mod study;
 mod types;
 
 pub use postgres::PostgresStorage;
 pub use sqlite::SqliteStorage;
+pub use study::{
+    for_analysis, AnswerRecord, InvitationRecord, NewSession, SessionRecord, StudyRecord,
+    StudyStorage, ViewEvent,
+};
 pub use types::*;
 
 use async_trait::async_trait;
@@ -74,7 +79,7 @@ pub(crate) fn is_connection_error(e: &sqlx::Error) -> bool {
 
 /// The one interface the service and the ingest command use.
 #[async_trait]
-pub trait Storage: Send + Sync + 'static {
+pub trait Storage: StudyStorage + Send + Sync + 'static {
     /// Which backend, for logs and metrics: `"sqlite"` or `"postgres"`.
     fn backend(&self) -> &'static str;
 

@@ -1,6 +1,7 @@
 //! The shared backend: PostgreSQL, for several servers on one database.
 
 use super::backend::sql_storage;
+use super::study::study_storage;
 use super::{
     is_connection_error, AudiencePolicy, ConnectOptions, LevelRecord, MappingRecord, ModelRecord,
     ModelSummary, NewModel, NewToken, StagedModel, Storage, StorageError, TexturePayload,
@@ -65,3 +66,4 @@ impl PostgresStorage {
 }
 
 sql_storage!(PostgresStorage, Postgres, "postgres", MIGRATOR);
+study_storage!(PostgresStorage, Postgres);

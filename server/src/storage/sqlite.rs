@@ -1,6 +1,7 @@
 //! The embedded backend: one SQLite file in WAL mode, created on first run.
 
 use super::backend::sql_storage;
+use super::study::study_storage;
 use super::{
     is_connection_error, AudiencePolicy, ConnectOptions, LevelRecord, MappingRecord, ModelRecord,
     ModelSummary, NewModel, NewToken, StagedModel, Storage, StorageError, TexturePayload,
@@ -82,3 +83,4 @@ impl SqliteStorage {
 }
 
 sql_storage!(SqliteStorage, Sqlite, "sqlite", MIGRATOR);
+study_storage!(SqliteStorage, Sqlite);

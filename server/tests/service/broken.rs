@@ -27,6 +27,9 @@ impl BrokenStorage {
 }
 
 #[async_trait]
+impl vitrine::storage::StudyStorage for BrokenStorage {}
+
+#[async_trait]
 impl Storage for BrokenStorage {
     fn backend(&self) -> &'static str {
         "broken"

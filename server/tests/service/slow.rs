@@ -40,6 +40,9 @@ impl SlowStorage {
 }
 
 #[async_trait]
+impl vitrine::storage::StudyStorage for SlowStorage {}
+
+#[async_trait]
 impl Storage for SlowStorage {
     fn backend(&self) -> &'static str {
         self.inner.backend()
