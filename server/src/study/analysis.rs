@@ -342,4 +342,30 @@ mod tests {
         assert_eq!(r.good_enough_level, Some(2));
         assert!(!r.enough);
     }
+
+    /// Seed 000's Tabela 18: good levels 7, 6, 7, 8 give the model level 8.
+    #[test]
+    fn tabela_18_gives_level_8() {
+        let text = include_str!("../../tests/fixtures/tabela18.csv");
+        let sessions: Vec<SessionAnswers> = crate::study::csv::read(text.as_bytes(), 12)
+            .unwrap()
+            .into_iter()
+            .map(|s| SessionAnswers {
+                participant: s.participant,
+                device: None,
+                complete: true,
+                answers: s.answers,
+            })
+            .collect();
+        assert!(sessions.iter().all(|s| s.answers.len() == 13));
+        let r = report(&sessions, 12, 4);
+        let levels: Vec<_> = r.sessions.iter().map(|s| s.good_level).collect();
+        assert_eq!(levels, vec![Some(7), Some(6), Some(7), Some(8)]);
+        assert_eq!(
+            (r.good_enough_level, r.valid_sessions, r.excluded_sessions),
+            (Some(8), 4, 0)
+        );
+        assert!(r.enough);
+        assert_eq!(r.control_steps, 4);
+    }
 }

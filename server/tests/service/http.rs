@@ -390,7 +390,7 @@ pub async fn shedding_and_body_limit(db: TestDb) {
 
     let big = http
         .get(server.url("/api/models"))
-        .body(vec![b'x'; 20_000])
+        .body(vec![b'x'; 70_000])
         .send()
         .await
         .unwrap();

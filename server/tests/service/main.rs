@@ -13,6 +13,7 @@ mod quality;
 mod slow;
 mod spec;
 mod story;
+mod study;
 mod viewer;
 
 use harness::{Backend, TestDb};
@@ -69,6 +70,8 @@ on_both_backends!(
     colour::ccc_ingest_from_vertex_colour,
     quality::quality_curve_stored_and_served,
     spec::responses_match_openapi,
+    study::scripted_participants,
+    study::bad_study_requests,
 );
 
 /// `server/openapi.json` is the served description, committed for reviewers

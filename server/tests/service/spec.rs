@@ -83,11 +83,33 @@ impl Spec {
         for (name, value) in call.headers {
             request = request.header(*name, *value);
         }
-        self.judge(call.path, call.status, request).await
+        self.judge("get", call.path, call.status, request).await
+    }
+
+    /// Sends `method` with an optional bearer and JSON body.
+    async fn send(
+        &mut self,
+        server: &TestServer,
+        method: &str,
+        path: &str,
+        bearer: Option<&str>,
+        body: Option<Value>,
+        status: u16,
+    ) -> Answer {
+        let verb = reqwest::Method::from_bytes(method.to_uppercase().as_bytes()).unwrap();
+        let mut request = self.http.request(verb, server.url(path));
+        if let Some(token) = bearer {
+            request = request.header("authorization", format!("Bearer {token}"));
+        }
+        if let Some(body) = body {
+            request = request.json(&body);
+        }
+        self.judge(method, path, status, request).await
     }
 
     async fn judge(
         &mut self,
+        method: &str,
         path: &str,
         expected: u16,
         request: reqwest::RequestBuilder,
@@ -96,10 +118,14 @@ impl Spec {
         let status = reply.status().as_u16();
         let headers = reply.headers().clone();
         let body = reply.bytes().await.unwrap();
-        let what = format!("GET {path} → {status} {}", String::from_utf8_lossy(&body));
+        let what = format!(
+            "{} {path} → {status} {}",
+            method.to_uppercase(),
+            String::from_utf8_lossy(&body)
+        );
         assert_eq!(status, expected, "{what}");
         let route = self.route_of(path);
-        let described = &self.doc["paths"][&route]["get"]["responses"][status.to_string()];
+        let described = &self.doc["paths"][&route][method]["responses"][status.to_string()];
         assert!(
             described.is_object(),
             "{route} does not describe {status}: {what}"
@@ -343,6 +369,7 @@ pub async fn responses_match_openapi(db: TestDb) {
     let last = format!("/api/compressions/{}/batches/{}", m.open, m.last);
     spec.check(&server, call(&last, 429)).await;
 
+    study_calls(&mut spec, &server, &db).await;
     refusals(&mut spec, &db, &m).await;
     spec.assert_every_route_called();
 }
@@ -438,8 +465,19 @@ async fn refusals(spec: &mut Spec, db: &TestDb, m: &Models) {
         let path = route
             .replace("{slug}", "open")
             .replace("{id}", "1")
-            .replace("{iteration}", "1");
-        spec.check(&full, call(&path, 503)).await;
+            .replace("{iteration}", "1")
+            .replace("{step}", "1");
+        let methods: Vec<String> = spec.doc["paths"][&route]
+            .as_object()
+            .unwrap()
+            .keys()
+            .filter(|k| ["get", "post", "put"].contains(&k.as_str()))
+            .cloned()
+            .collect();
+        for method in methods {
+            let body = (method != "get").then(|| json!({}));
+            spec.send(&full, &method, &path, None, body, 503).await;
+        }
     }
 
     let mut hasty = config();
@@ -456,9 +494,161 @@ async fn refusals(spec: &mut Spec, db: &TestDb, m: &Models) {
     spec.check(&surge, call("/api/models/open", 200)).await;
     spec.check(&surge, call("/api/models/open", 503)).await;
 
-    // No route takes a body.
+    // Bodies over the limit (64 KiB).
     for path in ["/api/models", "/healthz"] {
-        let request = spec.http.get(surge.url(path)).body(vec![b'x'; 20_000]);
-        spec.judge(path, 413, request).await;
+        let request = spec.http.get(surge.url(path)).body(vec![b'x'; 70_000]);
+        spec.judge("get", path, 413, request).await;
     }
+}
+
+/// The study's routes with an invitation of `open`'s study (T = 0, so steps
+/// may be answered at once).
+async fn study_calls(spec: &mut Spec, server: &TestServer, db: &TestDb) {
+    use vitrine::storage::sha256_hex;
+    use vitrine::study::{new_invitation, Transition};
+    let record = db.storage.model_by_slug("open").await.unwrap().unwrap();
+    let id = db
+        .storage
+        .create_study(record.model_id, &[Transition(0, 1), Transition(1, 2)], 0)
+        .await
+        .unwrap();
+    let invitation = new_invitation();
+    db.storage
+        .insert_invitations(id, &[sha256_hex(invitation.as_bytes())], None)
+        .await
+        .unwrap();
+    let inv = Some(invitation.as_str());
+    let consent =
+        json!({"consent": true, "device": "tablet", "viewport": [1024, 768], "pixel_ratio": 2.0});
+    let answer = json!({"improvement": "a-little", "sufficient": true, "shown_ms": [0, 0]});
+    let event = json!({"at_ms": 5.0, "step": 1, "state": "pre", "kind": "camera",
+        "camera": {"eye": [0, 0, 2], "target": [0, 0, 0], "up": [0, 1, 0], "fov": 50}, "zoom": 1.5});
+    spec.send(server, "get", "/api/study/open/results", None, None, 404)
+        .await;
+    spec.send(server, "get", "/api/study/open", None, None, 403)
+        .await;
+    spec.send(server, "get", "/api/study/missing", inv, None, 404)
+        .await;
+    spec.send(server, "get", "/api/study/Not_A_Slug", inv, None, 400)
+        .await;
+    let info = spec
+        .send(server, "get", "/api/study/open", inv, None, 200)
+        .await;
+    assert_eq!(info.json()["step_count"], 3);
+    spec.send(server, "get", "/api/study/open/session", inv, None, 409)
+        .await;
+    spec.send(
+        server,
+        "post",
+        "/api/study/open/session",
+        inv,
+        Some(json!({"consent": false, "device": "tablet", "viewport": [1, 1], "pixel_ratio": 1.0})),
+        422,
+    )
+    .await;
+    spec.send(
+        server,
+        "post",
+        "/api/study/open/session",
+        inv,
+        Some(consent.clone()),
+        201,
+    )
+    .await;
+    spec.send(
+        server,
+        "post",
+        "/api/study/open/session",
+        inv,
+        Some(consent),
+        200,
+    )
+    .await;
+    let plan = spec
+        .send(server, "get", "/api/study/open/session", inv, None, 200)
+        .await;
+    assert_eq!(plan.json()["next_step"], 1);
+    spec.send(
+        server,
+        "put",
+        "/api/study/open/session/answers/9",
+        inv,
+        Some(answer.clone()),
+        404,
+    )
+    .await;
+    spec.send(
+        server,
+        "put",
+        "/api/study/open/session/answers/2",
+        inv,
+        Some(answer.clone()),
+        409,
+    )
+    .await;
+    spec.send(
+        server,
+        "put",
+        "/api/study/open/session/answers/1",
+        inv,
+        Some(json!({"improvement": "meh"})),
+        422,
+    )
+    .await;
+    spec.send(
+        server,
+        "post",
+        "/api/study/open/session/finish",
+        inv,
+        Some(json!({})),
+        409,
+    )
+    .await;
+    for step in 1..=3 {
+        let path = format!("/api/study/open/session/answers/{step}");
+        spec.send(server, "put", &path, inv, Some(answer.clone()), 201)
+            .await;
+    }
+    spec.send(
+        server,
+        "put",
+        "/api/study/open/session/answers/3",
+        inv,
+        Some(answer),
+        200,
+    )
+    .await;
+    spec.send(
+        server,
+        "post",
+        "/api/study/open/session/views",
+        inv,
+        Some(json!({"events": [event]})),
+        204,
+    )
+    .await;
+    spec.send(
+        server,
+        "post",
+        "/api/study/open/session/views",
+        inv,
+        Some(json!({"events": [{"at_ms": 1.0}]})),
+        422,
+    )
+    .await;
+    let done = spec
+        .send(
+            server,
+            "post",
+            "/api/study/open/session/finish",
+            inv,
+            Some(json!({})),
+            200,
+        )
+        .await;
+    assert_eq!(done.json()["good_level"], 1);
+    spec.send(server, "get", "/api/study/open/results", None, None, 200)
+        .await;
+    spec.check(server, call("/study/open", 200)).await;
+    spec.check(server, call("/study/Not_A_Slug", 400)).await;
 }
