@@ -198,7 +198,7 @@ impl ViewEventBody {
                 .chain(&c.target)
                 .chain(&c.up)
                 .all(|v| v.is_finite() && v.abs() < 1e9);
-            if !finite || !(c.fov > 0.0 && c.fov < 180.0) {
+            if !(finite && c.fov > 0.0 && c.fov < 180.0) {
                 return Err("camera vectors must be finite and fov between 0 and 180".into());
             }
         }
