@@ -25,5 +25,10 @@ if [ -f "$mask" ]; then
 fi
 $vitrine ingest data/plate.ply --db "sqlite:$db" --slug tunnel-plate --policy open --guard features \
     --title "Tunnel plate" --description "A genus-3 plate with sharp edges and tunnels, kept sharp in the coarse levels by the feature guard; try Relief."
-echo "Vitrine: open http://127.0.0.1:${PORT:-8080}/"
+# A quality study of the torus (T = 5 s here; the thesis used 20): one invitation link.
+base=http://127.0.0.1:${PORT:-8080}
+$vitrine study create --db "sqlite:$db" --slug painted-torus --seconds 5 >/dev/null
+study_link=$($vitrine study invite --db "sqlite:$db" --slug painted-torus --base-url "$base")
+echo "Vitrine: open $base/"
+echo "Quality study (one participant): $study_link"
 exec $vitrine serve --db "sqlite:$db" --listen "127.0.0.1:${PORT:-8080}" --web-dir web/dist

@@ -57,6 +57,11 @@ pub struct ServeArgs {
     #[arg(long, env = "VITRINE_GOOD_ENOUGH_FRACTION", default_value_t = 0.2)]
     pub good_enough_fraction: f64,
 
+    /// Hold every model at its good-enough level whatever the load (a launch
+    /// day expecting a crowd; the thesis' capped reconstruction, §6.5).
+    /// Study participants are not held.
+    #[arg(long, env = "VITRINE_LOAD_PIN")]
+    pub load_pin: bool,
     /// Load is high at this many data requests in flight…
     #[arg(long, env = "VITRINE_LOAD_HIGH_INFLIGHT", default_value_t = 384)]
     pub load_high_inflight: u64,
@@ -193,6 +198,10 @@ pub async fn run(args: ServeArgs) -> anyhow::Result<()> {
     warn_stale_models(storage.as_ref()).await;
     let state = AppState::new(storage, args.service_config());
     let _sampler = state.spawn_load_sampler();
+    if args.load_pin {
+        state.load().force_pressure(Some(u8::MAX));
+        tracing::info!("load caps pinned at every model's good-enough level");
+    }
     let listener = listen(args.listen)?;
     tracing::info!(
         addr = %listener.local_addr()?,
