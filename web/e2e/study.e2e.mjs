@@ -202,6 +202,12 @@ test('a participant answers every step through the page; answers, durations, loc
   // The view log: state events of every step, each period at least T from its own start.
   const events = requests.filter((r) => r.method === 'POST' && r.url.endsWith('/session/views')).flatMap((r) => r.body.events);
   assert.ok(events.length > 0, 'the view log was sent');
+  // …and stored: `vitrine study export --views` has every event sent.
+  const stored = readFileSync(views, 'utf8').trim().split('\n');
+  assert.equal(stored[0], 'participant,at_ms,step,state,kind,data');
+  const storedStates = stored.slice(1).filter((line) => /^[^,]+,[\d.]+,\d+,\w+,state,/.test(line));
+  assert.equal(stored.length - 1, events.length, 'every view event stored');
+  assert.equal(storedStates.length, events.filter((e) => e.kind === 'state').length);
   for (const r of requests.filter((r) => r.url.endsWith('/session/views'))) assert.ok(r.body.events.length <= 200);
   /** @type {Record<string, number[]>} */
   const periods = { pre: [], post: [] };
@@ -225,6 +231,7 @@ test('a participant answers every step through the page; answers, durations, loc
   t.diagnostic(`T = ${T * 1000} ms; pre (+ transition) ${fmt(periods.pre)}; post ${fmt(periods.post)}; shown_ms ${fmt(shown)}`);
 
   // Prefetch: the next step's level is requested during this step's questions, before its answer goes.
+  let prefetched = 0;
   for (let k = 0; k + 1 < steps.length; k++) {
     const step = steps[k];
     const next = steps[k + 1];
@@ -235,7 +242,10 @@ test('a participant answers every step through the page; answers, durations, loc
     assert.ok(batch.i < putAt[step.step], `batch ${next.to} requested before step ${step.step}'s answer`);
     const asked = requests.findIndex((r) => r.i > since && new RegExp(`/batches/${step.to}(\\?|$)`).test(r.url));
     assert.ok(asked === -1 || asked <= batch.i, 'in order');
+    prefetched++;
   }
+  assert.ok(prefetched >= steps.length - 2, `${prefetched} prefetches checked`);
+  t.diagnostic(`${steps.length} steps (control: step ${steps.find((s) => s.control)?.step}), ${prefetched} prefetches checked, ${events.length} view events`);
   assert.deepEqual(problems, []);
   await page.close();
 
