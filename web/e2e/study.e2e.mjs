@@ -272,6 +272,64 @@ test('a participant answers every step through the page; answers, durations, loc
   await model.close();
 });
 
+test('a participant who leaves after two steps resumes at the third; a slow batch delays the swap; every step is stored once', async (t) => {
+  const [link] = inviteToStudy(service, { slug: SLUG, count: 1 });
+  const invitation = invitationOf(link);
+  const page = await browser.context.newPage();
+  /** @type {string[]} */
+  const problems = [];
+  page.on('pageerror', (e) => problems.push(e.message));
+  await throughIntroduction(page, link);
+  await page.getByRole('button', { name: 'Continue' }).click();
+  await page.getByRole('button', { name: 'Begin the steps' }).click();
+  /** @param {number} step @param {number} total */
+  const answer = async (step, total) => {
+    const form = page.locator('form.study-questions');
+    await page.getByRole('heading', { name: `Step ${step} of ${total}: your answers` }).waitFor({ timeout: 60_000 });
+    await form.getByRole('radio', { name: 'Improved', exact: true }).check();
+    await form.getByRole('radio', { name: 'No', exact: true }).check();
+    const stored = page.waitForResponse((r) => r.url().includes(`/session/answers/${step}`) && r.request().method() === 'PUT');
+    await form.getByRole('button', { name: 'Submit answers' }).click();
+    assert.equal((await stored).status(), 201, `step ${step} stored`);
+  };
+  const headers = { authorization: `Bearer ${invitation}` };
+  const { steps } = await (await fetch(`${service.url}/api/study/${SLUG}/session`, { headers })).json();
+  await answer(1, steps.length);
+  await answer(2, steps.length);
+  // After the reload, one step's m_b arrives 2.5 s late: m_a stays on screen until it is ready.
+  const slow = steps.find((/** @type {{ step: number, from: number, to: number }} */ s) => s.step >= 3 && s.to > s.from);
+  await page.route(new RegExp(`/batches/${slow.to}(\\?|$)`), async (route) => {
+    await new Promise((resolve) => setTimeout(resolve, 2500));
+    await route.continue();
+  });
+  /** @type {any[]} */
+  const events = [];
+  page.on('request', (r) => {
+    if (r.method() === 'POST' && r.url().endsWith('/session/views')) events.push(...r.postDataJSON().events);
+  });
+  await page.reload();
+  await page.getByText('continues where you left off').waitFor();
+  await page.getByRole('button', { name: 'Continue' }).click();
+  await page.getByLabel(/I agree/).check();
+  const resumed = page.waitForResponse((r) => r.url().endsWith('/session') && r.request().method() === 'POST');
+  await page.getByRole('button', { name: 'Start' }).click();
+  assert.equal((await resumed).status(), 200, 'the session is resumed, not created');
+  for (let step = 3; step <= steps.length; step++) await answer(step, steps.length);
+  await page.getByRole('heading', { name: 'Thank you' }).waitFor({ timeout: 30_000 });
+  const plan = await (await fetch(`${service.url}/api/study/${SLUG}/session`, { headers })).json();
+  assert.deepEqual(plan.answered, steps.map((/** @type {{ step: number }} */ s) => s.step));
+  assert.equal(plan.finished, true);
+  const states = events.filter((e) => e.kind === 'state' && e.step === slow.step);
+  const at = (/** @type {string} */ name) => states.find((e) => e.state === name)?.at_ms;
+  assert.deepEqual(states.map((e) => e.state), ['pre', 'transition', 'post', 'answer']);
+  assert.ok(at('transition') - at('pre') >= T * 1000 - 0.1);
+  assert.ok(at('post') - at('transition') >= 1000, `the swap waited for the slow batch (${at('post') - at('transition')} ms)`);
+  assert.ok(at('answer') - at('post') >= T * 1000 - 0.1, 'the post period counts from the swap');
+  t.diagnostic(`slow batch on step ${slow.step}: pre ${(at('transition') - at('pre')).toFixed(1)} ms, transition ${(at('post') - at('transition')).toFixed(1)} ms, post ${(at('answer') - at('post')).toFixed(1)} ms`);
+  assert.deepEqual(problems, []);
+  await page.close();
+});
+
 test('the study page fits from 320 px wide to 4K: information, questions, no overlap', async () => {
   const [link] = inviteToStudy(service, { slug: SLUG, count: 1 });
   const page = await browser.context.newPage();

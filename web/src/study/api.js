@@ -111,9 +111,9 @@ export class StudyApi {
     return this.#call('PUT', `/session/answers/${step}`, answer);
   }
 
-  /** @param {ViewEvent[]} events */
+  /** @param {ViewEvent[]} events at most 200, under 64 KiB of JSON (log.js batches them) */
   views(events) {
-    return this.#call('POST', '/session/views', { events });
+    return this.#call('POST', '/session/views', { events }, { keepalive: true });
   }
 
   /** @returns {Promise<{ good_level: number | null }>} */
@@ -125,8 +125,9 @@ export class StudyApi {
    * @param {string} method
    * @param {string} path
    * @param {unknown} [body]
+   * @param {{ keepalive?: boolean }} [options] keepalive: the request outlives the page (the log's last batch)
    */
-  async #call(method, path, body) {
+  async #call(method, path, body, options = {}) {
     /** @type {Record<string, string>} */
     const headers = { authorization: `Bearer ${this.invitation}` };
     if (body !== undefined) headers['content-type'] = 'application/json';
@@ -137,6 +138,7 @@ export class StudyApi {
         headers,
         body: body === undefined ? undefined : JSON.stringify(body),
         cache: 'no-store',
+        keepalive: options.keepalive,
       });
     } catch (error) {
       throw new StudyError(0, 'network', `could not reach the server (${error instanceof Error ? error.message : error})`);

@@ -160,6 +160,9 @@ export class StudyPage {
       ]),
       el('p', { class: 'actions' }, [next]),
     );
+    if (info.invitation === 'started') {
+      heading.after(el('p', { class: 'study-resume' }, ['You have started this study before: it continues where you left off.']));
+    }
     heading.focus();
     next.onclick = () => this.#consent();
   }
