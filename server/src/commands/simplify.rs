@@ -47,7 +47,7 @@ pub enum CollapseKind {
 pub struct SimplifyArgs {
     /// Input mesh: .ply, .obj, .off, .gltf or .glb.
     pub input: PathBuf,
-    /// Output mesh; the extension picks the format: .ply, .obj or .glb.
+    /// Output mesh; the extension picks the format: .ply, .obj, .glb or .md2.
     #[arg(short, long)]
     pub output: PathBuf,
     /// The simplifier.
