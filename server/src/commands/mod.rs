@@ -8,6 +8,7 @@ pub mod encode;
 pub mod guard;
 pub mod ingest;
 pub mod inspect;
+pub mod lod;
 pub mod mesh_format;
 pub mod models;
 pub mod sample;
@@ -43,8 +44,11 @@ pub enum Command {
     Inspect(inspect::InspectArgs),
     /// Write a generated sample mesh (torus, sphere, plate) as PLY.
     Sample(sample::SampleArgs),
-    /// Simplify a mesh to a vertex count and write PLY, OBJ or GLB, with a report.
+    /// Simplify a mesh to a vertex count and write PLY, OBJ, GLB or MD2, with a report.
     Simplify(simplify::SimplifyArgs),
+    /// Levels of detail by Melax's collapses: one GLB with MSFT_lod (and an
+    /// MD2's frames as morph targets), or one GLB or MD2 per level.
+    Lod(lod::LodArgs),
 }
 
 impl Command {
@@ -59,6 +63,7 @@ impl Command {
             Command::Inspect(args) => inspect::run(args),
             Command::Sample(args) => sample::run(args),
             Command::Simplify(args) => simplify::run(args),
+            Command::Lod(args) => lod::run(args),
         }
     }
 }
