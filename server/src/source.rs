@@ -24,11 +24,21 @@ pub struct SourceMesh {
     pub imported_faces: usize,
 }
 
-/// Reads a mesh file (PLY, OBJ, OFF, glTF, GLB) with its colour texture when
+/// Reads a mesh file (PLY, OBJ, OFF, glTF, GLB, MD2 frame 0) with its colour texture when
 /// it has one, and repairs it. Texture problems are warnings on stderr, not
 /// errors: the mesh is still encodable without its texture.
 pub fn load_coloured_mesh(path: &Path) -> anyhow::Result<SourceMesh> {
-    let imported = import_path_textured(path, &ImportOptions::default())
+    load_coloured_frame(path, 0)
+}
+
+/// [`load_coloured_mesh`] of animation frame `frame` (MD2; other formats
+/// have one frame and ignore it).
+pub fn load_coloured_frame(path: &Path, frame: usize) -> anyhow::Result<SourceMesh> {
+    let options = ImportOptions {
+        frame,
+        ..ImportOptions::default()
+    };
+    let imported = import_path_textured(path, &options)
         .with_context(|| format!("reading {}", path.display()))?;
     for w in &imported.warnings {
         eprintln!("warning: {}: {w}", path.display());

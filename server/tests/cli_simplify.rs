@@ -258,6 +258,6 @@ fn simplify_refuses_bad_arguments() {
     }
     let stl = dir.path().join("out.stl");
     let e = simplify(&["--target-fraction", "0.5"], &stl);
-    assert!(e.contains("must end in .ply, .obj or .glb"), "{e}");
+    assert!(e.contains("must end in .ply, .obj, .glb or .md2"), "{e}");
     assert!(!ply.exists() && !stl.exists());
 }

@@ -19,6 +19,7 @@ pub fn import_options() -> ImportOptions {
     ImportOptions {
         max_vertices: 1 << 16,
         max_faces: 1 << 17,
+        ..ImportOptions::default()
     }
 }
 

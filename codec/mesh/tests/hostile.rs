@@ -1041,6 +1041,7 @@ mod files {
         ImportOptions {
             max_vertices: 1000,
             max_faces: 2000,
+            ..ImportOptions::default()
         }
     }
 

@@ -564,6 +564,7 @@ fn bad_inputs_are_clear_errors() {
     let small = ImportOptions {
         max_vertices: 2,
         max_faces: 100,
+        ..ImportOptions::default()
     };
     match import_bytes(&good, Ply, &small) {
         Err(Error::Limit(m)) => assert!(m.contains("limit of 2"), "{m}"),
@@ -1541,7 +1542,7 @@ mod textured {
         let got = textured(&path);
         assert!(got.texture.is_none());
         assert!(
-            got.warnings[0].contains("only PNG and JPEG"),
+            got.warnings[0].contains("only PNG, JPEG, TGA and PCX"),
             "{:?}",
             got.warnings
         );

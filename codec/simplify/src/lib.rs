@@ -11,6 +11,9 @@
 //!   edge, half-edge or triangle collapses of the vertices off the borders
 //!   and away from features, each checked (link condition, no flips), down
 //!   to an exact vertex count.
+//! - [`melax`]: Melax's progressive edge collapse (seed 003) for levels of
+//!   detail: heap-ordered, checked like [`simplify`], seams and borders
+//!   kept, one collapse order for every frame of an animated model.
 //!
 //! ```
 //! use vitrine_simplify::{simplify, Collapse, SimplifyOptions, StopReason, Target};
@@ -30,6 +33,7 @@
 mod collapse;
 pub mod deviation;
 mod feature_guard;
+pub mod melax;
 
 pub use collapse::{
     simplify, simplify_with, Cleanup, Collapse, PassReport, Simplified, SimplifyOptions,

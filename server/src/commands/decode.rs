@@ -1,4 +1,4 @@
-//! `vitrine decode`: a stream file, up to a level, as a PLY, OBJ or GLB mesh.
+//! `vitrine decode`: a stream file, up to a level, as a PLY, OBJ, GLB or MD2 mesh.
 
 use super::mesh_format::MeshFormat;
 use anyhow::Context;
@@ -10,7 +10,7 @@ use vitrine_codec::{decode, Limits};
 pub struct DecodeArgs {
     /// Stream file written by `vitrine encode`.
     pub input: PathBuf,
-    /// Output mesh; the extension picks the format: .ply, .obj or .glb.
+    /// Output mesh; the extension picks the format: .ply, .obj, .glb or .md2.
     #[arg(short, long)]
     pub output: PathBuf,
     /// Number of refinement batches to apply (default: all).

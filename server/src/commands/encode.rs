@@ -5,7 +5,7 @@ use super::guard::GuardArgs;
 use super::ingest::CccArgs;
 use crate::ccc_files::CccFiles;
 use crate::ingest::{GuardOptions, Guards};
-use crate::source::{default_colour_mode, describe_repair, load_coloured_mesh, SourceMesh};
+use crate::source::{default_colour_mode, describe_repair, load_coloured_frame, SourceMesh};
 use anyhow::Context;
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
@@ -17,8 +17,11 @@ use vitrine_colour::{encode_coloured, ColourMode};
 
 #[derive(Args, Debug)]
 pub struct EncodeArgs {
-    /// Input mesh: .ply, .obj, .off, .gltf or .glb.
+    /// Input mesh: .ply, .obj, .off, .gltf, .glb or .md2.
     pub input: PathBuf,
+    /// MD2: the animation frame the stream carries.
+    #[arg(long, default_value_t = 0)]
+    pub frame: usize,
     /// Output stream file (default: input with extension .vtr).
     #[arg(short, long)]
     pub output: Option<PathBuf>,
@@ -66,7 +69,7 @@ pub fn run(args: EncodeArgs) -> anyhow::Result<()> {
         .clone()
         .unwrap_or_else(|| args.input.with_extension("vtr"));
     let guards = args.guard.options()?;
-    let source = load_coloured_mesh(&args.input)?;
+    let source = load_coloured_frame(&args.input, args.frame)?;
     if let Some(text) = describe_repair(&source.repair) {
         eprintln!("repair: {text}");
     }

@@ -5,7 +5,7 @@ use crate::database::open_storage;
 use crate::ingest::{
     ingest_coloured, IngestOptions, IngestReport, MeasuredQuality, ModelMeta, SourceInfo,
 };
-use crate::source::load_coloured_mesh;
+use crate::source::load_coloured_frame;
 use crate::storage::{ConnectOptions, OnExisting};
 use std::path::PathBuf;
 use std::time::Duration;
@@ -16,8 +16,12 @@ use vitrine_quality::QualityOptions;
 
 #[derive(clap::Args, Clone, Debug)]
 pub struct IngestArgs {
-    /// Mesh file: PLY, OBJ, OFF, glTF or GLB.
+    /// Mesh file: PLY, OBJ, OFF, glTF, GLB or MD2.
     pub mesh: PathBuf,
+    /// MD2: the animation frame the stream carries (its skin becomes the
+    /// texture the cell complex samples).
+    #[arg(long, default_value_t = 0)]
+    pub frame: usize,
     /// Database URL: `sqlite:vitrine.db` or `postgres://user@host/db`.
     #[arg(long, env = "VITRINE_DB", default_value = "sqlite:vitrine.db")]
     pub db: String,
@@ -101,9 +105,9 @@ impl CccArgs {
 pub async fn run(args: IngestArgs) -> anyhow::Result<()> {
     super::init_tracing();
     let options = args.options()?;
-    let path = args.mesh.clone();
+    let (path, frame) = (args.mesh.clone(), args.frame);
     let (source, info) = tokio::task::spawn_blocking(move || -> anyhow::Result<_> {
-        let source = load_coloured_mesh(&path)?;
+        let source = load_coloured_frame(&path, frame)?;
         let info = SourceInfo {
             name: path
                 .file_name()

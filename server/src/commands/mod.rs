@@ -8,6 +8,7 @@ pub mod encode;
 pub mod guard;
 pub mod ingest;
 pub mod inspect;
+pub mod lod;
 pub mod mesh_format;
 pub mod models;
 pub mod sample;
@@ -44,10 +45,13 @@ pub enum Command {
     Inspect(inspect::InspectArgs),
     /// Write a generated sample mesh (torus, sphere, plate) as PLY.
     Sample(sample::SampleArgs),
-    /// Simplify a mesh to a vertex count and write PLY, OBJ or GLB, with a report.
+    /// Simplify a mesh to a vertex count and write PLY, OBJ, GLB or MD2, with a report.
     Simplify(simplify::SimplifyArgs),
     /// The quality study: invitations, answers, and the level cap they set.
     Study(study::StudyArgs),
+    /// Levels of detail by Melax's collapses: one GLB with MSFT_lod (and an
+    /// MD2's frames as morph targets), or one GLB or MD2 per level.
+    Lod(lod::LodArgs),
 }
 
 impl Command {
@@ -63,6 +67,7 @@ impl Command {
             Command::Sample(args) => sample::run(args),
             Command::Simplify(args) => simplify::run(args),
             Command::Study(args) => block_on(study::run(args)),
+            Command::Lod(args) => lod::run(args),
         }
     }
 }

@@ -12,6 +12,7 @@ use std::time::Instant;
 use vitrine_codec::IndexedMesh;
 use vitrine_colour::vertex_colours_from_texture;
 use vitrine_quality::metrics::hausdorff;
+use vitrine_simplify::melax::melax_simplify;
 use vitrine_simplify::{simplify, Collapse, FeatureThreshold, SimplifyOptions, StopReason, Target};
 
 /// A simplifier.
@@ -21,6 +22,11 @@ pub enum Method {
     /// features (average normal deviation θ, seed 004), each checked for
     /// the link condition and flips, to an exact vertex count.
     NormalDeviation,
+    /// Melax's edge collapses (seed 003): each vertex into its cheapest
+    /// neighbour (distance times the crease it leaves), cheapest first,
+    /// borders locked, link condition and flips checked; positions never
+    /// move.
+    Melax,
 }
 
 impl Method {
@@ -28,6 +34,7 @@ impl Method {
     pub fn name(self) -> &'static str {
         match self {
             Method::NormalDeviation => "normal-deviation",
+            Method::Melax => "melax",
         }
     }
 }
@@ -45,9 +52,9 @@ pub enum CollapseKind {
 
 #[derive(Args, Debug)]
 pub struct SimplifyArgs {
-    /// Input mesh: .ply, .obj, .off, .gltf or .glb.
+    /// Input mesh: .ply, .obj, .off, .gltf, .glb or .md2.
     pub input: PathBuf,
-    /// Output mesh; the extension picks the format: .ply, .obj or .glb.
+    /// Output mesh; the extension picks the format: .ply, .obj, .glb or .md2.
     #[arg(short, long)]
     pub output: PathBuf,
     /// The simplifier.
@@ -153,6 +160,7 @@ pub fn run(args: SimplifyArgs) -> anyhow::Result<()> {
     let started = Instant::now();
     let outcome = match args.method {
         Method::NormalDeviation => normal_deviation(&input, &args)?,
+        Method::Melax => melax(&input, &args)?,
     };
     let seconds = started.elapsed().as_secs_f64();
     format.write(&outcome.mesh, &args.output)?;
@@ -203,6 +211,21 @@ fn normal_deviation(mesh: &IndexedMesh, args: &SimplifyArgs) -> anyhow::Result<O
         },
         collapse: Some(name),
         feature_threshold_degrees: Some(out.threshold_radians.to_degrees()),
+    })
+}
+
+fn melax(mesh: &IndexedMesh, args: &SimplifyArgs) -> anyhow::Result<Outcome> {
+    let out = melax_simplify(mesh, args.target.target())?;
+    Ok(Outcome {
+        mesh: out.mesh,
+        passes: 1,
+        stopped: if out.reached {
+            "target"
+        } else {
+            "no-candidate"
+        },
+        collapse: None,
+        feature_threshold_degrees: None,
     })
 }
 

@@ -19,8 +19,10 @@ use std::path::Path;
 use crate::{Error, IndexedMesh, Result};
 
 mod gltf;
+pub mod md2;
 mod obj;
 mod off;
+mod pcx;
 mod ply;
 mod texture;
 
@@ -39,6 +41,8 @@ pub enum MeshFormat {
     Gltf,
     /// glTF 2.0 binary container.
     Glb,
+    /// Quake II model: one frame ([`ImportOptions::frame`]), skin as texture.
+    Md2,
 }
 
 impl MeshFormat {
@@ -51,6 +55,7 @@ impl MeshFormat {
             "off" | "coff" => MeshFormat::Off,
             "gltf" => MeshFormat::Gltf,
             "glb" => MeshFormat::Glb,
+            "md2" => MeshFormat::Md2,
             _ => return None,
         })
     }
@@ -59,6 +64,9 @@ impl MeshFormat {
     pub fn sniff(bytes: &[u8]) -> Option<Self> {
         if bytes.starts_with(b"glTF") {
             return Some(MeshFormat::Glb);
+        }
+        if bytes.starts_with(&md2::MD2_MAGIC) {
+            return Some(MeshFormat::Md2);
         }
         if bytes.starts_with(b"ply\n") || bytes.starts_with(b"ply\r\n") {
             return Some(MeshFormat::Ply);
@@ -100,6 +108,7 @@ impl MeshFormat {
             MeshFormat::Off => "OFF file",
             MeshFormat::Gltf => "glTF file",
             MeshFormat::Glb => "GLB file",
+            MeshFormat::Md2 => "MD2 file",
         }
     }
 }
@@ -111,6 +120,8 @@ pub struct ImportOptions {
     pub max_vertices: usize,
     /// Most faces a file may declare, and most triangles it may produce (default 100 million).
     pub max_faces: usize,
+    /// The animation frame read from formats with several (MD2; default 0).
+    pub frame: usize,
 }
 
 impl Default for ImportOptions {
@@ -118,6 +129,7 @@ impl Default for ImportOptions {
         ImportOptions {
             max_vertices: 50_000_000,
             max_faces: 100_000_000,
+            frame: 0,
         }
     }
 }
@@ -227,6 +239,9 @@ pub fn import_path_textured_with(
             tex.max_texture_pixels,
             &mut warnings,
         )?,
+        MeshFormat::Md2 => {
+            md2::read_textured(&bytes, opts, base, tex.max_texture_pixels, &mut warnings)?
+        }
         _ => (import_bytes(&bytes, format, opts)?, None),
     };
     Ok(Imported {
@@ -246,7 +261,7 @@ fn detect_format(path: &Path, bytes: &[u8]) -> Result<MeshFormat> {
         Some(f) => f,
         None => MeshFormat::sniff(bytes).ok_or_else(|| {
             Error::Unsupported(format!(
-                "{}: unknown mesh format (expected .ply, .obj, .off, .gltf or .glb)",
+                "{}: unknown mesh format (expected .ply, .obj, .off, .gltf, .glb or .md2)",
                 path.display()
             ))
         })?,
@@ -262,6 +277,7 @@ pub fn import_bytes(bytes: &[u8], format: MeshFormat, opts: &ImportOptions) -> R
         MeshFormat::Obj => obj::read(bytes, opts)?,
         MeshFormat::Off => off::read(bytes, opts)?,
         MeshFormat::Gltf | MeshFormat::Glb => gltf::read(bytes, format, None, opts)?,
+        MeshFormat::Md2 => md2::read(bytes, opts)?,
     };
     debug_assert!(mesh
         .triangles

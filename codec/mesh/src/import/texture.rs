@@ -27,7 +27,7 @@ pub(super) enum Source<'a> {
     Bytes(&'a [u8]),
 }
 
-/// Decodes a PNG or JPEG into 8-bit RGB (grey is replicated, alpha dropped,
+/// Decodes a PNG, JPEG, TGA or PCX into 8-bit RGB (grey is replicated, alpha dropped,
 /// 16-bit channels scaled). `name` says which texture, for messages.
 ///
 /// `Ok(Err(warning))` is for textures that are absent or in a format this
@@ -39,7 +39,10 @@ pub(super) fn load(
     max_pixels: u64,
 ) -> Result<std::result::Result<RgbImage, String>> {
     match src {
-        Source::Bytes(b) => decode(|| Ok(Cursor::new(b)), name, max_pixels),
+        Source::Bytes(b) if super::pcx::is_pcx(b) => {
+            super::pcx::decode(b, name, max_pixels).map(Ok)
+        }
+        Source::Bytes(b) => decode(|| Ok(Cursor::new(b)), None, name, max_pixels),
         Source::File(path) => {
             let open = || std::fs::File::open(path).map(std::io::BufReader::new);
             match open() {
@@ -55,14 +58,34 @@ pub(super) fn load(
                     "{name}: {} is a folder, not a texture image; imported without texture",
                     path.display()
                 ))),
-                Ok(_) => decode(open, name, max_pixels),
+                Ok(_) if starts_like_pcx(path) => {
+                    let bytes = std::fs::read(path).map_err(|e| {
+                        Error::Io(std::io::Error::new(
+                            e.kind(),
+                            format!("{name}: {}: {e}", path.display()),
+                        ))
+                    })?;
+                    super::pcx::decode(&bytes, name, max_pixels).map(Ok)
+                }
+                // TGA has no signature: its extension says what it is.
+                Ok(_) => decode(open, ImageFormat::from_path(path).ok(), name, max_pixels),
             }
         }
     }
 }
 
+/// PCX has no magic `image` knows: peek at the first bytes.
+fn starts_like_pcx(path: &Path) -> bool {
+    use std::io::Read;
+    let mut head = [0u8; 4];
+    std::fs::File::open(path)
+        .and_then(|mut f| f.read_exact(&mut head))
+        .is_ok_and(|()| super::pcx::is_pcx(&head))
+}
+
 fn decode<R: BufRead + Seek>(
     open: impl Fn() -> std::io::Result<R>,
+    hint: Option<ImageFormat>,
     name: &str,
     max_pixels: u64,
 ) -> Result<std::result::Result<RgbImage, String>> {
@@ -70,11 +93,15 @@ fn decode<R: BufRead + Seek>(
     let reader = ImageReader::new(open().map_err(io)?)
         .with_guessed_format()
         .map_err(io)?;
-    let format = match reader.format() {
-        Some(f @ (ImageFormat::Png | ImageFormat::Jpeg)) => f,
+    let guessed = match (reader.format(), hint) {
+        (None, Some(ImageFormat::Tga)) => Some(ImageFormat::Tga),
+        (f, _) => f,
+    };
+    let format = match guessed {
+        Some(f @ (ImageFormat::Png | ImageFormat::Jpeg | ImageFormat::Tga)) => f,
         Some(f) => {
             return Ok(Err(format!(
-                "{name}: {f:?} textures are not read (only PNG and JPEG); \
+                "{name}: {f:?} textures are not read (only PNG, JPEG, TGA and PCX); \
                  imported without texture"
             )))
         }
@@ -86,6 +113,7 @@ fn decode<R: BufRead + Seek>(
         }
     };
     // Header only: no pixel memory yet.
+    let reader = ImageReader::with_format(open().map_err(io)?, format);
     let (w, h) = reader.into_dimensions().map_err(|e| image_error(e, name))?;
     let pixels = w as u64 * h as u64;
     if pixels == 0 {

@@ -18,8 +18,8 @@
 
 mod cleanup;
 mod pass;
-mod topology;
-mod working;
+pub(crate) mod topology;
+pub(crate) mod working;
 
 use std::str::FromStr;
 
@@ -97,7 +97,7 @@ impl FromStr for Target {
 }
 
 impl Target {
-    fn validate(self) -> Result<()> {
+    pub(crate) fn validate(self) -> Result<()> {
         match self {
             Target::Fraction(f) if !(0.0..=1.0).contains(&f) => Err(Error::Parameter(format!(
                 "target fraction must be within 0–1, got {f}"
@@ -106,7 +106,7 @@ impl Target {
         }
     }
 
-    fn vertices(self, used: usize) -> usize {
+    pub(crate) fn vertices(self, used: usize) -> usize {
         match self {
             Target::Vertices(n) => n,
             Target::Fraction(f) => (f * used as f64).round() as usize,

@@ -24,14 +24,14 @@ const MIN_SHAPE: f64 = 1e-3;
 
 /// Reusable buffers, so that checking a merge allocates nothing.
 #[derive(Default)]
-pub(super) struct Scratch {
+pub(crate) struct Scratch {
     keep: Vec<u32>,
     gone: Vec<u32>,
     star: Vec<StarFace>,
 }
 
 /// The link condition and flip rejection together.
-pub(super) fn allows(mesh: &WorkingMesh, merge: &Merge, scratch: &mut Scratch) -> bool {
+pub(crate) fn allows(mesh: &WorkingMesh, merge: &Merge, scratch: &mut Scratch) -> bool {
     link_condition(mesh, merge.keep, merge.gone, scratch) && keeps_orientation(mesh, merge, scratch)
 }
 
@@ -40,7 +40,7 @@ pub(super) fn allows(mesh: &WorkingMesh, merge: &Merge, scratch: &mut Scratch) -
 /// corners opposite the edge (else a face or edge would double), and the
 /// edge between those two must not be in both links (a tetrahedron, which
 /// would collapse into two coincident faces).
-pub(super) fn link_condition(mesh: &WorkingMesh, a: u32, b: u32, scratch: &mut Scratch) -> bool {
+pub(crate) fn link_condition(mesh: &WorkingMesh, a: u32, b: u32, scratch: &mut Scratch) -> bool {
     let mut opposite = [u32::MAX; 2];
     let mut edge_faces = 0;
     for &f in &mesh.faces_of[b as usize] {
@@ -82,7 +82,7 @@ struct StarFace {
 /// shape (does not become a sliver, unless it was one); and no two faces
 /// sharing an edge around the survivor fold past 90° unless they already
 /// did (the seed's "pyramids" are such folds).
-pub(super) fn keeps_orientation(mesh: &WorkingMesh, merge: &Merge, scratch: &mut Scratch) -> bool {
+pub(crate) fn keeps_orientation(mesh: &WorkingMesh, merge: &Merge, scratch: &mut Scratch) -> bool {
     let moved = mesh.positions[merge.keep as usize] != merge.to;
     let to = DVec3::from(merge.to.map(f64::from));
     let at = |v: u32| if v == merge.keep { to } else { mesh.point(v) };
@@ -161,7 +161,7 @@ fn shares_edge(a: &[u32; 3], b: &[u32; 3]) -> bool {
 }
 
 /// Twice the area times the unit normal.
-pub(super) fn normal(p: &[DVec3; 3]) -> DVec3 {
+pub(crate) fn normal(p: &[DVec3; 3]) -> DVec3 {
     (p[1] - p[0]).cross(p[2] - p[0])
 }
 

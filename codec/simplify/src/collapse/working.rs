@@ -12,14 +12,14 @@ use crate::FeatureThreshold;
 /// One vertex merged into another: `gone`'s faces move to `keep`, the two
 /// faces on the edge between them die, and `keep` moves to `to`.
 #[derive(Clone, Copy, Debug)]
-pub(super) struct Merge {
+pub(crate) struct Merge {
     pub keep: u32,
     pub gone: u32,
     pub to: [f32; 3],
     pub colour: Option<[f32; 3]>,
 }
 
-pub(super) struct WorkingMesh {
+pub(crate) struct WorkingMesh {
     pub positions: Vec<[f32; 3]>,
     /// Colours as floats, so that averages of averages stay exact enough.
     pub colours: Option<Vec<[f32; 3]>>,
@@ -46,6 +46,17 @@ impl WorkingMesh {
         let theta = normal_deviation(mesh);
         let threshold = threshold.radians(&theta);
         let ring = one_ring_max(mesh, &theta);
+        Ok((Self::build(mesh, ring)?, threshold))
+    }
+
+    /// The mesh without θ (every vertex at 0), for simplifiers that cost
+    /// collapses otherwise (Melax).
+    pub fn without_deviation(mesh: &IndexedMesh) -> Result<Self> {
+        validate(mesh)?;
+        Self::build(mesh, vec![0.0; mesh.positions.len()])
+    }
+
+    fn build(mesh: &IndexedMesh, ring: Vec<f64>) -> Result<Self> {
         let mut faces_of = vec![Vec::new(); mesh.positions.len()];
         for (f, t) in mesh.triangles.iter().enumerate() {
             for &v in t {
@@ -68,7 +79,7 @@ impl WorkingMesh {
             live_vertices,
         };
         working.check_fans()?;
-        Ok((working, threshold))
+        Ok(working)
     }
 
     pub fn live_faces(&self) -> usize {
@@ -223,7 +234,7 @@ impl WorkingMesh {
 }
 
 /// The corner after `v` in `t`, counter-clockwise (`t` must contain `v`).
-pub(super) fn after(t: [u32; 3], v: u32) -> u32 {
+pub(crate) fn after(t: [u32; 3], v: u32) -> u32 {
     let i = t.iter().position(|&w| w == v).unwrap_or(0);
     t[(i + 1) % 3]
 }

@@ -1,8 +1,19 @@
 //! Mesh writers: binary PLY, OBJ and GLB. Each output reads back through
 //! [`crate::import`] as the same mesh: bit-exact positions, colours and
-//! triangles.
+//! triangles. [`md2`] writes Quake II models (quantized to bytes, so only
+//! an MD2 read back re-writes bit for bit).
 
 use std::io::Write;
+
+mod lod_glb;
+pub mod md2;
+mod md2_sample;
+mod normal_table;
+
+pub use lod_glb::{screen_coverage, write_lod_glb, LodGlb};
+pub use md2::{mesh_to_md2, write_md2, write_mesh_md2};
+pub use md2_sample::{sample_md2, SAMPLE_SKIN};
+pub use normal_table::{nearest_normal, normal_table, NORMAL_COUNT};
 
 use crate::import::srgb_u8_to_linear;
 use crate::{Error, IndexedMesh, Result};

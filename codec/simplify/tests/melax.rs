@@ -1,0 +1,220 @@
+//! Melax LOD chains (seed 003) on generated meshes: exact level sizes
+//! ⌊n·p/100⌋, manifold levels of the input's topology, no flipped face in
+//! any level or frame, borders and UV seams kept.
+
+use std::collections::HashSet;
+
+use glam::DVec3;
+use vitrine_codec::IndexedMesh;
+use vitrine_mesh::export::sample_md2;
+use vitrine_mesh::repair::check_manifold;
+use vitrine_samples::{grid, icosphere, punch_holes, torus};
+use vitrine_simplify::melax::{compact, melax_chain, melax_simplify, MelaxChain, MelaxModel};
+use vitrine_simplify::{border_vertices, Target};
+
+const LEVELS: [u32; 5] = [100, 80, 60, 40, 20];
+
+fn chain_of(mesh: &IndexedMesh) -> MelaxChain {
+    let frames = [mesh.positions.clone()];
+    melax_chain(&MelaxModel {
+        triangles: &mesh.triangles,
+        frames: &frames,
+        corner_uvs: None,
+    })
+    .unwrap()
+}
+
+fn euler(mesh: &IndexedMesh) -> i64 {
+    let mut edges = HashSet::new();
+    for t in &mesh.triangles {
+        for k in 0..3 {
+            let (a, b) = (t[k], t[(k + 1) % 3]);
+            edges.insert((a.min(b), a.max(b)));
+        }
+    }
+    mesh.positions.len() as i64 - edges.len() as i64 + mesh.triangles.len() as i64
+}
+
+/// Area-weighted vertex normals of `triangles` over `positions`.
+fn vertex_normals(positions: &[[f32; 3]], triangles: &[[u32; 3]]) -> Vec<DVec3> {
+    let p = |v: u32| DVec3::from(positions[v as usize].map(f64::from));
+    let mut n = vec![DVec3::ZERO; positions.len()];
+    for &[a, b, c] in triangles {
+        let f = (p(b) - p(a)).cross(p(c) - p(a));
+        for v in [a, b, c] {
+            n[v as usize] += f;
+        }
+    }
+    n
+}
+
+/// Faces of a level (input indices) facing away from the input around
+/// their corners.
+fn flipped(positions: &[[f32; 3]], input: &[[u32; 3]], level: &[[u32; 3]]) -> usize {
+    let reference = vertex_normals(positions, input);
+    let p = |v: u32| DVec3::from(positions[v as usize].map(f64::from));
+    level
+        .iter()
+        .filter(|&&[a, b, c]| {
+            let n = (p(b) - p(a)).cross(p(c) - p(a));
+            let r: DVec3 = [a, b, c]
+                .iter()
+                .map(|&v| reference[v as usize].normalize_or_zero())
+                .sum();
+            n.dot(r) <= 0.0
+        })
+        .count()
+}
+
+#[test]
+fn levels_have_exactly_n_p_over_100_vertices_and_stay_manifold() {
+    for (name, mesh) in [
+        ("torus", torus(40, 20, 1.0, 0.35)),
+        ("icosphere", icosphere(3)),
+    ] {
+        let chain = chain_of(&mesh);
+        let n = mesh.positions.len();
+        for p in LEVELS {
+            let level = chain.level(chain.percent(p)).unwrap();
+            let (out, origin) = compact(&mesh, &level.triangles);
+            assert_eq!(out.positions.len(), n * p as usize / 100, "{name} {p} %");
+            assert_eq!(level.vertices, out.positions.len());
+            check_manifold(&out).unwrap_or_else(|e| panic!("{name} {p} %: {e}"));
+            assert_eq!(euler(&out), euler(&mesh), "{name} {p} %: topology");
+            assert_eq!(
+                flipped(&mesh.positions, &mesh.triangles, &level.triangles),
+                0,
+                "{name} {p} %"
+            );
+            // Positions never move.
+            for (o, &v) in out.positions.iter().zip(&origin) {
+                assert_eq!(*o, mesh.positions[v as usize]);
+            }
+        }
+        // One vertex per collapse, and the chain is deterministic.
+        assert_eq!(chain.collapses, chain_of(&mesh).collapses);
+        assert!(
+            chain.min_vertices() <= n / 10,
+            "{name}: stops at {}",
+            chain.min_vertices()
+        );
+    }
+}
+
+#[test]
+fn borders_are_locked() {
+    let mesh = punch_holes(&grid(24), &[[12.0, 12.0, 0.0]], 4.0);
+    let mesh = vitrine_samples::compact(mesh);
+    let border = border_vertices(&mesh);
+    let out = melax_simplify(&mesh, Target::Fraction(0.2)).unwrap();
+    let kept: HashSet<u32> = out.origin.iter().copied().collect();
+    for (v, &b) in border.iter().enumerate() {
+        if b {
+            assert!(kept.contains(&(v as u32)), "border vertex {v} collapsed");
+        }
+    }
+    check_manifold(&out.mesh).unwrap();
+}
+
+#[test]
+fn a_flat_region_goes_before_a_crease() {
+    // A cube-ish sphere has no flat region; a grid folded along a ridge does.
+    let mut mesh = grid(16);
+    for p in &mut mesh.positions {
+        p[2] = -(p[0] - 8.0).abs();
+    }
+    let frames = [mesh.positions.clone()];
+    let chain = melax_chain(&MelaxModel {
+        triangles: &mesh.triangles,
+        frames: &frames,
+        corner_uvs: None,
+    })
+    .unwrap();
+    // Sliding along the ridge (x = 8) or within a flank is free; leaving
+    // the ridge is not, and comes after every free collapse.
+    let ridge = |v: u32| mesh.positions[v as usize][0] == 8.0;
+    let first_off = chain
+        .collapses
+        .iter()
+        .position(|c| ridge(c.gone) && !ridge(c.keep))
+        .unwrap_or(chain.collapses.len());
+    assert!(
+        first_off > 200,
+        "a ridge vertex left the ridge at collapse {first_off}"
+    );
+}
+
+#[test]
+fn animated_models_share_one_collapse_map_and_keep_their_seams() {
+    let model = sample_md2(24, 16, 6);
+    let triangles = model.mesh_triangles();
+    let corner_uvs: Vec<[u32; 3]> = model
+        .triangles
+        .iter()
+        .map(|t| [t.st[0], t.st[2], t.st[1]].map(u32::from))
+        .collect();
+    let frames: Vec<Vec<[f32; 3]>> = model.frames.iter().map(|f| f.positions()).collect();
+    let chain = melax_chain(&MelaxModel {
+        triangles: &triangles,
+        frames: &frames,
+        corner_uvs: Some(&corner_uvs),
+    })
+    .unwrap();
+    let pairs: HashSet<(u32, u32)> = triangles
+        .iter()
+        .zip(&corner_uvs)
+        .flat_map(|(t, s)| (0..3).map(move |k| (t[k], s[k])))
+        .collect();
+    // Vertices whose corners carry several texture coordinates: the seam.
+    let seam: HashSet<u32> = (0..frames[0].len() as u32)
+        .filter(|&v| pairs.iter().filter(|p| p.0 == v).count() > 1)
+        .collect();
+    assert_eq!(seam.len(), 24 + 16 - 1);
+    for p in LEVELS {
+        let level = chain.level(chain.percent(p)).unwrap();
+        let uvs = level.corner_uvs.as_ref().unwrap();
+        let used: HashSet<u32> = level.triangles.iter().flatten().copied().collect();
+        assert_eq!(used.len(), 384 * p as usize / 100);
+        assert!(
+            seam.iter().all(|v| used.contains(v)),
+            "{p} %: a seam vertex collapsed"
+        );
+        // Every corner keeps a texture coordinate its vertex had: none
+        // crossed a seam.
+        for (t, s) in level.triangles.iter().zip(uvs) {
+            for k in 0..3 {
+                assert!(
+                    pairs.contains(&(t[k], s[k])),
+                    "{p} %: corner {:?}",
+                    (t[k], s[k])
+                );
+            }
+        }
+        for (k, f) in frames.iter().enumerate() {
+            assert_eq!(
+                flipped(f, &triangles, &level.triangles),
+                0,
+                "{p} % frame {k}"
+            );
+        }
+        let mesh = IndexedMesh {
+            positions: frames[0].clone(),
+            colors: None,
+            triangles: level.triangles.clone(),
+        };
+        check_manifold(&compact(&mesh, &level.triangles).0).unwrap();
+    }
+}
+
+#[test]
+fn the_target_is_reached_exactly_or_the_stop_is_said() {
+    let mesh = torus(24, 12, 1.0, 0.3);
+    let out = melax_simplify(&mesh, Target::Vertices(50)).unwrap();
+    assert!(out.reached);
+    assert_eq!(out.mesh.positions.len(), 50);
+    let chain = chain_of(&mesh);
+    let e = chain
+        .level(chain.min_vertices().saturating_sub(1))
+        .unwrap_err();
+    assert!(e.to_string().contains("Melax stops at"), "{e}");
+}

@@ -1,0 +1,285 @@
+//! `vitrine lod`, `vitrine simplify --method melax` and MD2 through
+//! `encode --frame` / `decode -o x.md2`, as a user runs them, on a generated
+//! animated MD2 model and a generated scan. Every GLB written goes through
+//! the Khronos glTF-Validator (web/scripts/validate-gltf.mjs) and must have
+//! 0 errors.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+use serde_json::Value;
+use vitrine_mesh::export::{sample_md2, write_md2};
+use vitrine_mesh::import::md2::Md2;
+use vitrine_mesh::import::{import_path, ImportOptions};
+use vitrine_mesh::repair::check_manifold;
+
+fn vitrine(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_vitrine"))
+        .args(args)
+        .env("RUST_BACKTRACE", "0")
+        .output()
+        .expect("vitrine runs")
+}
+
+fn succeeds(args: &[&str]) -> String {
+    let out = vitrine(args);
+    let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
+    assert!(out.status.success(), "vitrine {args:?} failed: {stderr}");
+    String::from_utf8_lossy(&out.stdout).into_owned() + &stderr
+}
+
+fn text(path: &Path) -> &str {
+    path.to_str().expect("a UTF-8 temporary path")
+}
+
+/// The sample: a 24 × 16 torus (384 vertices) with 6 frames.
+fn md2_file(dir: &Path) -> (PathBuf, Md2) {
+    let model = sample_md2(24, 16, 6);
+    let path = dir.join("torus.md2");
+    let mut bytes = Vec::new();
+    write_md2(&model, &mut bytes).unwrap();
+    std::fs::write(&path, bytes).unwrap();
+    (path, model)
+}
+
+/// Runs the Khronos validator on `files`; every one must have 0 errors.
+fn assert_valid_gltf(files: &[PathBuf]) {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+    let script = root.join("web/scripts/validate-gltf.mjs");
+    assert!(
+        root.join("web/node_modules/gltf-validator").exists(),
+        "web/node_modules/gltf-validator is missing: run `npm ci` in web/ (scripts/setup.sh does)"
+    );
+    let out = Command::new("node")
+        .arg(&script)
+        .args(files)
+        .output()
+        .expect("node runs (needed for the glTF validator)");
+    let report = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "glTF validator: {report}{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let lines: Vec<Value> = report
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect();
+    assert_eq!(lines.len(), files.len());
+    for l in lines {
+        assert_eq!(l["errors"], 0, "{l}");
+    }
+}
+
+/// A GLB's JSON and BIN chunks.
+fn glb(path: &Path) -> (Value, Vec<u8>) {
+    let bytes = std::fs::read(path).unwrap();
+    let u32_at = |at: usize| u32::from_le_bytes(bytes[at..at + 4].try_into().unwrap()) as usize;
+    assert_eq!(&bytes[..4], b"glTF");
+    assert_eq!(u32_at(8), bytes.len());
+    let json_len = u32_at(12);
+    let json = serde_json::from_slice(&bytes[20..20 + json_len]).unwrap();
+    let bin_at = 20 + json_len;
+    let bin = bytes[bin_at + 8..bin_at + 8 + u32_at(bin_at)].to_vec();
+    (json, bin)
+}
+
+/// Accessor `a`'s components as 4-byte little-endian words.
+fn words(json: &Value, bin: &[u8], a: usize) -> Vec<[u8; 4]> {
+    let acc = &json["accessors"][a];
+    let view = &json["bufferViews"][acc["bufferView"].as_u64().unwrap() as usize];
+    let start = view["byteOffset"].as_u64().unwrap_or(0) as usize;
+    let len = view["byteLength"].as_u64().unwrap() as usize;
+    bin[start..start + len]
+        .chunks_exact(4)
+        .map(|c| c.try_into().unwrap())
+        .collect()
+}
+
+fn floats(json: &Value, bin: &[u8], a: usize) -> Vec<f32> {
+    words(json, bin, a)
+        .into_iter()
+        .map(f32::from_le_bytes)
+        .collect()
+}
+
+fn indices(json: &Value, bin: &[u8], a: usize) -> Vec<u32> {
+    words(json, bin, a)
+        .into_iter()
+        .map(u32::from_le_bytes)
+        .collect()
+}
+
+#[test]
+fn lod_of_an_md2_is_one_valid_glb_with_msft_lod_and_its_animation() {
+    let dir = tempfile::tempdir().unwrap();
+    let (input, model) = md2_file(dir.path());
+    let out = dir.path().join("lod.glb");
+    succeeds(&[
+        "lod",
+        text(&input),
+        "--levels",
+        "100,80,60,40,20",
+        "-o",
+        text(&out),
+    ]);
+    assert_valid_gltf(std::slice::from_ref(&out));
+    let (json, bin) = glb(&out);
+    let node = &json["nodes"][0];
+    assert_eq!(
+        node["extensions"]["MSFT_lod"]["ids"],
+        serde_json::json!([1, 2, 3, 4])
+    );
+    assert_eq!(
+        node["extras"]["MSFT_screencoverage"]
+            .as_array()
+            .unwrap()
+            .len(),
+        5
+    );
+    assert_eq!(json["extensionsUsed"], serde_json::json!(["MSFT_lod"]));
+    for (i, p) in [100usize, 80, 60, 40, 20].iter().enumerate() {
+        let prim = &json["meshes"][i]["primitives"][0];
+        let idx = indices(&json, &bin, prim["indices"].as_u64().unwrap() as usize);
+        let mut used = idx.clone();
+        used.sort_unstable();
+        used.dedup();
+        assert_eq!(used.len(), 384 * p / 100, "level {p} %");
+        assert_eq!(prim["targets"].as_array().unwrap().len(), 5);
+    }
+    // Frame midpoints: the animation's LINEAR weights at (k + ½)/fps give
+    // the linear interpolation of frames k and k + 1.
+    let frames: Vec<Vec<[f32; 3]>> = model.frames.iter().map(|f| f.positions()).collect();
+    let base = floats(&json, &bin, 0);
+    let anim = &json["animations"][0];
+    let sampler = &anim["samplers"][0];
+    assert_eq!(sampler["interpolation"], "LINEAR");
+    let times = floats(&json, &bin, sampler["input"].as_u64().unwrap() as usize);
+    assert_eq!(times, (0..6).map(|k| k as f32 / 10.0).collect::<Vec<_>>());
+    let keys = floats(&json, &bin, sampler["output"].as_u64().unwrap() as usize);
+    let targets: Vec<Vec<f32>> = json["meshes"][0]["primitives"][0]["targets"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|t| floats(&json, &bin, t["POSITION"].as_u64().unwrap() as usize))
+        .collect();
+    for k in 0..5 {
+        let t = (k as f32 + 0.5) / 10.0;
+        let s = (t - times[k]) / (times[k + 1] - times[k]);
+        let weight = |j: usize| keys[k * 5 + j] * (1.0 - s) + keys[(k + 1) * 5 + j] * s;
+        for v in 0..384 {
+            for c in 0..3 {
+                let morphed: f32 = base[3 * v + c]
+                    + (0..5)
+                        .map(|j| weight(j) * targets[j][3 * v + c])
+                        .sum::<f32>();
+                let midpoint = (frames[k][v][c] + frames[k + 1][v][c]) / 2.0;
+                assert!(
+                    (morphed - midpoint).abs() <= 1e-5 * midpoint.abs().max(1.0),
+                    "frame {k}+½ vertex {v}: {morphed} vs {midpoint}"
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn lod_splits_into_glbs_and_md2s_of_exact_sizes() {
+    let dir = tempfile::tempdir().unwrap();
+    let (input, model) = md2_file(dir.path());
+    let out = dir.path().join("knight.glb");
+    succeeds(&["lod", text(&input), "--split", "-o", text(&out)]);
+    let files: Vec<PathBuf> = [100, 80, 60, 40, 20]
+        .iter()
+        .map(|p| dir.path().join(format!("knight-{p}.glb")))
+        .collect();
+    assert_valid_gltf(&files);
+    succeeds(&["lod", text(&input), "--format", "md2", "-o", text(&out)]);
+    for p in [100usize, 80, 60, 40, 20] {
+        let path = dir.path().join(format!("knight-{p}.md2"));
+        let bytes = std::fs::read(&path).unwrap();
+        let level = Md2::parse(&bytes, &ImportOptions::default()).unwrap();
+        assert_eq!(level.vertex_count(), 384 * p / 100, "{p} %");
+        assert_eq!(level.frames.len(), 6);
+        // Packed vertices are the input's, bit for bit.
+        for (f, g) in level.frames.iter().zip(&model.frames) {
+            assert!(f
+                .vertices
+                .iter()
+                .all(|v| g.vertices.iter().any(|w| w[..3] == v[..3])));
+            assert_eq!((f.scale, f.translate), (g.scale, g.translate));
+        }
+        let mut again = Vec::new();
+        write_md2(&level, &mut again).unwrap();
+        assert_eq!(again, bytes, "{p} %: re-written byte-identical");
+        let mesh = import_path(&path, &ImportOptions::default()).unwrap();
+        check_manifold(&vitrine_samples::compact(mesh)).unwrap();
+    }
+}
+
+#[test]
+fn lod_of_a_scan_and_melax_simplify() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("plate.ply");
+    let mesh = vitrine_samples::plate_with_tunnels(3, 6);
+    let n = mesh.positions.len();
+    let file = std::fs::File::create(&input).unwrap();
+    vitrine_mesh::export::write_ply(&mesh, &mut std::io::BufWriter::new(file)).unwrap();
+    let out = dir.path().join("plate.glb");
+    succeeds(&[
+        "lod",
+        text(&input),
+        "--levels",
+        "100,50,20",
+        "-o",
+        text(&out),
+    ]);
+    assert_valid_gltf(std::slice::from_ref(&out));
+    let simplified = dir.path().join("melax.glb");
+    let report = succeeds(&[
+        "simplify",
+        text(&input),
+        "--method",
+        "melax",
+        "--target-fraction",
+        "0.3",
+        "--hausdorff-samples",
+        "5000",
+        "-o",
+        text(&simplified),
+    ]);
+    let want = (0.3 * n as f64).round() as usize;
+    assert!(report.contains(&format!("→ {want} vertices")), "{report}");
+    assert!(report.contains("stopped: target"), "{report}");
+    let back = import_path(&simplified, &ImportOptions::default()).unwrap();
+    assert_eq!(back.positions.len(), want);
+    check_manifold(&back).unwrap();
+    assert_valid_gltf(std::slice::from_ref(&simplified));
+}
+
+#[test]
+fn an_md2_frame_encodes_and_decodes_to_md2() {
+    let dir = tempfile::tempdir().unwrap();
+    let (input, model) = md2_file(dir.path());
+    let stream = dir.path().join("torus.vtr");
+    succeeds(&["encode", text(&input), "--frame", "3", "-o", text(&stream)]);
+    let level = dir.path().join("level.md2");
+    succeeds(&["decode", text(&stream), "-o", text(&level)]);
+    let back = import_path(&level, &ImportOptions::default()).unwrap();
+    assert_eq!(back.positions.len(), 384);
+    // Frame 3's bounding box, within the stream's and MD2's quantization.
+    let frame = model.frames[3].positions();
+    let extent = |ps: &[[f32; 3]], k: usize| {
+        let (lo, hi) = ps
+            .iter()
+            .fold((f32::MAX, f32::MIN), |(l, h), p| (l.min(p[k]), h.max(p[k])));
+        hi - lo
+    };
+    for k in 0..3 {
+        let (a, b) = (extent(&back.positions, k), extent(&frame, k));
+        assert!((a - b).abs() < 0.02 * b.max(1.0), "axis {k}: {a} vs {b}");
+    }
+    let missing = vitrine(&["encode", text(&input), "--frame", "6", "-o", text(&stream)]);
+    assert!(!missing.status.success());
+    assert!(String::from_utf8_lossy(&missing.stderr).contains("has 6 frames"));
+}
