@@ -11,6 +11,9 @@
 //!   edge, half-edge or triangle collapses of the vertices off the borders
 //!   and away from features, each checked (link condition, no flips), down
 //!   to an exact vertex count.
+//! - [`simplify_voronoi`]: the intrinsic Voronoi simplifier (Oliveira,
+//!   seed 001): geodesic discs, their Voronoi diagram refined to the
+//!   closed-ball property, and its dual; input vertices only, topology kept.
 //!
 //! ```
 //! use vitrine_simplify::{simplify, Collapse, SimplifyOptions, StopReason, Target};
@@ -30,6 +33,7 @@
 mod collapse;
 pub mod deviation;
 mod feature_guard;
+pub mod voronoi;
 
 pub use collapse::{
     simplify, simplify_with, Cleanup, Collapse, PassReport, Simplified, SimplifyOptions,
@@ -37,3 +41,4 @@ pub use collapse::{
 };
 pub use deviation::{border_vertices, normal_deviation, one_ring_max, VertexFaces};
 pub use feature_guard::{FeatureGuard, FeatureThreshold, DEFAULT_FEATURE_SHARE};
+pub use voronoi::{simplify_voronoi, Distance, Order, Radius, VoronoiOptions, VoronoiSimplified};
