@@ -8,8 +8,11 @@
 //! - `table MESH R…`: the seed's Tabela 4.2 configurations (Dijkstra or
 //!   fast marching × incremental, farthest or curvature order) at each r:
 //!   output triangles, refinement rounds and time per stage.
-//! - `timing [FACES]`: a generated torus of FACES triangles (default
-//!   150 000), every configuration, whole time on one core.
+//! - `timing [FACES [CODE R]]`: a generated torus of FACES triangles
+//!   (default 150 000), every configuration at r = 0.02 and 0.05, or only
+//!   CODE (DI, DD, …) at R, so that `time` can give its CPU seconds.
+//!
+//! Run as:
 //!
 //!     pip install fast-simplification plyfile numpy
 //!     cargo run --release -p vitrine-simplify --example voronoi_bench -- hausdorff \
@@ -141,23 +144,35 @@ fn hausdorff_table(mut args: Vec<String>) -> Result<(), Failure> {
 fn configurations(label: &str, mesh: &IndexedMesh, radii: &[f64]) -> Result<(), Failure> {
     for &r in radii {
         for (code, distance, order) in CONFIGURATIONS {
-            let (out, s) = ours(mesh, distance, order, r)?;
-            let st = out.stages;
-            println!(
-                "| {label} ({}) | {code} | {r} | {} | {} → {} | {} | {:.2} | {:.2} / {:.2} / {:.2} / {:.2} |",
-                mesh.triangles.len(),
-                out.mesh.triangles.len(),
-                out.cover_sites,
-                out.sites,
-                out.rounds,
-                s,
-                st.cover.as_secs_f64(),
-                st.diagram.as_secs_f64(),
-                st.refinement.as_secs_f64(),
-                st.dual.as_secs_f64(),
-            );
+            configuration(label, mesh, code, distance, order, r)?;
         }
     }
+    Ok(())
+}
+
+fn configuration(
+    label: &str,
+    mesh: &IndexedMesh,
+    code: &str,
+    distance: Distance,
+    order: Order,
+    r: f64,
+) -> Result<(), Failure> {
+    let (out, s) = ours(mesh, distance, order, r)?;
+    let st = out.stages;
+    println!(
+        "| {label} ({}) | {code} | {r} | {} | {} → {} | {} | {:.2} | {:.2} / {:.2} / {:.2} / {:.2} |",
+        mesh.triangles.len(),
+        out.mesh.triangles.len(),
+        out.cover_sites,
+        out.sites,
+        out.rounds,
+        s,
+        st.cover.as_secs_f64(),
+        st.diagram.as_secs_f64(),
+        st.refinement.as_secs_f64(),
+        st.dual.as_secs_f64(),
+    );
     Ok(())
 }
 
@@ -191,7 +206,14 @@ fn main() -> Result<(), Failure> {
             let rings = faces / (2 * sides);
             let mesh = vitrine_samples::torus(rings, sides, 1.0, 0.35);
             println!("{CONFIG_HEADER}");
-            configurations("torus", &mesh, &[0.02, 0.05])
+            match (args.get(1), args.get(2)) {
+                (Some(code), Some(r)) => {
+                    let only: Vec<_> = CONFIGURATIONS.iter().filter(|c| c.0 == code).collect();
+                    let &&(code, distance, order) = only.first().ok_or("no such configuration")?;
+                    configuration("torus", &mesh, code, distance, order, r.parse()?)
+                }
+                _ => configurations("torus", &mesh, &[0.02, 0.05]),
+            }
         }
         other => Err(format!("unknown mode {other}").into()),
     }
