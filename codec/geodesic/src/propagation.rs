@@ -91,10 +91,10 @@ impl<'s> Propagation<'s> {
         }
     }
 
-    /// From now on, log every vertex brought closer, for
+    /// Whether to log every vertex brought closer from now on, for
     /// [`Propagation::take_changed`] (the farthest-point cover reads it).
-    pub fn track_changes(&mut self) {
-        self.changed.get_or_insert_with(Vec::new);
+    pub fn track_changes(&mut self, on: bool) {
+        self.changed = on.then(Vec::new);
     }
 
     /// The vertices brought closer since the last call (with repeats).

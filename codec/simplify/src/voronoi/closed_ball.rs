@@ -183,3 +183,71 @@ impl Forest {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Labels of the sphere's vertices by the nearest of `directions`.
+    fn nearest_of(surface: &Surface, directions: &[[f64; 3]]) -> Vec<u32> {
+        (0..surface.vertex_count() as u32)
+            .map(|v| {
+                let p = surface.position(v);
+                let score = |d: &[f64; 3]| p.dot(glam::DVec3::from(*d));
+                (0..directions.len())
+                    .max_by(|&a, &b| score(&directions[a]).total_cmp(&score(&directions[b])))
+                    .unwrap() as u32
+            })
+            .collect()
+    }
+
+    fn sphere() -> Surface {
+        Surface::new(&vitrine_samples::icosphere(3)).unwrap()
+    }
+
+    #[test]
+    fn four_cells_like_a_tetrahedron_have_the_property() {
+        let s = sphere();
+        let tetra = [
+            [1.0, 1.0, 1.0],
+            [1.0, -1.0, -1.0],
+            [-1.0, 1.0, -1.0],
+            [-1.0, -1.0, 1.0],
+        ];
+        assert_eq!(violations(&s, &nearest_of(&s, &tetra), 4), vec![]);
+    }
+
+    #[test]
+    fn one_cell_is_a_sphere_two_meet_in_a_loop_three_in_two_points() {
+        let s = sphere();
+        let one = vec![0; s.vertex_count()];
+        assert_eq!(violations(&s, &one, 1), vec![Violation::Cell(0)]);
+        let two = nearest_of(&s, &[[0.3, 0.1, 1.0], [-0.3, -0.1, -1.0]]);
+        assert_eq!(violations(&s, &two, 2), vec![Violation::Pair(0, 1)]);
+        // Three wedges around an axis: each pair meets in an arc from pole
+        // to pole, and all three at both poles.
+        let wedges = nearest_of(
+            &s,
+            &[[1.0, 0.05, 0.1], [-0.5, 0.87, 0.1], [-0.5, -0.87, 0.1]],
+        );
+        let found = violations(&s, &wedges, 3);
+        assert!(found.contains(&Violation::Triple([0, 1, 2])), "{found:?}");
+        assert!(
+            !found.iter().any(|v| matches!(v, Violation::Cell(_))),
+            "{found:?}"
+        );
+    }
+
+    #[test]
+    fn a_cell_in_two_pieces_or_an_annulus_is_not_a_disc() {
+        let s = sphere();
+        // Cell 0 at both poles, cell 1 the band between: 0 is in two
+        // pieces, 1 is an annulus (χ = 0).
+        let labels: Vec<u32> = (0..s.vertex_count() as u32)
+            .map(|v| u32::from(s.position(v).z.abs() < 0.5))
+            .collect();
+        let found = violations(&s, &labels, 2);
+        assert!(found.contains(&Violation::Cell(0)), "{found:?}");
+        assert!(found.contains(&Violation::Cell(1)), "{found:?}");
+    }
+}

@@ -78,7 +78,7 @@ pub(super) fn farthest_points(
     radius: f64,
     first_label: u32,
 ) -> Vec<u32> {
-    front.track_changes();
+    front.track_changes(true);
     front.run(f64::INFINITY);
     // Largest distance first, then lowest vertex.
     let mut heap: BinaryHeap<(u64, Reverse<u32>)> = candidates
@@ -102,6 +102,7 @@ pub(super) fn farthest_points(
             heap.push((ordered(front.distance(w)), Reverse(w)));
         }
     }
+    front.track_changes(false);
     centres
 }
 
