@@ -261,3 +261,178 @@ fn simplify_refuses_bad_arguments() {
     assert!(e.contains("must end in .ply, .obj, .glb or .md2"), "{e}");
     assert!(!ply.exists() && !stl.exists());
 }
+
+/// The genus-3 plate's χ, components and border loops, and whether every
+/// vertex of `out` is one of `input`'s, bit for bit.
+fn same_topology_and_vertices(input: &IndexedMesh, out: &IndexedMesh) {
+    use std::collections::HashSet;
+    let counts = |m: &IndexedMesh| {
+        let s = vitrine_geodesic_surface(m);
+        let used = (0..s.vertex_count() as u32)
+            .filter(|&v| !s.faces_of(v).is_empty())
+            .count() as i64;
+        let chi = used - (s.edge_ids() / 2) as i64 + m.triangles.len() as i64;
+        (chi, s.components().0, s.boundary_loops().len())
+    };
+    assert_eq!(counts(out), counts(input));
+    let bits: HashSet<[u32; 3]> = input
+        .positions
+        .iter()
+        .map(|p| p.map(f32::to_bits))
+        .collect();
+    assert!(out
+        .positions
+        .iter()
+        .all(|p| bits.contains(&p.map(f32::to_bits))));
+}
+
+fn vitrine_geodesic_surface(mesh: &IndexedMesh) -> vitrine_geodesic::Surface {
+    vitrine_geodesic::Surface::new(mesh).expect("a manifold")
+}
+
+#[test]
+fn simplify_by_voronoi_keeps_the_plates_topology_in_every_configuration() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = plate(dir.path());
+    let original = repaired(&input);
+    for (distance, order) in [
+        ("dijkstra", "incremental"),
+        ("fmm", "farthest"),
+        ("fmm", "curvature"),
+    ] {
+        let output = dir.path().join(format!("{distance}-{order}.ply"));
+        let (stdout, _) = succeeds(&[
+            "simplify",
+            text(&input),
+            "--method",
+            "voronoi",
+            "--distance",
+            distance,
+            "--order",
+            order,
+            "--radius",
+            "0.05",
+            "--hausdorff-samples",
+            "20000",
+            "--json",
+            "-o",
+            text(&output),
+        ]);
+        let report: serde_json::Value = serde_json::from_str(&stdout).expect("JSON on stdout");
+        assert_eq!(report["method"], "voronoi");
+        assert_eq!(report["stopped"], "radius");
+        assert_eq!(report["voronoi"]["distance"], distance);
+        assert_eq!(report["voronoi"]["order"], order);
+        assert_eq!(report["voronoi"]["radius"], 0.05);
+        let mesh = read(&output);
+        check_manifold(&mesh).unwrap_or_else(|e| panic!("{distance} {order}: {e}"));
+        assert!(
+            mesh.face_count() * 4 < original.face_count(),
+            "{}",
+            mesh.face_count()
+        );
+        assert_eq!(report["output"]["faces"], mesh.face_count());
+        same_topology_and_vertices(&original, &mesh);
+    }
+}
+
+#[test]
+fn simplify_by_voronoi_to_a_vertex_target_or_fraction() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = plate(dir.path());
+    let output = dir.path().join("v.obj");
+    let (stdout, _) = succeeds(&[
+        "simplify",
+        text(&input),
+        "--method",
+        "voronoi",
+        "--target-vertices",
+        "300",
+        "--hausdorff-samples",
+        "20000",
+        "-o",
+        text(&output),
+    ]);
+    assert!(
+        stdout.contains("voronoi (dijkstra distance, farthest order"),
+        "{stdout}"
+    );
+    let got = read(&output).vertex_count();
+    assert!(got.abs_diff(300) <= 30, "{got}");
+    // A fraction is a vertex target of that share of the input (5504).
+    let (stdout, _) = succeeds(&[
+        "simplify",
+        text(&input),
+        "--method",
+        "voronoi",
+        "--target-fraction",
+        "0.05",
+        "--hausdorff-samples",
+        "20000",
+        "--json",
+        "-o",
+        text(&output),
+    ]);
+    let report: serde_json::Value = serde_json::from_str(&stdout).unwrap();
+    let got = report["output"]["vertices"].as_u64().unwrap();
+    assert!(got.abs_diff(275) <= 28, "{got}");
+    assert!(matches!(
+        report["stopped"].as_str(),
+        Some("target" | "nearest")
+    ));
+}
+
+#[test]
+fn simplify_by_voronoi_refuses_bad_arguments_and_input() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = plate(dir.path());
+    let out = dir.path().join("out.ply");
+    let base = |rest: &[&str]| {
+        let mut args = vec!["simplify", text(&input), "-o", text(&out)];
+        args.extend_from_slice(rest);
+        fails(&args)
+    };
+    let e = base(&[
+        "--method",
+        "voronoi",
+        "--radius",
+        "0.05",
+        "--target-vertices",
+        "10",
+    ]);
+    assert!(e.contains("cannot be used with"), "{e}");
+    let e = base(&["--method", "voronoi", "--radius", "0"]);
+    assert!(e.contains("must be a number within (0, 10]"), "{e}");
+    let e = base(&[
+        "--method",
+        "voronoi",
+        "--radius",
+        "0.1",
+        "--distance",
+        "euclid",
+    ]);
+    assert!(e.contains("invalid value 'euclid'"), "{e}");
+    let e = base(&["--method", "normal-deviation", "--radius", "0.1"]);
+    assert!(
+        e.contains("--radius applies to --method voronoi only"),
+        "{e}"
+    );
+    let empty = dir.path().join("empty.ply");
+    std::fs::write(
+        &empty,
+        "ply\nformat ascii 1.0\nelement vertex 0\nproperty float x\nproperty float y\nproperty float z\nelement face 0\nproperty list uchar int vertex_indices\nend_header\n",
+    )
+    .unwrap();
+    let e = fails(&[
+        "simplify",
+        text(&empty),
+        "--method",
+        "voronoi",
+        "--radius",
+        "0.1",
+        "-o",
+        text(&out),
+    ]);
+    assert!(!e.contains("panicked"), "{e}");
+    assert!(!out.exists());
+}

@@ -78,6 +78,29 @@ export class VitrineCodec {
   }
 
   /**
+   * A decoded level's surface, for geodesic measurements between picked
+   * points (crate vitrine-geodesic).
+   * @param {Float32Array} positions x, y, z per vertex
+   * @param {Uint32Array} indices three per triangle
+   * @returns {SurfaceDistance}
+   */
+  surface(positions, indices) {
+    const e = this.exports;
+    const p = e.geodesic_positions(positions.length);
+    new Float32Array(e.memory.buffer, p, positions.length).set(positions);
+    const i = e.geodesic_indices(indices.length);
+    new Uint32Array(e.memory.buffer, i, indices.length).set(indices);
+    const handle = e.geodesic_new();
+    if (handle === 0) throw this.#error();
+    return new SurfaceDistance(this, handle);
+  }
+
+  /** The last error as a DecodeError. */
+  lastError() {
+    return this.#error();
+  }
+
+  /**
    * A view on a level buffer inside the WebAssembly memory (no copy): valid
    * only until the next call into the decoder, which may move or grow it.
    * @param {number} handle
@@ -157,6 +180,54 @@ export class StreamDecoder {
 
   free() {
     this.codec.exports.decoder_free(this.handle);
+  }
+}
+
+/** Geodesic distance by Dijkstra on edges (0) or fast marching on faces (1). */
+export const DIJKSTRA = 0;
+export const FAST_MARCHING = 1;
+
+/**
+ * Distance along a level's surface (see VitrineCodec.surface). Points are
+ * positions; each is taken to the nearest point of the surface.
+ */
+export class SurfaceDistance {
+  /**
+   * @param {VitrineCodec} codec
+   * @param {number} handle
+   */
+  constructor(codec, handle) {
+    this.codec = codec;
+    this.handle = handle;
+  }
+
+  /**
+   * Distance along the surface between two points (Infinity across parts).
+   * @param {ArrayLike<number>} from x, y, z
+   * @param {ArrayLike<number>} to x, y, z
+   * @param {number} [method] DIJKSTRA or FAST_MARCHING (default)
+   */
+  distance(from, to, method = FAST_MARCHING) {
+    const d = this.codec.exports.geodesic_distance(this.handle, method, from[0], from[1], from[2], to[0], to[1], to[2]);
+    if (Number.isNaN(d)) throw this.codec.lastError();
+    return d;
+  }
+
+  /**
+   * Distance from a point to every vertex (a copy).
+   * @param {ArrayLike<number>} from x, y, z
+   * @param {number} [method] DIJKSTRA or FAST_MARCHING (default)
+   * @returns {Float64Array}
+   */
+  field(from, method = FAST_MARCHING) {
+    const e = this.codec.exports;
+    const ptr = e.geodesic_field(this.handle, method, from[0], from[1], from[2]);
+    if (ptr === 0) throw this.codec.lastError();
+    return new Float64Array(e.memory.buffer.slice(ptr, ptr + 8 * e.geodesic_field_len()));
+  }
+
+  free() {
+    this.codec.exports.geodesic_free(this.handle);
   }
 }
 

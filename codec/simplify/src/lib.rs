@@ -14,6 +14,9 @@
 //! - [`melax`]: Melax's progressive edge collapse (seed 003) for levels of
 //!   detail: heap-ordered, checked like [`simplify`], seams and borders
 //!   kept, one collapse order for every frame of an animated model.
+//! - [`simplify_voronoi`]: the intrinsic Voronoi simplifier (Oliveira,
+//!   seed 001): geodesic discs, their Voronoi diagram refined to the
+//!   closed-ball property, and its dual; input vertices only, topology kept.
 //!
 //! ```
 //! use vitrine_simplify::{simplify, Collapse, SimplifyOptions, StopReason, Target};
@@ -34,6 +37,7 @@ mod collapse;
 pub mod deviation;
 mod feature_guard;
 pub mod melax;
+pub mod voronoi;
 
 pub use collapse::{
     simplify, simplify_with, Cleanup, Collapse, PassReport, Simplified, SimplifyOptions,
@@ -41,3 +45,4 @@ pub use collapse::{
 };
 pub use deviation::{border_vertices, normal_deviation, one_ring_max, VertexFaces};
 pub use feature_guard::{FeatureGuard, FeatureThreshold, DEFAULT_FEATURE_SHARE};
+pub use voronoi::{simplify_voronoi, Distance, Order, Radius, VoronoiOptions, VoronoiSimplified};

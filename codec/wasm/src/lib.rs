@@ -12,9 +12,14 @@
 //!    before the next call, which may move memory.
 //! 4. On error `error_ptr()` / `error_len()` give a UTF-8 message.
 //!
+//! [`geodesic`] adds distance along the surface of a decoded level, for
+//! the viewer's measurement tool.
+//!
 //! Exported symbols need `#[no_mangle]`, which the `unsafe_code` lint flags;
 //! nothing here dereferences a raw pointer: all memory is Rust-owned `Vec`s.
 #![deny(unsafe_code)]
+
+pub mod geodesic;
 
 use std::cell::RefCell;
 use vitrine_codec::{Decoder, Limits};

@@ -14,6 +14,7 @@ pub mod models;
 pub mod sample;
 pub mod serve;
 pub mod simplify;
+pub mod simplify_voronoi;
 pub mod study;
 pub mod token;
 

@@ -27,6 +27,11 @@ pub enum Method {
     /// borders locked, link condition and flips checked; positions never
     /// move.
     Melax,
+    /// Geodesic discs, their intrinsic Voronoi diagram refined to the
+    /// closed-ball property, and its dual (seed 001): input vertices only,
+    /// genus, components and borders kept (`--distance`, `--order`,
+    /// `--radius`).
+    Voronoi,
 }
 
 impl Method {
@@ -35,6 +40,7 @@ impl Method {
         match self {
             Method::NormalDeviation => "normal-deviation",
             Method::Melax => "melax",
+            Method::Voronoi => "voronoi",
         }
     }
 }
@@ -69,6 +75,8 @@ pub struct SimplifyArgs {
     /// angle in degrees (`12` or `12deg`) or a percentile (`p95`).
     #[arg(long, value_name = "mean+2sigma|DEG|pP", default_value = "mean+2sigma")]
     pub feature_threshold: FeatureThreshold,
+    #[command(flatten)]
+    pub voronoi: super::simplify_voronoi::VoronoiArgs,
     /// Area samples per mesh for the Hausdorff distance (plus every vertex).
     #[arg(long, default_value_t = 200_000)]
     pub hausdorff_samples: usize,
@@ -87,16 +95,26 @@ pub struct TargetArgs {
     /// Fraction of the input's vertices in the output, within (0, 1].
     #[arg(long, value_name = "F", value_parser = parse_fraction)]
     pub target_fraction: Option<f64>,
+    /// voronoi: the disc radius as a fraction of the bounding-box diagonal.
+    #[arg(long, value_name = "R", value_parser = parse_radius)]
+    pub radius: Option<f64>,
 }
 
 impl TargetArgs {
-    fn target(&self) -> Target {
+    fn target(&self) -> anyhow::Result<Target> {
         match (self.target_vertices, self.target_fraction) {
-            (Some(n), _) => Target::Vertices(n as usize),
-            (None, Some(f)) => Target::Fraction(f),
-            // clap's group requires one of them.
-            (None, None) => unreachable!("no target"),
+            (Some(n), _) => Ok(Target::Vertices(n as usize)),
+            (None, Some(f)) => Ok(Target::Fraction(f)),
+            // clap's group requires one of the three; --radius is voronoi's.
+            (None, None) => anyhow::bail!("--radius applies to --method voronoi only"),
         }
+    }
+}
+
+fn parse_radius(s: &str) -> Result<f64, String> {
+    match s.parse::<f64>() {
+        Ok(r) if r > 0.0 && r <= 10.0 => Ok(r),
+        _ => Err(format!("must be a number within (0, 10], got {s:?}")),
     }
 }
 
@@ -128,6 +146,9 @@ pub struct SimplifyReport {
     pub collapse: Option<&'static str>,
     #[serde(skip_serializing_if = "Option::is_none")]
     pub feature_threshold_degrees: Option<f64>,
+    /// voronoi's parameters and counts.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub voronoi: Option<super::simplify_voronoi::VoronoiReport>,
 }
 
 #[derive(Clone, Copy, Debug, Serialize)]
@@ -152,6 +173,7 @@ struct Outcome {
     stopped: &'static str,
     collapse: Option<&'static str>,
     feature_threshold_degrees: Option<f64>,
+    voronoi: Option<super::simplify_voronoi::VoronoiReport>,
 }
 
 pub fn run(args: SimplifyArgs) -> anyhow::Result<()> {
@@ -161,6 +183,7 @@ pub fn run(args: SimplifyArgs) -> anyhow::Result<()> {
     let outcome = match args.method {
         Method::NormalDeviation => normal_deviation(&input, &args)?,
         Method::Melax => melax(&input, &args)?,
+        Method::Voronoi => voronoi(&input, &args)?,
     };
     let seconds = started.elapsed().as_secs_f64();
     format.write(&outcome.mesh, &args.output)?;
@@ -196,7 +219,7 @@ fn normal_deviation(mesh: &IndexedMesh, args: &SimplifyArgs) -> anyhow::Result<O
     };
     let options = SimplifyOptions {
         collapse,
-        target: args.target.target(),
+        target: args.target.target()?,
         threshold: args.feature_threshold,
         ..SimplifyOptions::default()
     };
@@ -211,11 +234,30 @@ fn normal_deviation(mesh: &IndexedMesh, args: &SimplifyArgs) -> anyhow::Result<O
         },
         collapse: Some(name),
         feature_threshold_degrees: Some(out.threshold_radians.to_degrees()),
+        voronoi: None,
+    })
+}
+
+fn voronoi(mesh: &IndexedMesh, args: &SimplifyArgs) -> anyhow::Result<Outcome> {
+    let t = &args.target;
+    let flags = super::simplify_voronoi::TargetFlags {
+        radius: t.radius,
+        target_vertices: t.target_vertices,
+        target_fraction: t.target_fraction,
+    };
+    let out = super::simplify_voronoi::run(mesh, &args.voronoi, flags)?;
+    Ok(Outcome {
+        mesh: out.mesh,
+        passes: out.rounds,
+        stopped: out.stopped,
+        collapse: None,
+        feature_threshold_degrees: None,
+        voronoi: Some(out.report),
     })
 }
 
 fn melax(mesh: &IndexedMesh, args: &SimplifyArgs) -> anyhow::Result<Outcome> {
-    let out = melax_simplify(mesh, args.target.target())?;
+    let out = melax_simplify(mesh, args.target.target()?)?;
     Ok(Outcome {
         mesh: out.mesh,
         passes: 1,
@@ -226,6 +268,7 @@ fn melax(mesh: &IndexedMesh, args: &SimplifyArgs) -> anyhow::Result<Outcome> {
         },
         collapse: None,
         feature_threshold_degrees: None,
+        voronoi: None,
     })
 }
 
@@ -247,6 +290,7 @@ fn measure(
         seconds,
         collapse: outcome.collapse,
         feature_threshold_degrees: outcome.feature_threshold_degrees,
+        voronoi: outcome.voronoi,
     }
 }
 
@@ -262,7 +306,10 @@ fn print_report(r: &SimplifyReport, output: &Path) {
     );
     let parameters = match (r.collapse, r.feature_threshold_degrees) {
         (Some(c), Some(t)) => format!(" ({c} collapses, feature threshold {t:.2}°)"),
-        _ => String::new(),
+        _ => r
+            .voronoi
+            .as_ref()
+            .map_or_else(String::new, super::simplify_voronoi::describe),
     };
     println!(
         "{}{parameters}: {} passes, stopped: {}",

@@ -1,0 +1,385 @@
+//! Simplification from the intrinsic Voronoi diagram (Oliveira 2011, seed
+//! 001, with the repairs of SEEDS.md 001): cover the surface with geodesic
+//! discs of radius r, label every vertex with its nearest centre by one
+//! multi-source propagation, split the cells that break the closed-ball
+//! property (halving their radius and re-covering what falls outside it,
+//! re-propagating only from the new sites) until none does, and take the
+//! dual. The output's vertices are input vertices, bit for bit, and it has
+//! the input's genus, components and border loops (holes are coned while
+//! the diagram is built: `closure`).
+
+mod closed_ball;
+mod closure;
+mod cover;
+mod curvature;
+mod dual;
+mod search;
+
+use std::time::{Duration, Instant};
+
+use vitrine_codec::{Error, IndexedMesh, Result};
+use vitrine_geodesic::{Propagation, Surface};
+
+/// How geodesic distance is measured (`vitrine_geodesic::Method`).
+pub use vitrine_geodesic::Method as Distance;
+
+use closed_ball::Violation;
+use closure::Closed;
+pub use cover::Order;
+
+/// The disc radius.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Radius {
+    /// r as this fraction of the bounding box's diagonal (the seed gives no
+    /// unit; SEEDS.md 001).
+    Fraction(f64),
+    /// The r whose output has the vertex count nearest to this, by search.
+    TargetVertices(usize),
+}
+
+/// Parameters of [`simplify_voronoi`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct VoronoiOptions {
+    pub distance: Distance,
+    pub order: Order,
+    pub radius: Radius,
+    /// Refinement rounds at most before giving up with an error.
+    pub max_rounds: usize,
+}
+
+impl Default for VoronoiOptions {
+    fn default() -> Self {
+        VoronoiOptions {
+            distance: Distance::Dijkstra,
+            order: Order::Farthest,
+            radius: Radius::Fraction(0.05),
+            max_rounds: 500,
+        }
+    }
+}
+
+/// Time spent in each stage (the seed's Tabela 4.2 splits them so).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Stages {
+    pub cover: Duration,
+    pub diagram: Duration,
+    pub refinement: Duration,
+    pub dual: Duration,
+}
+
+/// The simplified mesh and how it came about.
+#[derive(Clone, Debug)]
+pub struct VoronoiSimplified {
+    /// Only input vertices (the sites), in input order, positions and
+    /// colours copied; faces oriented as the input.
+    pub mesh: IndexedMesh,
+    /// For each output vertex, the input vertex it is.
+    pub origin: Vec<u32>,
+    /// r over the bounding box's diagonal, as given or as the search found.
+    pub radius_fraction: f64,
+    /// Sites at the end (cones included) and at the end of the cover.
+    pub sites: usize,
+    pub cover_sites: usize,
+    /// Refinement rounds, and cells split over all of them.
+    pub rounds: usize,
+    pub splits: usize,
+    /// Radii tried (1 unless searching for a vertex count).
+    pub attempts: usize,
+    /// Of the last attempt.
+    pub stages: Stages,
+}
+
+/// Simplifies `mesh` (an oriented 2-manifold, borders allowed: what
+/// `vitrine_mesh::repair::prepare` produces). Errors on a mesh that is not
+/// one, on NaN coordinates, on no faces and on a radius out of range.
+pub fn simplify_voronoi(mesh: &IndexedMesh, options: &VoronoiOptions) -> Result<VoronoiSimplified> {
+    if mesh.triangles.is_empty() {
+        return Err(Error::input("mesh", "it has no faces"));
+    }
+    if mesh
+        .colors
+        .as_ref()
+        .is_some_and(|c| c.len() != mesh.positions.len())
+    {
+        return Err(Error::input(
+            "mesh",
+            "its colours do not match its vertices",
+        ));
+    }
+    let closed = Closed::new(mesh)?;
+    if closed.surface.diagonal() <= 0.0 {
+        return Err(Error::input("mesh", "all its vertices coincide"));
+    }
+    let curvature =
+        (options.order == Order::Curvature).then(|| curvature::gaussian_curvature(&closed.surface));
+    let run =
+        |fraction: f64| Diagram::simplify(&closed, mesh, curvature.as_deref(), options, fraction);
+    match options.radius {
+        Radius::Fraction(f) if f.is_finite() && f > 0.0 && f <= 10.0 => run(f),
+        Radius::Fraction(f) => Err(Error::Parameter(format!(
+            "radius must be a fraction of the diagonal within (0, 10], got {f}"
+        ))),
+        Radius::TargetVertices(0) => Err(Error::Parameter(
+            "target vertices must be at least 1".into(),
+        )),
+        Radius::TargetVertices(n) => search::nearest(&closed.surface, n, run),
+    }
+}
+
+/// The diagram as it is refined: the sites (cones first), their radii and
+/// the front that labels every vertex.
+struct Diagram<'a> {
+    closed: &'a Closed,
+    options: &'a VoronoiOptions,
+    curvature: Option<&'a [f64]>,
+    site_vertex: Vec<u32>,
+    radius: Vec<f64>,
+    front: Propagation<'a>,
+    scratch: Propagation<'a>,
+}
+
+impl<'a> Diagram<'a> {
+    fn simplify(
+        closed: &'a Closed,
+        mesh: &IndexedMesh,
+        curvature: Option<&'a [f64]>,
+        options: &'a VoronoiOptions,
+        fraction: f64,
+    ) -> Result<VoronoiSimplified> {
+        let surface = &closed.surface;
+        let r = fraction * surface.diagonal();
+        let mut stages = Stages::default();
+        let mut diagram = Diagram {
+            closed,
+            options,
+            curvature,
+            site_vertex: (closed.first_cone..surface.vertex_count() as u32).collect(),
+            radius: vec![0.0; surface.vertex_count() - closed.first_cone as usize],
+            front: Propagation::new(surface, options.distance),
+            scratch: Propagation::new(surface, options.distance),
+        };
+        let started = Instant::now();
+        diagram.cover(r);
+        let cover_sites = diagram.site_vertex.len();
+        stages.cover = started.elapsed();
+        let started = Instant::now();
+        diagram.front.run(f64::INFINITY);
+        stages.diagram = started.elapsed();
+        let started = Instant::now();
+        let (mut rounds, mut splits) = (0, 0);
+        let labels = loop {
+            let labels = diagram.labels();
+            let violations = closed_ball::violations(surface, &labels, diagram.site_vertex.len());
+            if violations.is_empty() {
+                break labels;
+            }
+            if rounds == options.max_rounds {
+                return Err(Error::Unsupported(format!(
+                    "the Voronoi diagram still breaks the closed-ball property after {rounds} \
+                     refinement rounds ({} violations)",
+                    violations.len()
+                )));
+            }
+            splits += diagram.refine(&labels, &violations)?;
+            rounds += 1;
+        };
+        stages.refinement = started.elapsed();
+        let started = Instant::now();
+        let faces = dual::dual_faces(surface, &labels, &diagram.site_vertex, |v| {
+            closed.is_cone(v)
+        });
+        let (mesh, origin) = compact(mesh, &faces);
+        stages.dual = started.elapsed();
+        Ok(VoronoiSimplified {
+            mesh,
+            origin,
+            radius_fraction: fraction,
+            sites: diagram.site_vertex.len(),
+            cover_sites,
+            rounds,
+            splits,
+            attempts: 1,
+            stages,
+        })
+    }
+
+    /// The used input vertices in the cover's order.
+    fn candidates(&self) -> Vec<u32> {
+        let surface = &self.closed.surface;
+        let mut c: Vec<u32> = (0..self.closed.first_cone)
+            .filter(|&v| !surface.faces_of(v).is_empty())
+            .collect();
+        if let Some(k) = self.curvature {
+            c.sort_by(|&a, &b| k[b as usize].abs().total_cmp(&k[a as usize].abs()));
+        }
+        c
+    }
+
+    fn cover(&mut self, r: f64) {
+        let candidates = self.candidates();
+        let first = self.site_vertex.len() as u32;
+        let centres = if self.options.order == Order::Farthest {
+            cover::farthest_points(&mut self.front, &candidates, r, first)
+        } else {
+            let mut covered = vec![false; self.closed.surface.vertex_count()];
+            let centres = cover::greedy_discs(&mut self.scratch, &candidates, r, &mut covered);
+            for (i, &c) in centres.iter().enumerate() {
+                self.front.seed(c, first + i as u32, 0.0);
+            }
+            centres
+        };
+        self.radius.extend(std::iter::repeat_n(r, centres.len()));
+        self.site_vertex.extend(centres);
+    }
+
+    /// Each vertex's site; cones (which the front does not enter) their own.
+    fn labels(&self) -> Vec<u32> {
+        let mut labels = self.front.labels().to_vec();
+        for (s, &v) in self.site_vertex.iter().enumerate() {
+            if self.closed.is_cone(v) {
+                labels[v as usize] = s as u32;
+            }
+        }
+        labels
+    }
+
+    /// Splits one cell per violation (seed Alg. 5): its radius halves, its
+    /// vertices now beyond it are covered by new discs of that radius, and
+    /// the front re-runs from the new sites only. Returns cells split.
+    fn refine(&mut self, labels: &[u32], violations: &[Violation]) -> Result<usize> {
+        let members = Members::new(labels, self.site_vertex.len());
+        let mut cells: Vec<u32> = violations
+            .iter()
+            .filter_map(|v| self.cell_to_split(v, &members))
+            .collect();
+        cells.sort_unstable();
+        cells.dedup();
+        if cells.is_empty() {
+            return Err(Error::Unsupported(
+                "the Voronoi diagram breaks the closed-ball property where no cell can be split"
+                    .into(),
+            ));
+        }
+        let mut covered = vec![false; self.closed.surface.vertex_count()];
+        for &cell in &cells {
+            let site = self.site_vertex[cell as usize];
+            let r = self.radius[cell as usize] / 2.0;
+            self.radius[cell as usize] = r;
+            let mut orphans: Vec<u32> = members
+                .of(cell)
+                .iter()
+                .copied()
+                .filter(|&v| v != site && self.front.distance(v) >= r)
+                .collect();
+            if orphans.is_empty() {
+                let far = members.of(cell).iter().copied().filter(|&v| v != site);
+                orphans.extend(
+                    far.max_by(|&a, &b| self.front.distance(a).total_cmp(&self.front.distance(b))),
+                );
+            }
+            self.order(&mut orphans);
+            for c in cover::greedy_discs(&mut self.scratch, &orphans, r, &mut covered) {
+                self.front.seed(c, self.site_vertex.len() as u32, 0.0);
+                self.site_vertex.push(c);
+                self.radius.push(r);
+            }
+        }
+        self.front.run(f64::INFINITY);
+        Ok(cells.len())
+    }
+
+    /// Re-covering follows the cover's order; "farthest" takes the
+    /// vertices farthest from the site first.
+    fn order(&self, vertices: &mut [u32]) {
+        match (self.options.order, self.curvature) {
+            (Order::Curvature, Some(k)) => {
+                vertices.sort_by(|&a, &b| k[b as usize].abs().total_cmp(&k[a as usize].abs()))
+            }
+            (Order::Farthest, _) => {
+                vertices.sort_by(|&a, &b| self.front.distance(b).total_cmp(&self.front.distance(a)))
+            }
+            _ => vertices.sort_unstable(),
+        }
+    }
+
+    /// The cell a violation splits: the one in question, or the largest of
+    /// those involved (cones and one-vertex cells cannot split).
+    fn cell_to_split(&self, violation: &Violation, members: &Members) -> Option<u32> {
+        let involved: &[u32] = match violation {
+            Violation::Cell(c) => std::slice::from_ref(c),
+            Violation::Pair(a, b) => &[*a, *b],
+            Violation::Triple(t) => t,
+        };
+        involved
+            .iter()
+            .copied()
+            .filter(|&c| {
+                !self.closed.is_cone(self.site_vertex[c as usize]) && members.of(c).len() > 1
+            })
+            .max_by_key(|&c| (members.of(c).len(), std::cmp::Reverse(c)))
+    }
+}
+
+/// The vertices of each cell.
+struct Members {
+    offsets: Vec<u32>,
+    vertices: Vec<u32>,
+}
+
+impl Members {
+    fn new(labels: &[u32], sites: usize) -> Self {
+        let mut offsets = vec![0u32; sites + 1];
+        for &l in labels.iter().filter(|&&l| (l as usize) < sites) {
+            offsets[l as usize + 1] += 1;
+        }
+        for i in 0..sites {
+            offsets[i + 1] += offsets[i];
+        }
+        let mut next = offsets.clone();
+        let mut vertices = vec![0; offsets[sites] as usize];
+        for (v, &l) in labels.iter().enumerate() {
+            if (l as usize) < sites {
+                vertices[next[l as usize] as usize] = v as u32;
+                next[l as usize] += 1;
+            }
+        }
+        Members { offsets, vertices }
+    }
+
+    fn of(&self, cell: u32) -> &[u32] {
+        &self.vertices
+            [self.offsets[cell as usize] as usize..self.offsets[cell as usize + 1] as usize]
+    }
+}
+
+/// The output over the input vertices its faces use, in input order.
+fn compact(mesh: &IndexedMesh, faces: &[[u32; 3]]) -> (IndexedMesh, Vec<u32>) {
+    let mut origin: Vec<u32> = faces.iter().flatten().copied().collect();
+    origin.sort_unstable();
+    origin.dedup();
+    let mut index = vec![u32::MAX; mesh.positions.len()];
+    for (i, &v) in origin.iter().enumerate() {
+        index[v as usize] = i as u32;
+    }
+    let out = IndexedMesh {
+        positions: origin.iter().map(|&v| mesh.positions[v as usize]).collect(),
+        colors: mesh
+            .colors
+            .as_ref()
+            .map(|c| origin.iter().map(|&v| c[v as usize]).collect()),
+        triangles: faces.iter().map(|f| f.map(|v| index[v as usize])).collect(),
+    };
+    (out, origin)
+}
+
+/// Area of the mesh (for the search's first radius).
+fn area(surface: &Surface) -> f64 {
+    surface
+        .triangles()
+        .iter()
+        .map(|t| {
+            let p = t.map(|v| surface.position(v));
+            (p[1] - p[0]).cross(p[2] - p[0]).length() / 2.0
+        })
+        .sum()
+}
