@@ -8,9 +8,10 @@
 //! - `table MESH R…`: the seed's Tabela 4.2 configurations (Dijkstra or
 //!   fast marching × incremental, farthest or curvature order) at each r:
 //!   output triangles, refinement rounds and time per stage.
-//! - `timing [FACES [CODE R]]`: a generated torus of FACES triangles
-//!   (default 150 000), every configuration at r = 0.02 and 0.05, or only
-//!   CODE (DI, DD, …) at R, so that `time` can give its CPU seconds.
+//! - `timing [FACES|MESH [CODE R]]`: a generated torus of FACES triangles
+//!   (default 150 000) or a mesh file, every configuration at r = 0.02 and
+//!   0.05, or only CODE (DI, DD, …) at R, so that `time` can give its CPU
+//!   seconds.
 //!
 //! Run as:
 //!
@@ -196,23 +197,25 @@ fn main() -> Result<(), Failure> {
             configurations(name(&path), &load(&path)?, &radii)
         }
         "timing" => {
-            let faces: u32 = args
-                .first()
-                .map(|a| a.parse())
-                .transpose()?
-                .unwrap_or(150_000);
-            // A torus of rings × sides with rings = 1.25 sides: 2 rings sides faces.
-            let sides = ((faces as f64 / 2.5).sqrt()).round() as u32;
-            let rings = faces / (2 * sides);
-            let mesh = vitrine_samples::torus(rings, sides, 1.0, 0.35);
+            // FACES makes a generated torus; anything else is a mesh file.
+            let first = args.first().cloned().unwrap_or_else(|| "150000".into());
+            let (label, mesh) = match first.parse::<u32>() {
+                Ok(faces) => {
+                    // rings = 1.25 sides, 2 rings sides faces.
+                    let sides = ((faces as f64 / 2.5).sqrt()).round() as u32;
+                    let rings = faces / (2 * sides);
+                    ("torus", vitrine_samples::torus(rings, sides, 1.0, 0.35))
+                }
+                Err(_) => (name(&first), load(&first)?),
+            };
             println!("{CONFIG_HEADER}");
             match (args.get(1), args.get(2)) {
                 (Some(code), Some(r)) => {
                     let only: Vec<_> = CONFIGURATIONS.iter().filter(|c| c.0 == code).collect();
                     let &&(code, distance, order) = only.first().ok_or("no such configuration")?;
-                    configuration("torus", &mesh, code, distance, order, r.parse()?)
+                    configuration(label, &mesh, code, distance, order, r.parse()?)
                 }
-                _ => configurations("torus", &mesh, &[0.02, 0.05]),
+                _ => configurations(label, &mesh, &[0.02, 0.05]),
             }
         }
         other => Err(format!("unknown mode {other}").into()),
