@@ -4,7 +4,7 @@
 
 use std::path::Path;
 
-use vitrine_mesh::export::{write_glb, write_obj, write_ply};
+use vitrine_mesh::export::{sample_md2, write_glb, write_md2, write_obj, write_ply};
 use vitrine_samples::{icosphere, plate_with_tunnels};
 use vitrine_codec::{encode, EncodeOptions, StreamIndex};
 use vitrine_codec_fuzz::{sample_meshes, sample_streams};
@@ -33,6 +33,13 @@ fn main() {
         std::fs::create_dir_all(&d).unwrap();
         std::fs::write(d.join(format!("seed-{name}")), bytes).unwrap();
     };
+
+    // import_md2: generated animated models (no game assets).
+    for (i, (rings, sides, frames)) in [(3, 3, 1), (8, 5, 3), (12, 8, 5)].into_iter().enumerate() {
+        let mut bytes = Vec::new();
+        write_md2(&sample_md2(rings, sides, frames), &mut bytes).unwrap();
+        write("import_md2", &format!("torus-{i}"), &bytes);
+    }
 
     // decode_stream: whole streams.
     for (i, s) in sample_streams().iter().enumerate() {

@@ -68,7 +68,7 @@ impl MeshFormat {
         if bytes.starts_with(&md2::MD2_MAGIC) {
             return Some(MeshFormat::Md2);
         }
-        if bytes.starts_with(b"ply\n") || bytes.starts_with(b"ply\r\n") {
+        if bytes.starts_with(b"ply\n") || bytes.starts_with(b"ply\r") {
             return Some(MeshFormat::Ply);
         }
         let head = &bytes[..bytes.len().min(4096)];

@@ -112,8 +112,16 @@ fn parse_header(bytes: &[u8]) -> Result<Header> {
     let mut line_no = 0usize;
     let mut encoding = None;
     let mut elements: Vec<Element> = Vec::new();
+    // Old Mac exporters end lines in CR alone: the "ply" line says which
+    // terminator the whole header uses (a binary body may hold any byte
+    // right after end_header, so the style is never guessed per line).
+    let terminator = if bytes.starts_with(b"ply\r") && !bytes.starts_with(b"ply\r\n") {
+        b'\r'
+    } else {
+        b'\n'
+    };
     loop {
-        let Some(nl) = bytes[pos..].iter().position(|&b| b == b'\n') else {
+        let Some(nl) = bytes[pos..].iter().position(|&b| b == terminator) else {
             return Err(Error::input(
                 WHAT,
                 if line_no == 0 {
