@@ -238,6 +238,7 @@ mod tests {
             public_max_vertex_fraction: 1.0,
             public_full_resolution: false,
             token_full_resolution: true,
+            downloads: false,
         }
     }
 

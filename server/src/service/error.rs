@@ -57,6 +57,9 @@ pub enum AppError {
     /// Well-formed, but not acceptable (a value out of range, too early).
     #[error("{0}")]
     Unprocessable(String),
+    /// The model's policy does not allow this (a download).
+    #[error("{0}")]
+    NotAllowed(String),
     /// This session has used its requests.
     #[error("{0}")]
     TooManyRequests(String),
@@ -101,6 +104,7 @@ impl AppError {
             AppError::Conflict(_) => StatusCode::CONFLICT,
             AppError::Unprocessable(_) => StatusCode::UNPROCESSABLE_ENTITY,
             AppError::TooManyRequests(_) => StatusCode::TOO_MANY_REQUESTS,
+            AppError::NotAllowed(_) => StatusCode::FORBIDDEN,
         }
     }
 
@@ -121,6 +125,7 @@ impl AppError {
             AppError::Conflict(_) => ErrorCode::Conflict,
             AppError::Unprocessable(_) => ErrorCode::Unprocessable,
             AppError::TooManyRequests(_) => ErrorCode::TooManyRequests,
+            AppError::NotAllowed(_) => ErrorCode::NotAllowed,
         }
     }
 
@@ -182,6 +187,7 @@ pub enum ErrorCode {
     Conflict,
     Unprocessable,
     TooManyRequests,
+    NotAllowed,
     Timeout,
     Internal,
 }

@@ -9,6 +9,7 @@ pub mod admission;
 mod api;
 mod cache;
 pub mod cap;
+mod download;
 mod error;
 mod guard;
 mod layers;
@@ -94,6 +95,8 @@ struct Inner {
     metrics: Metrics,
     /// The global concurrency limit.
     permits: Arc<Semaphore>,
+    /// GLB downloads decoded at once.
+    downloads: Arc<Semaphore>,
 }
 
 impl AppState {
@@ -106,6 +109,7 @@ impl AppState {
             admission: Admission::new(config.admission.clone()),
             metrics: Metrics::default(),
             permits: Arc::new(Semaphore::new(config.limits.max_concurrency)),
+            downloads: Arc::new(Semaphore::new(download::MAX_CONCURRENT_DOWNLOADS)),
             config,
         }))
     }
@@ -141,6 +145,10 @@ impl AppState {
 
     pub(crate) fn permits(&self) -> &Arc<Semaphore> {
         &self.0.permits
+    }
+
+    pub(crate) fn downloads(&self) -> &Arc<Semaphore> {
+        &self.0.downloads
     }
 
     /// Forgets cached records, tokens and the model list, so that a new

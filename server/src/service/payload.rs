@@ -152,7 +152,7 @@ pub async fn batch(
 }
 
 /// Refuses a batch above the visitor's level cap.
-fn within_cap(
+pub(super) fn within_cap(
     state: &AppState,
     record: &ModelRecord,
     visitor: &Visitor,
@@ -182,12 +182,27 @@ async fn mesh(
     level: u32,
     headers: &HeaderMap,
 ) -> Result<Response, AppError> {
-    let id = record.compression_id;
     let etag = etag(&record.levels[level as usize].sha256);
     let cache_control = cache_control(record, level);
     if not_modified(headers, &etag) {
         return Ok(not_modified_response(etag, cache_control));
     }
+    let bytes = level_bytes(state, record, level).await?;
+    Ok(payload_response(
+        bytes,
+        etag,
+        cache_control,
+        HeaderValue::from_static(OCTET_STREAM),
+    ))
+}
+
+/// The stored payload of level `level`, through the payload cache.
+pub(super) async fn level_bytes(
+    state: &AppState,
+    record: &ModelRecord,
+    level: u32,
+) -> Result<Bytes, AppError> {
+    let id = record.compression_id;
     let storage = state.storage();
     let load = async {
         let bytes = if level == 0 {
@@ -209,12 +224,7 @@ async fn mesh(
             "payload cache returned a texture for a mesh key".into(),
         ));
     };
-    Ok(payload_response(
-        bytes,
-        etag,
-        cache_control,
-        HeaderValue::from_static(OCTET_STREAM),
-    ))
+    Ok(bytes)
 }
 
 /// An image of a CCC colour mapping: the cell texture (PNG) or the full- or
@@ -311,7 +321,7 @@ fn missing(id: i64, level: u32) -> StorageError {
 
 /// Public levels may sit in shared caches; levels above the public cap only
 /// in the token holder's browser.
-fn cache_control(record: &ModelRecord, level: u32) -> &'static str {
+pub(super) fn cache_control(record: &ModelRecord, level: u32) -> &'static str {
     if record.policy.public_access && level <= audience_cap(record, Audience::Public) {
         PUBLIC_IMMUTABLE
     } else {
@@ -326,7 +336,7 @@ fn etag(sha256: &str) -> HeaderValue {
 }
 
 /// RFC 9110 §13.1.2: `If-None-Match` uses the weak comparison.
-fn not_modified(headers: &HeaderMap, etag: &HeaderValue) -> bool {
+pub(super) fn not_modified(headers: &HeaderMap, etag: &HeaderValue) -> bool {
     let ours = etag.as_bytes();
     headers
         .get_all(header::IF_NONE_MATCH)
@@ -339,7 +349,7 @@ fn not_modified(headers: &HeaderMap, etag: &HeaderValue) -> bool {
         })
 }
 
-fn not_modified_response(etag: HeaderValue, cache_control: &'static str) -> Response {
+pub(super) fn not_modified_response(etag: HeaderValue, cache_control: &'static str) -> Response {
     let headers = [
         (header::ETAG, etag),
         (

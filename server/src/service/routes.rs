@@ -4,7 +4,7 @@
 
 use super::error::AppError;
 use super::web::{self, Viewer};
-use super::{api, guard, ops, payload, study, AppState, ServiceConfig};
+use super::{api, download, guard, ops, payload, study, AppState, ServiceConfig};
 use axum::http::{header, HeaderValue};
 use axum::response::{IntoResponse, Response};
 use axum::routing::any;
@@ -77,6 +77,7 @@ fn list(viewer: Option<&Viewer>) -> OpenApiRouter<AppState> {
         .routes(routes!(payload::base))
         .routes(routes!(payload::batch))
         .routes(routes!(payload::texture))
+        .routes(routes!(download::download))
         .routes(routes!(study::info))
         .routes(routes!(study::start, study::plan))
         .routes(routes!(study::answer))

@@ -30,6 +30,7 @@ macro_rules! sql_storage {
                             .try_get("public_full_resolution")
                             .map_err(get)?,
                         token_full_resolution: row.try_get("token_full_resolution").map_err(get)?,
+                        downloads: row.try_get("downloads").map_err(get)?,
                     },
                     good_enough_level: match row
                         .try_get::<Option<i64>, _>("good_enough_level")

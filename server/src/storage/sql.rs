@@ -10,7 +10,7 @@ macro_rules! record_select {
     () => {
         "SELECT m.id AS model_id, m.slug, m.version, m.title, m.description, \
          m.good_enough_level, m.created_at, p.name AS policy_name, p.public_access, \
-         p.public_max_vertex_fraction, p.public_full_resolution, p.token_full_resolution, \
+         p.public_max_vertex_fraction, p.public_full_resolution, p.token_full_resolution, p.downloads, \
          c.id AS compression_id, c.codec_version, c.quantization_bits, c.has_colour, c.mapping_id, \
          tm.parameters AS mapping_parameters \
          FROM model m JOIN audience_policy p ON p.id = m.policy_id \

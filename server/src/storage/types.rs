@@ -13,6 +13,8 @@ pub struct AudiencePolicy {
     pub public_max_vertex_fraction: f64,
     pub public_full_resolution: bool,
     pub token_full_resolution: bool,
+    /// Levels within the visitor's cap may be downloaded as GLB.
+    pub downloads: bool,
 }
 
 /// Counts after one level; level 0 is the base mesh.

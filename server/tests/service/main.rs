@@ -5,6 +5,7 @@
 mod broken;
 mod caps;
 mod colour;
+mod download;
 mod harness;
 mod http;
 mod kill;
@@ -72,6 +73,7 @@ on_both_backends!(
     spec::responses_match_openapi,
     study::scripted_participants,
     study::bad_study_requests,
+    download::glb_download_of_a_level,
 );
 
 /// `server/openapi.json` is the served description, committed for reviewers

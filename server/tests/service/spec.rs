@@ -370,6 +370,7 @@ pub async fn responses_match_openapi(db: TestDb) {
     spec.check(&server, call(&last, 429)).await;
 
     study_calls(&mut spec, &server, &db).await;
+    download_calls(&mut spec, &server, &db).await;
     refusals(&mut spec, &db, &m).await;
     spec.assert_every_route_called();
 }
@@ -651,4 +652,34 @@ async fn study_calls(spec: &mut Spec, server: &TestServer, db: &TestDb) {
         .await;
     spec.check(server, call("/study/open", 200)).await;
     spec.check(server, call("/study/Not_A_Slug", 400)).await;
+}
+
+/// The GLB download of a level, where the policy allows it and where not.
+async fn download_calls(spec: &mut Spec, server: &TestServer, db: &TestDb) {
+    ingest_sample(&*db.storage, "handout", "open-download").await;
+    let glb = spec
+        .check(
+            server,
+            call("/api/models/handout/download.glb?level=1", 200),
+        )
+        .await;
+    let etag = glb.header("etag");
+    let revalidate: &[(&str, &str)] = &[("if-none-match", &etag)];
+    spec.check(
+        server,
+        call_with("/api/models/handout/download.glb?level=1", revalidate, 304),
+    )
+    .await;
+    spec.check(
+        server,
+        call("/api/models/handout/download.glb?level=x", 400),
+    )
+    .await;
+    spec.check(
+        server,
+        call("/api/models/handout/download.glb?level=99", 404),
+    )
+    .await;
+    spec.check(server, call("/api/models/open/download.glb", 403))
+        .await;
 }
