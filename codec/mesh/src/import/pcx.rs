@@ -89,4 +89,23 @@ mod tests {
         let e = decode(&bytes, "t", 10).unwrap_err().to_string();
         assert!(e.contains("limit"), "{e}");
     }
+
+    #[test]
+    fn mutated_headers_are_errors_not_panics() {
+        let mut bytes = Vec::new();
+        let mut writer = pcx::WriterRgb::new(&mut bytes, (6, 4), (72, 72)).unwrap();
+        for _ in 0..4 {
+            writer.write_row(&[7u8; 18]).unwrap();
+        }
+        writer.finish().unwrap();
+        // Every value of every header byte (the header is 128 bytes).
+        for at in 0..128 {
+            for value in 0..=255u8 {
+                let mut b = bytes.clone();
+                b[at] = value;
+                let r = std::panic::catch_unwind(|| decode(&b, "t", 1 << 16).is_ok());
+                assert!(r.is_ok(), "byte {at} = {value} panics");
+            }
+        }
+    }
 }
