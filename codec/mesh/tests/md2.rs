@@ -227,6 +227,11 @@ fn hostile_headers_are_clear_errors_in_bounded_memory() {
     bytes[ofs_frames..ofs_frames + 4].copy_from_slice(&f32::NAN.to_le_bytes());
     let e = import_bytes(&bytes, MeshFormat::Md2, &opts(0)).unwrap_err();
     assert!(e.to_string().contains("non-finite"), "{e}");
+    // Finite fields whose product overflows (found by fuzzing).
+    let mut bytes = good.clone();
+    bytes[ofs_frames..ofs_frames + 4].copy_from_slice(&3e37f32.to_le_bytes());
+    let e = import_bytes(&bytes, MeshFormat::Md2, &opts(0)).unwrap_err();
+    assert!(e.to_string().contains("non-finite"), "{e}");
 }
 
 #[test]

@@ -329,7 +329,13 @@ impl Md2 {
             let at = ofs_frames + k * frame_size;
             let scale: [f32; 3] = std::array::from_fn(|c| f32_at(bytes, at + 4 * c));
             let translate: [f32; 3] = std::array::from_fn(|c| f32_at(bytes, at + 12 + 4 * c));
-            if scale.iter().chain(&translate).any(|x| !x.is_finite()) {
+            // v · scale + translate is monotonic in v ∈ [0, 255]: finite at
+            // both ends, finite for every vertex (found by the fuzzer: finite
+            // fields whose product overflows).
+            let far = |k: usize| 255.0 * scale[k] + translate[k];
+            if scale.iter().chain(&translate).any(|x| !x.is_finite())
+                || (0..3).any(|k| !far(k).is_finite())
+            {
                 return Err(Error::input(
                     WHAT,
                     format!("frame {k} has a non-finite scale or translation"),
