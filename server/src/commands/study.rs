@@ -101,6 +101,17 @@ pub struct StudyDesign {
     pub to: Option<u32>,
 }
 
+impl Default for StudyDesign {
+    /// What `invite` and `import` open when no study is: T = 20 s, the default steps.
+    fn default() -> Self {
+        StudyDesign {
+            seconds: DEFAULT_STATE_SECONDS,
+            from: None,
+            to: None,
+        }
+    }
+}
+
 pub async fn run(args: StudyArgs) -> anyhow::Result<()> {
     super::init_tracing();
     let target = match &args.action {
@@ -177,12 +188,7 @@ pub async fn run(args: StudyArgs) -> anyhow::Result<()> {
             let study = match storage.current_study(&record.slug).await? {
                 Some(s) => s,
                 None => {
-                    let design = StudyDesign {
-                        seconds: DEFAULT_STATE_SECONDS,
-                        from: None,
-                        to: None,
-                    };
-                    let id = create(&storage, &record, &design).await?;
+                    let id = create(&storage, &record, &StudyDesign::default()).await?;
                     eprintln!("opened study {id} for the imported answers");
                     current(&storage, &record).await?
                 }
@@ -249,22 +255,15 @@ async fn create(
         bail!("--seconds must be 0 to 600");
     }
     let last = record.batch_count();
-    let transitions: Vec<Transition> = match (design.from, design.to) {
-        (None, None) => {
-            let vertices: Vec<u32> = record.levels.iter().map(|l| l.vertices).collect();
-            default_transitions(&vertices)
-        }
-        (from, to) => {
-            let vertices: Vec<u32> = record.levels.iter().map(|l| l.vertices).collect();
-            let from = from.unwrap_or_else(|| {
-                default_transitions(&vertices)
-                    .first()
-                    .map_or(0, |t| t.from())
-            });
-            let to = to.unwrap_or(last);
-            (from..to).map(|a| Transition(a, a + 1)).collect()
-        }
-    };
+    // The default is every consecutive pair from the first level with 1 %
+    // of the vertices to the last; --from and --to move either end.
+    let vertices: Vec<u32> = record.levels.iter().map(|l| l.vertices).collect();
+    let defaults = default_transitions(&vertices);
+    let from = design
+        .from
+        .unwrap_or_else(|| defaults.first().map_or(0, |t| t.from()));
+    let to = design.to.unwrap_or(last);
+    let transitions: Vec<Transition> = (from..to).map(|a| Transition(a, a + 1)).collect();
     check_transitions(&transitions, last).map_err(anyhow::Error::msg)?;
     let state_ms = (design.seconds * 1000.0).round() as u64;
     Ok(storage
@@ -282,12 +281,7 @@ async fn invite(
     let study = match open_study(storage, record).await? {
         Some(s) => s,
         None => {
-            let design = StudyDesign {
-                seconds: DEFAULT_STATE_SECONDS,
-                from: None,
-                to: None,
-            };
-            let id = create(storage, record, &design).await?;
+            let id = create(storage, record, &StudyDesign::default()).await?;
             eprintln!(
                 "opened study {id} of {} version {} (T = {DEFAULT_STATE_SECONDS} s)",
                 record.slug, record.version
