@@ -15,12 +15,19 @@
  * @property {number} pitch radians above the horizon
  */
 
+import { fitDistance } from './frame.js';
+
 const FOV_Y = (40 * Math.PI) / 180;
 const PITCH_LIMIT = Math.PI / 2 - 0.01;
 
 export class OrbitCamera {
-  /** @param {import('./geometry.js').Bounds} box */
-  constructor(box) {
+  /**
+   * @param {import('./geometry.js').Bounds} box in world (upright) coordinates
+   * @param {number} [aspect] the view's width / height: the home view fits the
+   *   box to it (frame()); without it, the bounding sphere fits the height
+   */
+  constructor(box, aspect) {
+    this.box = box;
     const centre = /** @type {Vec3} */ (box.min.map((lo, k) => (lo + box.max[k]) / 2));
     const radius = Math.max(1e-6, Math.hypot(...box.max.map((hi, k) => hi - box.min[k])) / 2);
     this.radius = radius;
@@ -29,6 +36,18 @@ export class OrbitCamera {
     /** @type {OrbitState} */
     this.home = { target: centre, distance: (1.1 * radius) / Math.sin(FOV_Y / 2), yaw: 0.5, pitch: 0.4 };
     /** @type {OrbitState} */
+    this.state = structuredClone(this.home);
+    if (aspect) this.frame(aspect);
+  }
+
+  /**
+   * Home view for a view of this aspect: the box fills most of it
+   * (frame.js fitDistance); the current view becomes the home view.
+   * @param {number} aspect width / height
+   */
+  frame(aspect) {
+    const { target, yaw, pitch } = this.home;
+    this.home.distance = fitDistance(this.box, target, { yaw, pitch, fovY: this.fovY, aspect });
     this.state = structuredClone(this.home);
   }
 

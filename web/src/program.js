@@ -2,14 +2,36 @@
 /**
  * The renderer's one shader program: its GLSL (lighting from shading.js, the
  * CCC colour lookup from ccc.js, the relief view's θ ramp from relief.js),
- * its uniforms, and the two textures the
+ * its uniforms (with the visitor's look: model rotation, key light, clay,
+ * section plane; see bindLook), and the two textures the
  * CCC lookup samples (the cell texture on unit 0, the colour texture on
  * unit 1). renderer.js decides when each is made and bound.
  */
 
 import { GLSL_CCC, cccUniforms } from './ccc.js';
 import { GLSL_RELIEF } from './relief.js';
-import { GLSL_SHADE, WIRE_ALPHA, WIRE_COLOUR } from './shading.js';
+import { CLAY, GLSL_SHADE, KEY, WIRE_ALPHA, WIRE_COLOUR, halfVector } from './shading.js';
+
+/** The colour of the cut where the section plane opens the model (its inside: back faces). */
+export const SECTION_COLOUR = /** @type {[number, number, number]} */ ([0.86, 0.47, 0.26]);
+
+/**
+ * How the visitor looks at the model, beside the camera: the model's
+ * rotation (frame.js upRotation: its up axis onto +Y), the key light
+ * (light.js), clay instead of the model's colour, and the section plane
+ * (unit normal and offset in upright world coordinates: what lies where
+ * n·p > d is cut away; null: no section).
+ * @typedef {object} Look
+ * @property {number[]} model column-major 3×3
+ * @property {import('./light.js').Light} light
+ * @property {boolean} clay
+ * @property {[number, number, number, number] | null} section
+ * @property {import('./geometry.js').Bounds | null} bounds the model's bounds (model coordinates,
+ *   from the manifest; null: the base mesh's): what the camera frames (frame.js frameBox)
+ */
+
+/** @type {Look} */
+export const DEFAULT_LOOK = { model: [1, 0, 0, 0, 1, 0, 0, 0, 1], light: { key: KEY, fill: 1 }, clay: false, section: null, bounds: null };
 
 export const VERTEX_SHADER = `#version 300 es
 layout(location = 0) in vec3 a_position;
@@ -18,16 +40,20 @@ layout(location = 2) in vec3 a_colour;
 layout(location = 3) in float a_theta;
 uniform mat4 u_view;
 uniform mat4 u_viewProjection;
+uniform mat3 u_model;
 out vec3 v_normal;
 out vec3 v_colour;
 out vec3 v_world;
+out vec3 v_upright;
 out float v_theta;
 void main() {
-  v_normal = mat3(u_view) * a_normal;
+  v_normal = mat3(u_view) * (u_model * a_normal);
   v_colour = a_colour;
   v_theta = a_theta;
+  // Model coordinates for the colour lookup, upright ones for the section plane.
   v_world = a_position;
-  gl_Position = u_viewProjection * vec4(a_position, 1.0);
+  v_upright = u_model * a_position;
+  gl_Position = u_viewProjection * vec4(v_upright, 1.0);
 }`;
 
 export const FRAGMENT_SHADER = `#version 300 es
@@ -35,8 +61,12 @@ precision highp float;
 in vec3 v_normal;
 in vec3 v_colour;
 in vec3 v_world;
+in vec3 v_upright;
 in float v_theta;
 uniform bool u_wire;
+uniform bool u_clay;
+uniform bool u_sectionOn;
+uniform vec4 u_section;
 uniform bool u_ccc;
 uniform bool u_relief;
 uniform float u_reliefTop;
@@ -45,12 +75,19 @@ ${GLSL_SHADE}
 ${GLSL_CCC}
 ${GLSL_RELIEF}
 void main() {
+  // The section plane: the half beyond it is cut away.
+  if (u_sectionOn && dot(v_upright, u_section.xyz) > u_section.w) discard;
   if (u_wire) {
     o_colour = vec4(${WIRE_COLOUR.join(', ')}, ${WIRE_ALPHA});
     return;
   }
   // Vertices on no face have a zero normal: light them as facing the eye.
   vec3 n = dot(v_normal, v_normal) > 0.0 ? normalize(v_normal) : vec3(0.0, 0.0, 1.0);
+  // Where the section opens the model, its inside shows as the cut.
+  if (u_sectionOn && !gl_FrontFacing) {
+    o_colour = vec4(vec3(${SECTION_COLOUR.join(', ')}) * (0.55 + 0.45 * abs(normalize(v_normal).z)), 1.0);
+    return;
+  }
   // Scans have holes: the inside is lit like the outside.
   if (!gl_FrontFacing) n = -n;
   // The relief view: θ (radians) on the ramp from 0 to the level's scale top, under a head-light.
@@ -59,7 +96,7 @@ void main() {
     return;
   }
   // Colour from the cell complex (the same texture at every level) or per vertex.
-  vec3 albedo = u_ccc ? cccColour(v_world) : v_colour;
+  vec3 albedo = u_clay ? vec3(${CLAY.join(', ')}) : u_ccc ? cccColour(v_world) : v_colour;
   o_colour = vec4(shade(n, albedo), 1.0);
 }`;
 
@@ -92,7 +129,7 @@ export function createProgram(gl) {
   }
   /** @type {Uniforms} */
   const uniforms = {};
-  const names = ['u_view', 'u_viewProjection', 'u_wire', 'u_ccc', 'u_relief', 'u_reliefTop', 'u_cells', 'u_atlas'];
+  const names = ['u_view', 'u_viewProjection', 'u_model', 'u_key', 'u_keyHalf', 'u_fillScale', 'u_clay', 'u_sectionOn', 'u_section', 'u_wire', 'u_ccc', 'u_relief', 'u_reliefTop', 'u_cells', 'u_atlas'];
   for (const name of [...names, ...Object.keys(cccUniforms(PLACEHOLDER, { width: 1, height: 1 }))]) {
     uniforms[name] = gl.getUniformLocation(program, name);
   }
@@ -100,7 +137,24 @@ export function createProgram(gl) {
   gl.useProgram(program);
   gl.uniform1i(uniforms.u_cells, 0);
   gl.uniform1i(uniforms.u_atlas, 1);
+  bindLook(gl, uniforms, DEFAULT_LOOK);
   return { program, uniforms };
+}
+
+/**
+ * The look's uniforms (the program in use).
+ * @param {WebGL2RenderingContext} gl
+ * @param {Uniforms} u
+ * @param {Look} look
+ */
+export function bindLook(gl, u, look) {
+  gl.uniformMatrix3fv(u.u_model, false, look.model);
+  gl.uniform3fv(u.u_key, look.light.key);
+  gl.uniform3fv(u.u_keyHalf, halfVector(look.light.key));
+  gl.uniform1f(u.u_fillScale, look.light.fill);
+  gl.uniform1i(u.u_clay, look.clay ? 1 : 0);
+  gl.uniform1i(u.u_sectionOn, look.section ? 1 : 0);
+  if (look.section) gl.uniform4fv(u.u_section, look.section);
 }
 
 /**

@@ -181,6 +181,27 @@ export class Reconstruction {
     this.post({ type: 'relief', level: this.level, relief, top }, [relief.buffer]);
   }
 
+  /**
+   * Distance along the surface of the newest decoded level between two
+   * points (model coordinates; each taken to its nearest surface point):
+   * the geodesic library in the codec (fast marching), on a copy of the
+   * level, which the library keeps while it measures.
+   * @param {ArrayLike<number>} from
+   * @param {ArrayLike<number>} to
+   * @returns {{ distance: number, level: number }}
+   */
+  surfaceDistance(from, to) {
+    if (!this.#decoder || this.level < 0) throw new Error('no level decoded yet');
+    const { positions, indices } = this.#decoder.view();
+    // Copies: the library's allocations may move the decoder's memory.
+    const surface = this.codec.surface(positions.slice(), indices.slice());
+    try {
+      return { distance: surface.distance(from, to), level: this.level };
+    } finally {
+      surface.free();
+    }
+  }
+
   cancel() {
     this.#cancelled = true;
     this.#abort.abort();

@@ -16,6 +16,7 @@ import { Renderer } from './renderer.js';
 /** @typedef {import('./reconstruction.js').LevelMessage} LevelMessage */
 /** @typedef {import('./renderer.js').AtlasResolution} AtlasResolution */
 /** @typedef {{ width: number, height: number, rgba: Uint8Array }} Capture */
+/** @typedef {{ hit: import('./pick.js').Hit | null, level: number | null, ms: number }} PickResult */
 
 /**
  * @typedef {object} RenderHooks
@@ -46,6 +47,12 @@ import { Renderer } from './renderer.js';
  * @property {(mapping: import('./renderer.js').ColourMapping | null) => void} setColourMapping
  * @property {(source: ImageBitmap, resolution: AtlasResolution) => void} setColourAtlas
  * @property {() => Promise<Capture>} capture draws and reads the pixels (rows bottom-up)
+ * @property {(look: import('./program.js').Look) => void} setLook model rotation, light, clay, section
+ * @property {(ray: import('./pick.js').Ray) => Promise<PickResult>} pick the surface point of the level
+ *   on screen along a ray (model coordinates)
+ * @property {(eye: number[], points: number[][], tolerance: number) => Promise<boolean[]>} occlusion which
+ *   points the level on screen hides from the eye
+ * @property {() => Promise<Blob>} snapshot the view as a PNG
  * @property {() => Promise<number>} finish resolves when the GPU has drawn every frame asked
  *   for so far, with performance.now() then (benchmarks: frames are drawn some time after they are issued)
  * @property {(port: MessagePort) => void} attach the port a decode worker posts its levels
@@ -192,6 +199,25 @@ class MainRenderer {
     return this.renderer.capture();
   }
 
+  /** @param {import('./program.js').Look} look */
+  setLook(look) {
+    this.renderer.setLook(look);
+  }
+
+  /** @param {import('./pick.js').Ray} ray */
+  async pick(ray) {
+    return this.renderer.pick(ray);
+  }
+
+  /** @param {number[]} eye @param {number[][]} points @param {number} tolerance */
+  async occlusion(eye, points, tolerance) {
+    return this.renderer.occlusion(eye, points, tolerance);
+  }
+
+  snapshot() {
+    return this.renderer.snapshot();
+  }
+
   async finish() {
     this.renderer.finish();
     return performance.now();
@@ -327,11 +353,13 @@ class WorkerRenderer {
         this.frames = message.frames;
         break;
       case 'captured':
-      case 'finished': {
+      case 'finished':
+      case 'answer': {
         const done = this.#captures.get(message.id);
         this.#captures.delete(message.id);
         if (message.type === 'captured') done?.({ width: message.width, height: message.height, rgba: message.rgba });
-        else done?.(message.at - performance.timeOrigin);
+        else if (message.type === 'finished') done?.(message.at - performance.timeOrigin);
+        else done?.(message.value);
         break;
       }
     }
@@ -354,7 +382,8 @@ class WorkerRenderer {
 
   /** The camera may have moved: the worker draws with the page's camera state. */
   requestFrame() {
-    this.worker.postMessage({ type: 'camera', state: this.camera ? this.camera.state : null });
+    const camera = this.camera;
+    this.worker.postMessage({ type: 'camera', state: camera ? camera.state : null, radius: camera?.radius ?? null });
   }
 
   /** @param {import('./renderer.js').ColourMapping | null} mapping */
@@ -379,6 +408,41 @@ class WorkerRenderer {
       this.#captures.set(id, resolve);
       this.worker.postMessage({ type: 'finish', id });
     });
+  }
+
+  /**
+   * A question for the worker, answered by id ('answer').
+   * @param {Record<string, unknown> & { type: string }} command
+   * @returns {Promise<any>}
+   */
+  #ask(command) {
+    const id = this.#nextCapture++;
+    return new Promise((resolve) => {
+      this.#captures.set(id, resolve);
+      this.worker.postMessage({ ...command, id });
+    });
+  }
+
+  /** @param {import('./program.js').Look} look */
+  setLook(look) {
+    this.worker.postMessage({ type: 'look', look });
+  }
+
+  /** @param {import('./pick.js').Ray} ray @returns {Promise<PickResult>} */
+  pick(ray) {
+    return this.#ask({ type: 'pick', ray });
+  }
+
+  /** @param {number[]} eye @param {number[][]} points @param {number} tolerance @returns {Promise<boolean[]>} */
+  occlusion(eye, points, tolerance) {
+    return this.#ask({ type: 'occlusion', eye, points, tolerance });
+  }
+
+  /** @returns {Promise<Blob>} */
+  async snapshot() {
+    const answer = await this.#ask({ type: 'snapshot' });
+    if (answer instanceof Blob) return answer;
+    throw new Error(String(answer?.error ?? 'the picture could not be encoded'));
   }
 
   /** @returns {Promise<Capture>} */

@@ -18,6 +18,7 @@
  */
 
 import { OrbitCamera } from './camera.js';
+import { frameBox } from './frame.js';
 import { Renderer } from './renderer.js';
 
 /**
@@ -25,7 +26,11 @@ import { Renderer } from './renderer.js';
  * @typedef {{ type: 'canvas', canvas: OffscreenCanvas, width: number, height: number, background?: [number, number, number] }
  *   | { type: 'source', port: MessagePort }
  *   | { type: 'size', width: number, height: number }
- *   | { type: 'camera', state: import('./camera.js').OrbitState | null }
+ *   | { type: 'camera', state: import('./camera.js').OrbitState | null, radius?: number | null }
+ *   | { type: 'look', look: import('./program.js').Look }
+ *   | { type: 'pick', id: number, ray: import('./pick.js').Ray }
+ *   | { type: 'occlusion', id: number, eye: number[], points: number[][], tolerance: number }
+ *   | { type: 'snapshot', id: number }
  *   | { type: 'wireframe', on: boolean }
  *   | { type: 'relief', on: boolean }
  *   | { type: 'hold', level: number | null }
@@ -46,7 +51,8 @@ import { Renderer } from './renderer.js';
  *       reliefTop: number | null, at: number }
  *   | { type: 'status', lost: boolean, settled: boolean, edges: boolean, frames: number }
  *   | { type: 'captured', id: number, width: number, height: number, rgba: Uint8Array }
- *   | { type: 'finished', id: number, at: number }} RenderReport
+ *   | { type: 'finished', id: number, at: number }
+ *   | { type: 'answer', id: number, value: unknown }} RenderReport
  */
 
 /**
@@ -67,6 +73,8 @@ let renderer = null;
 let source = null;
 /** @type {import('./camera.js').OrbitState | null} */
 let cameraState = null;
+/** The page camera's radius (near and far planes), when it frames other bounds than the base mesh's. @type {number | null} */
+let cameraRadius = null;
 let lastStatus = '';
 /** Level and colour texture of the last frame reported. */
 let lastFrame = '';
@@ -102,8 +110,11 @@ function fromDecoder(message) {
   if (message.type === 'level') {
     // The same camera the page makes from the same bounds; the page's moves follow as 'camera'.
     if (!renderer.camera) {
-      renderer.camera = new OrbitCamera(message.baseBounds);
+      // Framed for this canvas's aspect as the page frames its own.
+      const { width, height } = renderer.canvas;
+      renderer.camera = new OrbitCamera(frameBox(renderer.look, message.baseBounds), width / Math.max(1, height));
       if (cameraState) renderer.camera.state = structuredClone(cameraState);
+      if (cameraRadius) renderer.camera.radius = cameraRadius;
     }
     renderer.show(message);
   } else if (message.type === 'edges') {
@@ -176,7 +187,9 @@ scope.onmessage = (event) => {
       break;
     case 'camera':
       cameraState = command.state;
+      cameraRadius = command.radius ?? cameraRadius;
       if (renderer?.camera && cameraState) renderer.camera.state = structuredClone(cameraState);
+      if (renderer?.camera && cameraRadius) renderer.camera.radius = cameraRadius;
       renderer?.requestFrame();
       break;
     case 'wireframe':
@@ -198,6 +211,24 @@ scope.onmessage = (event) => {
       if (!renderer) break;
       const { width, height, rgba } = renderer.capture();
       report({ type: 'captured', id: command.id, width, height, rgba }, [rgba.buffer]);
+      break;
+    }
+    case 'look':
+      renderer?.setLook(command.look);
+      break;
+    case 'pick':
+      report({ type: 'answer', id: command.id, value: renderer?.pick(command.ray) ?? { hit: null, level: null, ms: 0 } });
+      break;
+    case 'occlusion':
+      report({ type: 'answer', id: command.id, value: renderer?.occlusion(command.eye, command.points, command.tolerance) ?? [] });
+      break;
+    case 'snapshot': {
+      const id = command.id;
+      if (!renderer) break;
+      renderer.snapshot().then(
+        (blob) => report({ type: 'answer', id, value: blob }),
+        (error) => report({ type: 'answer', id, value: { error: String(error) } }),
+      );
       break;
     }
     case 'finish':

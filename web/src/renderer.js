@@ -30,7 +30,8 @@
 
 import { multiply } from './camera.js';
 import { NormalsTask, deriveNormals } from './normals-task.js';
-import { bindCcc, bindRelief, createAtlasTexture, createCellTexture, createProgram } from './program.js';
+import { occluded, intersect } from './pick.js';
+import { DEFAULT_LOOK, bindCcc, bindLook, bindRelief, createAtlasTexture, createCellTexture, createProgram } from './program.js';
 import { BACKGROUND, CLAY } from './shading.js';
 import {
   VertexStore,
@@ -97,6 +98,8 @@ export class Renderer {
   reliefTop = null;
   lost = false;
   frames = 0;
+  /** Model rotation, key light, clay, section plane (program.js Look). */
+  look = DEFAULT_LOOK;
   /** Milliseconds spent deriving normals of levels that came without them. */
   normalsMs = 0;
   /**
@@ -348,6 +351,52 @@ export class Renderer {
     this.requestFrame();
   }
 
+  /** @param {import('./program.js').Look} look */
+  setLook(look) {
+    this.look = look;
+    this.requestFrame();
+  }
+
+  /**
+   * The nearest surface point of the level on screen along a ray in model
+   * coordinates (pick.js), with the time it took.
+   * @param {import('./pick.js').Ray} ray
+   * @returns {{ hit: import('./pick.js').Hit | null, level: number | null, ms: number }}
+   */
+  pick(ray) {
+    const mesh = this.current;
+    const t0 = performance.now();
+    const hit = mesh ? intersect(this.#store.positions, mesh.source.indices, ray) : null;
+    return { hit, level: mesh?.source.level ?? null, ms: performance.now() - t0 };
+  }
+
+  /**
+   * Which of `points` the level on screen hides from `eye` (model coordinates).
+   * @param {ArrayLike<number>} eye
+   * @param {ReadonlyArray<ArrayLike<number>>} points
+   * @param {number} tolerance model units
+   * @returns {boolean[]}
+   */
+  occlusion(eye, points, tolerance) {
+    const mesh = this.current;
+    if (!mesh) return points.map(() => false);
+    return points.map((p) => occluded(this.#store.positions, mesh.source.indices, eye, p, tolerance));
+  }
+
+  /**
+   * Draws and encodes the picture as a PNG in the same task (the drawing
+   * buffer is not preserved between frames), with the browser's own encoder.
+   * @returns {Promise<Blob>}
+   */
+  snapshot() {
+    this.#draw();
+    const canvas = this.canvas;
+    if ('convertToBlob' in canvas) return canvas.convertToBlob({ type: 'image/png' });
+    return new Promise((resolve, reject) =>
+      canvas.toBlob((blob) => (blob ? resolve(blob) : reject(new Error('the picture could not be encoded'))), 'image/png'),
+    );
+  }
+
   /**
    * Draws now and reads the pixels back in the same task, before the
    * compositor clears the drawing buffer (tests and benchmarks).
@@ -518,6 +567,7 @@ export class Renderer {
     gl.useProgram(this.#program);
     gl.uniformMatrix4fv(this.#uniforms.u_view, false, view);
     gl.uniformMatrix4fv(this.#uniforms.u_viewProjection, false, multiply(projection, view));
+    bindLook(gl, this.#uniforms, this.look);
     gl.bindVertexArray(mesh.vao);
     if (!mesh.source.colours) gl.vertexAttrib4f(2, CLAY[0], CLAY[1], CLAY[2], 1);
     const wire = this.wireframe && mesh.edgeBuffer && mesh.uploads.length === 0;

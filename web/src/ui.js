@@ -8,6 +8,8 @@
  */
 
 import { describeLevel, describeStudyLevel, renderQualityChart } from './quality-chart.js';
+import { NOTES_STYLE } from './annotations.js';
+import { TOOLS_STYLE } from './tools-ui.js';
 import { SCALE_PERCENTILE, formatDegrees, rampGradient, reliefTicks } from './relief.js';
 
 /** Device pixels per CSS pixel, capped: beyond 2 a tablet pays 2.25× the fill for little gain. */
@@ -21,18 +23,33 @@ canvas { display: block; width: 100%; height: 100%; outline: none; cursor: grab;
 canvas:active { cursor: grabbing; }
 canvas:focus-visible { box-shadow: inset 0 0 0 2px #88c0d0; }
 .pill { background: rgba(20, 22, 26, 0.72); border-radius: 6px; padding: 6px 10px; }
-.panel { position: absolute; top: 10px; left: 10px; max-width: min(26rem, 60%); }
-.panel h1 { font-size: 16px; margin: 0; font-weight: 600; }
+.chrome { position: absolute; inset: 10px 10px 12px; display: flex; flex-direction: column; gap: 8px;
+  pointer-events: none; min-height: 0; }
+.chrome > * { pointer-events: auto; }
+/* The title panel and the toolbar share the top: side by side where they fit, else the
+   toolbar above and the panel under it (wrap-reverse stacks the second line on top). */
+.top { display: flex; flex-wrap: wrap-reverse; align-items: flex-end; align-content: flex-end; gap: 8px;
+  pointer-events: none; flex: none; }
+.top > * { pointer-events: auto; }
+.panel { flex: 0 1 26rem; min-width: 0; max-width: 100%; max-height: 40vh; overflow: auto; }
+.panel h1 { font-size: 16px; margin: 0; font-weight: 600; overflow-wrap: anywhere; }
 .panel p { margin: 4px 0 0; color: #cfd5de; }
 .panel:empty, [hidden] { display: none !important; }
-.tools { position: absolute; top: 10px; right: 10px; display: flex; flex-wrap: wrap; justify-content: flex-end;
-  gap: 6px; max-width: calc(100% - 20px); }
+.tools { display: flex; flex-wrap: wrap; justify-content: flex-end; gap: 6px; margin-left: auto; max-width: 100%; }
 button { font: inherit; color: inherit; background: rgba(20, 22, 26, 0.72); border: 1px solid #4c566a;
   border-radius: 6px; min-height: 36px; padding: 4px 12px; cursor: pointer; }
 button:hover { background: rgba(59, 66, 82, 0.9); }
+button:focus-visible { outline: 2px solid #88c0d0; outline-offset: 1px; }
 button[aria-pressed="true"] { background: #5e81ac; border-color: #81a1c1; }
-.status { position: absolute; left: 10px; bottom: 12px; right: 10px; display: flex; flex-direction: column;
-  align-items: flex-start; gap: 6px; pointer-events: none; }
+.panes { display: flex; flex-wrap: wrap; justify-content: flex-end; align-items: flex-start; gap: 8px;
+  min-height: 0; flex: 0 1 auto; overflow: auto; pointer-events: none; }
+.panes:not(:has(> :not([hidden]))) { display: none; }
+.panes > * { pointer-events: auto; width: min(20rem, 100%); max-height: 100%; overflow: auto; }
+.spacer { flex: 1 1 0; min-height: 0; pointer-events: none; }
+.live { position: absolute; width: 1px; height: 1px; overflow: hidden; clip-path: inset(50%); white-space: nowrap; }
+.markers { position: absolute; inset: 0; overflow: hidden; pointer-events: none; }
+.status { display: flex; flex-direction: column; align-items: flex-start; gap: 6px; pointer-events: none; flex: none; }
+.status > * { max-width: 100%; }
 .notice { background: rgba(94, 72, 20, 0.88); border: 1px solid #ebcb8b; }
 .colour { font-size: 12px; color: #cfd5de; }
 .colour::before { content: ""; display: inline-block; width: 8px; height: 8px; border-radius: 50%;
@@ -50,10 +67,11 @@ button[aria-pressed="true"] { background: #5e81ac; border-color: #81a1c1; }
 .quality svg { display: block; width: 100%; max-width: 260px; height: auto; margin-top: 4px; }
 .quality p { font-size: 12px; }
 @media (max-width: 480px), (max-height: 360px) { .quality { display: none; } }
-/* Phones: narrower buttons, and the title panel under them rather than beside. */
+/* Phones: narrower buttons; the panel goes under the toolbar (.top wraps). */
 @media (max-width: 480px) {
   button { padding: 4px 8px; }
-  .panel { top: 56px; max-width: calc(100% - 20px); }
+  .tools { gap: 4px; }
+  .panel { flex-basis: 100%; max-height: 30vh; }
 }
 .legend { width: min(280px, 100%); font-size: 12px; }
 .legend-title { color: #cfd5de; }
@@ -65,7 +83,7 @@ button[aria-pressed="true"] { background: #5e81ac; border-color: #81a1c1; }
 :host([chrome="minimal"]) .panel p { display: none; }
 :host([chrome="minimal"]) .quality { display: none; }
 :host([chrome="minimal"]) button.optional { display: none; }
-:host([chrome="none"]) :is(.panel, .tools, .status, .bar) { display: none !important; }
+:host([chrome="none"]) :is(.chrome, .bar, .markers) { display: none !important; }
 `;
 
 export class ViewerUi {
@@ -88,17 +106,29 @@ export class ViewerUi {
    */
   constructor(host, shadow) {
     this.root = host;
-    shadow.innerHTML = `<style>${STYLE}</style>
+    shadow.innerHTML = `<style>${STYLE}${TOOLS_STYLE}${NOTES_STYLE}</style>
 <div class="stage" part="stage">
   <canvas aria-label="3D view: drag to turn, pinch or scroll to zoom, two fingers or right-drag to pan"></canvas>
+  <div class="markers"></div>
+  <div class="chrome">
+  <div class="top">
   <div class="panel pill" part="panel"></div>
-  <div class="tools">
+  <div class="tools" role="toolbar" aria-label="View tools">
     <button data-action="reset" title="Reset view (R)">Reset</button>
     <button data-action="wireframe" title="Wireframe (W)" aria-pressed="false" class="optional">Wireframe</button>
     <button data-action="relief" title="Relief: colour by average normal deviation θ (erosion, tool marks)"
       aria-pressed="false" class="optional">Relief</button>
+    <button data-action="notes" title="The curators' notes on this object" aria-pressed="false" hidden>Notes</button>
+    <button data-action="measure" title="Measure: click two points on the surface" aria-pressed="false" class="optional">Measure</button>
+    <button data-action="light" title="Light: move the light, raking light for inscriptions" aria-pressed="false" class="optional">Light</button>
+    <button data-action="section" title="Section: cut the model with a plane" aria-pressed="false" class="optional">Section</button>
+    <button data-action="clay" title="Clay: hide the colour to see the shape" aria-pressed="false" class="optional">Clay</button>
+    <button data-action="snapshot" title="Save the view as a PNG image" class="optional">Snapshot</button>
     <button data-action="fullscreen" title="Fullscreen (F)">Fullscreen</button>
   </div>
+  </div>
+  <div class="panes"></div>
+  <div class="spacer"></div>
   <div class="status">
     <div class="legend pill" role="group" aria-label="Relief legend" hidden>
       <div class="legend-title"></div>
@@ -109,6 +139,8 @@ export class ViewerUi {
     <div class="colour pill" hidden></div>
     <div class="progress pill" aria-live="polite">Loading…</div>
   </div>
+  </div>
+  <div class="live" aria-live="polite"></div>
   <div class="bar" style="width: 0"></div>
   <div class="error" role="alert" hidden><div><p></p><button data-action="retry">Try again</button></div></div>
 </div>`;
@@ -124,6 +156,13 @@ export class ViewerUi {
     this.wireButton = $('[data-action="wireframe"]');
     this.reliefButton = $('[data-action="relief"]');
     this.legend = $('.legend');
+    /** Tool panes (annotations list, measurement, light, section), under the toolbar. */
+    this.panes = $('.panes');
+    /** Annotation markers over the canvas. */
+    this.markers = $('.markers');
+    /** Announcements for screen readers (the annotation selected). */
+    this.live = $('.live');
+    this.shadow = shadow;
     this.quality = document.createElement('details');
     this.quality.className = 'quality';
     this.quality.open = true;
@@ -135,6 +174,14 @@ export class ViewerUi {
     $('[data-action="fullscreen"]').onclick = () => this.toggleFullscreen();
     $('[data-action="retry"]').onclick = () => this.onRetry();
     this.#watchSize();
+  }
+
+  /**
+   * A toolbar button by its action.
+   * @param {string} action
+   */
+  button(action) {
+    return /** @type {HTMLButtonElement} */ (this.shadow.querySelector(`.tools [data-action="${action}"]`));
   }
 
   /** Keeps the drawing buffer at the canvas's size in device pixels. */

@@ -9,6 +9,10 @@
 import { OrbitCamera } from './camera.js';
 import { ColourLoader } from './colour-loader.js';
 import { OrbitControls } from './controls.js';
+import { frameBox, upRotation, validBounds } from './frame.js';
+import { DEFAULT_LOOK } from './program.js';
+import { Annotations } from './annotations.js';
+import { Inspection } from './inspection.js';
 import { canTransfer, openRenderer } from './render-host.js';
 import { retryAfterSeconds, waitToRetry } from './retry.js';
 
@@ -40,6 +44,9 @@ import { retryAfterSeconds, waitToRetry } from './retry.js';
  * @property {ManifestColour} [colour]
  * @property {{ device: string, audience: string }} visitor
  * @property {{ level: number, reason: string | null, retry_after_s: number | null }} cap
+ * @property {string} [up] which model axis points up (`x`, `y`, `z`, `-x`, `-y`, `-z`; default `y`)
+ * @property {'mm' | 'cm' | 'm' | 'in' | null} [unit] the model's unit
+ * @property {import('./geometry.js').Bounds} [bounds] every level's extent, model coordinates
  */
 
 /**
@@ -173,6 +180,11 @@ export class Viewer {
   #shownWaiters = [];
   /** The turntable's animation frame, while it turns. @type {number | null} */
   #turning = null;
+  /** Model rotation, light, clay, section (program.js Look): sent to the renderer. */
+  #look = DEFAULT_LOOK;
+  /** @type {Map<number, (answer: { distance?: number, level?: number, error?: string }) => void>} */
+  #geodesics = new Map();
+  #nextGeodesic = 1;
   /** The cap in force: from the manifest, or from a batch the server refused. */
   #cap = { level: 0, reason: /** @type {string | null} */ (null), retryAfterS: /** @type {number | null} */ (null) };
 
@@ -187,7 +199,10 @@ export class Viewer {
     this.#hold = options.hold ?? null;
     this.controls = new OrbitControls(ui.canvas, {
       camera: () => this.camera,
-      changed: () => this.renderer?.requestFrame(),
+      changed: () => {
+        this.renderer?.requestFrame();
+        this.cameraMoved();
+      },
       reset: () => this.resetView(),
       toggleWireframe: () => this.setWireframe(!this.#wireframe),
       toggleFullscreen: () => ui.toggleFullscreen(),
@@ -197,7 +212,86 @@ export class Viewer {
     ui.onWireframe = () => this.setWireframe(!this.#wireframe);
     ui.onRelief = () => this.setRelief(!this.#relief);
     ui.onRetry = () => this.start();
-    ui.onResize = () => this.renderer?.requestFrame();
+    ui.onResize = () => {
+      this.renderer?.requestFrame();
+      this.cameraMoved();
+    };
+    /** Measurement, light, section, snapshot (inspection.js). */
+    this.inspection = new Inspection(this);
+    /** The curators' notes on the model (annotations.js). */
+    this.annotations = new Annotations(this);
+  }
+
+  /** The look in force (program.js Look). */
+  get look() {
+    return this.#look;
+  }
+
+  /**
+   * Changes the look (light, clay, section…) and redraws.
+   * @param {Partial<import('./program.js').Look>} patch
+   */
+  setLook(patch) {
+    this.#look = { ...this.#look, ...patch };
+    this.renderer?.setLook(this.#look);
+  }
+
+  /** The camera moved or the view was resized: what is anchored to the model follows. */
+  cameraMoved() {
+    this.annotations.place();
+    this.inspection.place();
+  }
+
+  /** The view's aspect, as the renderer draws it. */
+  aspect() {
+    return this.ui.canvas.width / Math.max(1, this.ui.canvas.height);
+  }
+
+  /**
+   * The camera, made once from the base mesh's bounds (or the manifest's)
+   * turned upright, framed for the view's aspect.
+   * @param {import('./geometry.js').Bounds} baseBounds
+   */
+  #makeCamera(baseBounds) {
+    this.camera ??= new OrbitCamera(frameBox(this.#look, baseBounds), this.aspect());
+    return this.camera;
+  }
+
+  /**
+   * Distance along the surface of the newest decoded level (the decode
+   * worker's geodesic library), in model units.
+   * @param {number[]} from
+   * @param {number[]} to
+   * @returns {Promise<{ distance: number, level: number }>}
+   */
+  surfaceDistance(from, to) {
+    const worker = this.#worker;
+    if (!worker) return Promise.reject(new Error('no model loaded'));
+    const id = this.#nextGeodesic++;
+    return new Promise((resolve, reject) => {
+      this.#geodesics.set(id, (answer) =>
+        answer.error !== undefined || answer.distance === undefined
+          ? reject(new Error(answer.error ?? 'no distance'))
+          : resolve({ distance: answer.distance, level: answer.level ?? -1 }),
+      );
+      worker.postMessage({ type: 'geodesic', id, from, to });
+    });
+  }
+
+  /**
+   * Lifts a `level` option or a hold and refines up to the visitor's cap
+   * (the measurement's "refine to measure more precisely").
+   */
+  refine() {
+    this.options.level = null;
+    this.#decodeTo = null;
+    this.#hold = null;
+    this.renderer?.setHold(null);
+    if (!this.manifest) return;
+    const target = this.#target(this.#cap.level);
+    if (target <= this.state.targetLevel) return;
+    this.#set({ targetLevel: target, status: 'refining' });
+    this.#worker?.postMessage({ type: 'extend', upTo: target });
   }
 
   /** Loads from scratch (also the retry after an error). */
@@ -229,6 +323,8 @@ export class Viewer {
       // Levels decoded before a failure are still shown (the error may come
       // before the renderer is ready); a retry's newer port replaces this one.
       if (this.#levels !== levels) return;
+      // The look first: the render worker frames its camera with it when the base mesh arrives.
+      renderer.setLook(this.#look);
       if (this.camera) renderer.camera = this.camera;
       // Normals are derived by the renderer when it has a thread of its own;
       // the main thread's fallback gets them from the decode worker.
@@ -251,8 +347,9 @@ export class Viewer {
   }
 
   resetView() {
-    this.camera?.reset();
+    this.camera?.frame(this.aspect());
     this.renderer?.requestFrame();
+    this.cameraMoved();
   }
 
   /**
@@ -395,6 +492,9 @@ export class Viewer {
     this.manifest = manifest;
     this.ui.setDetails(manifest.title, manifest.description);
     this.ui.setQuality(manifest.quality ?? null);
+    this.#look = { ...this.#look, model: upRotation(manifest.up), bounds: validBounds(manifest.bounds, null) };
+    this.annotations.load();
+    this.inspection.begin();
     this.#worker = worker;
     worker.onmessage = (event) => this.#message(event.data);
     worker.onerror = (event) => this.#fail(`the decoder failed: ${event.message}`);
@@ -439,7 +539,7 @@ export class Viewer {
         onSwap: (level) => this.#shown(level),
         onHeld: (level) => this.#ready(level),
         onFrame: (frame) => this.#framed(frame),
-        camera: (bounds) => (this.camera ??= new OrbitCamera(bounds)),
+        camera: (bounds) => this.#makeCamera(bounds),
       },
       {
         offscreen: this.options.offscreen,
@@ -479,14 +579,22 @@ export class Viewer {
     this.ui.root.dispatchEvent(new CustomEvent(type, { detail, bubbles: true, composed: true }));
   }
 
-  /** @param {import('./reconstruction.js').PageMessage} message */
+  /** @param {import('./reconstruction.js').PageMessage | { type: 'geodesic', id: number, distance?: number, level?: number, error?: string }} message */
   #message(message) {
+    if (message.type === 'geodesic') {
+      this.#geodesics.get(message.id)?.(message);
+      this.#geodesics.delete(message.id);
+      return;
+    }
     switch (message.type) {
       case 'level':
         // A notice: the buffers went to the renderer.
         if (!this.camera) {
-          this.camera = new OrbitCamera(message.baseBounds);
-          if (this.renderer) this.renderer.camera = this.camera;
+          this.#makeCamera(message.baseBounds);
+          if (this.renderer) {
+            this.renderer.camera = this.camera;
+            this.renderer.requestFrame();
+          }
         }
         this.#set({
           decodedLevel: message.level,
@@ -518,6 +626,8 @@ export class Viewer {
   /** @param {{ level: number, vertices: number, normalsMs: number }} level */
   #shown(level) {
     this.#set({ shownLevel: level.level, vertices: level.vertices, normalsMs: level.normalsMs });
+    this.annotations.levelShown();
+    this.inspection.levelShown();
     this.#ready(level.level);
     if (level.level < this.state.targetLevel || this.state.status !== 'refining') return;
     const last = /** @type {Manifest} */ (this.manifest).last_level;

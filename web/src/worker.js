@@ -16,7 +16,9 @@ import { Reconstruction } from './reconstruction.js';
  *   | { type: 'extend', upTo: number }
  *   | { type: 'wireframe', on: boolean }
  *   | { type: 'relief', on: boolean }
- *   | { type: 'normals', which: 'always' | 'last' }} WorkerCommand
+ *   | { type: 'normals', which: 'always' | 'last' }
+ *   | { type: 'geodesic', id: number, from: number[], to: number[] }} WorkerCommand
+ * `geodesic` is answered with `{ type: 'geodesic', id, distance, level }` or `{ type: 'geodesic', id, error }`.
  */
 
 const scope = /** @type {DedicatedWorkerGlobalScope} */ (/** @type {unknown} */ (self));
@@ -71,6 +73,14 @@ scope.onmessage = async (/** @type {MessageEvent<WorkerCommand>} */ event) => {
   } else if (command.type === 'relief') {
     relief = command.on;
     job?.setRelief(command.on);
+  } else if (command.type === 'geodesic') {
+    try {
+      if (!job) throw new Error('no model loaded');
+      const { distance, level } = job.surfaceDistance(command.from, command.to);
+      scope.postMessage({ type: 'geodesic', id: command.id, distance, level });
+    } catch (error) {
+      scope.postMessage({ type: 'geodesic', id: command.id, error: error instanceof Error ? error.message : String(error) });
+    }
   } else if (command.type === 'normals') {
     normals = command.which;
     job?.setNormals(command.which);

@@ -1,0 +1,93 @@
+// @ts-check
+/**
+ * The markup of the tool panes under the toolbar (measurement, light,
+ * section) and their styles; inspection.js gives them their behaviour.
+ */
+
+/**
+ * @param {string} className
+ * @param {string} label
+ * @param {string} html
+ */
+function pane(className, label, html) {
+  const section = document.createElement('section');
+  section.className = `${className} pill`;
+  section.setAttribute('aria-label', label);
+  section.hidden = true;
+  section.innerHTML = html;
+  return section;
+}
+
+/** @param {HTMLElement} root @param {string} selector */
+function $(root, selector) {
+  return /** @type {HTMLElement} */ (root.querySelector(selector));
+}
+
+export function measurePane() {
+  const p = pane(
+    'measure',
+    'Measurement',
+    `<h2>Measure</h2><p class="measure-status" role="status"></p><p class="measure-reading"></p>
+<p class="measure-surface"></p><div class="row"><button type="button" class="refine" hidden></button>
+<button type="button" class="clear">Clear</button></div>`,
+  );
+  return {
+    pane: p,
+    status: $(p, '.measure-status'),
+    reading: $(p, '.measure-reading'),
+    surface: $(p, '.measure-surface'),
+    refine: /** @type {HTMLButtonElement} */ ($(p, '.refine')),
+    clear: /** @type {HTMLButtonElement} */ ($(p, '.clear')),
+  };
+}
+
+export function lightPane() {
+  const p = pane(
+    'light',
+    'Light',
+    `<h2>Light</h2><div class="disc" tabindex="0" role="slider" aria-label="Light direction: drag, or arrow keys"
+  aria-valuetext="light direction"><span class="handle"></span></div>
+<div class="row"><button type="button" data-raking="left">Raking ←</button><button type="button" data-raking="right">Raking →</button>
+<button type="button" data-raking="top">Raking ↑</button><button type="button" data-raking="bottom">Raking ↓</button>
+<button type="button" class="studio">Studio</button></div>`,
+  );
+  /** @type {Record<string, HTMLButtonElement>} */
+  const raking = {};
+  for (const b of p.querySelectorAll('[data-raking]')) raking[/** @type {string} */ (/** @type {HTMLElement} */ (b).dataset.raking)] = /** @type {HTMLButtonElement} */ (b);
+  return { pane: p, disc: $(p, '.disc'), handle: $(p, '.handle'), studio: /** @type {HTMLButtonElement} */ ($(p, '.studio')), raking };
+}
+
+export function sectionPane() {
+  const p = pane(
+    'section',
+    'Section',
+    `<h2>Section</h2><div class="row" role="group" aria-label="Plane perpendicular to">
+<button type="button" data-axis="x" aria-pressed="true">X</button><button type="button" data-axis="y" aria-pressed="false">Y</button>
+<button type="button" data-axis="z" aria-pressed="false">Z</button>
+<button type="button" class="flip" aria-pressed="false">Other side</button></div>
+<label class="offset">Position <input type="range" min="0" max="1000" value="500"></label>`,
+  );
+  return {
+    pane: p,
+    axis: /** @type {HTMLButtonElement[]} */ ([...p.querySelectorAll('[data-axis]')]),
+    flip: /** @type {HTMLButtonElement} */ ($(p, '.flip')),
+    offset: /** @type {HTMLInputElement} */ ($(p, 'input')),
+  };
+}
+
+export const TOOLS_STYLE = `
+.panes h2 { font-size: 14px; margin: 0 0 4px; }
+.panes p { margin: 4px 0; }
+.panes .row { display: flex; flex-wrap: wrap; gap: 4px; margin-top: 4px; }
+.panes .row button { min-height: 32px; padding: 2px 8px; }
+.measure-reading { font-weight: 600; font-variant-numeric: tabular-nums; }
+.disc { position: relative; width: 96px; height: 96px; border-radius: 50%; margin: 4px auto;
+  background: radial-gradient(circle at 50% 50%, #4c566a, #1d2026); border: 1px solid #81a1c1; touch-action: none; cursor: pointer; }
+.disc:focus-visible { outline: 2px solid #88c0d0; }
+.handle { position: absolute; left: 28%; top: 20%; width: 14px; height: 14px; margin: -7px 0 0 -7px; border-radius: 50%;
+  background: #ebcb8b; pointer-events: none; }
+.offset { display: flex; align-items: center; gap: 8px; margin-top: 6px; }
+.offset input { flex: 1; min-width: 0; }
+.pick-dot { position: absolute; left: 0; top: 0; width: 10px; height: 10px; border-radius: 50%; background: #bf616a;
+  border: 2px solid #fff; }
+`;
