@@ -55,16 +55,35 @@ async function gallery() {
   try {
     const response = await fetch('/api/models', { cache: 'no-store' });
     if (!response.ok) throw new Error(`the server answered ${response.status}`);
-    /** @type {{ models: Array<{ slug: string, title: string, levels: number, page_url: string }> }} */
+    /** @type {{ models: Array<{ slug: string, title: string, levels: number, page_url: string, thumbnail?: string | null }> }} */
     const { models } = await response.json();
     if (models.length === 0) list.append(el('li', {}, ['No models yet: `vitrine ingest` adds one.']));
     for (const m of models) {
-      const link = el('a', { href: m.page_url }, [el('strong', {}, [m.title]), el('small', {}, [`${m.levels} levels`])]);
+      const link = el('a', { href: m.page_url }, [thumbnail(m), el('strong', {}, [m.title]), el('small', {}, [`${m.levels} levels`])]);
       list.append(el('li', {}, [link]));
     }
   } catch (error) {
     list.append(el('li', { class: 'error', role: 'alert' }, [`Could not load the models: ${error}`]));
   }
+}
+
+/**
+ * The model's picture (rendered at ingest), lazily loaded in a box of
+ * fixed aspect so the grid does not move as pictures arrive; a neutral
+ * placeholder when the server has none (or an older server, without the field).
+ * @param {{ title: string, thumbnail?: string | null }} m
+ */
+function thumbnail(m) {
+  const box = el('span', { class: 'thumb' });
+  if (typeof m.thumbnail === 'string' && m.thumbnail) {
+    const img = el('img', { src: m.thumbnail, alt: `${m.title}: preview`, loading: 'lazy', decoding: 'async', width: '320', height: '240' });
+    img.addEventListener('error', () => img.replaceWith(el('span', { class: 'thumb-none', 'aria-hidden': 'true' })));
+    box.append(img);
+  } else {
+    box.classList.add('thumb-none');
+    box.setAttribute('aria-hidden', 'true');
+  }
+  return box;
 }
 
 /** @param {string} slug */

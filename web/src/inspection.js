@@ -11,14 +11,14 @@
 
 import { STUDIO, discLight, discPosition, rakingLight } from './light.js';
 import { diagonal, formatReading, levelHausdorff, measurement } from './measure.js';
-import { projectPoint, snap, viewRay } from './pick.js';
+import { pixelSize, projectPoint, viewRay } from './pick.js';
 import { lightPane, measurePane, sectionPane } from './tools-ui.js';
 
 /** @typedef {[number, number, number]} Vec3 */
 
 /** A press that moves less than this (CSS px) is a click, not a turn. */
 const CLICK_PX = 4;
-/** Picks snap to a corner of the hit triangle within this many CSS px. */
+/** Picks snap to the nearest vertex within about this many CSS px. */
 const SNAP_PX = 8;
 
 /**
@@ -119,13 +119,17 @@ export class Inspection {
     const width = canvas.clientWidth;
     const height = canvas.clientHeight;
     const model = this.viewer.look.model;
-    const { hit, level, ms } = await renderer.pick(viewRay(camera, model, x, y, width, height));
+    const ray = viewRay(camera, model, x, y, width, height);
+    // Snap radius: SNAP_PX at the depth of the model's centre.
+    const { eye } = camera.basis();
+    const depth = Math.hypot(...[0, 1, 2].map((k) => camera.state.target[k] - eye[k]));
+    const { hit, vertex, level, ms } = await renderer.pick(ray, SNAP_PX * pixelSize(camera, depth, height));
     this.pickMs = ms;
     if (!hit || level === null) {
       this.measure.status.textContent = 'No surface there: click on the model.';
       return null;
     }
-    const point = snap(hit, (p) => projectPoint(camera, model, p, width, height), { x, y }, SNAP_PX);
+    const point = vertex ?? hit.point;
     if (this.points.length >= 2) this.points = [];
     this.points.push(point);
     if (this.points.length === 2) void this.#read(level);

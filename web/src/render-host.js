@@ -16,7 +16,7 @@ import { Renderer } from './renderer.js';
 /** @typedef {import('./reconstruction.js').LevelMessage} LevelMessage */
 /** @typedef {import('./renderer.js').AtlasResolution} AtlasResolution */
 /** @typedef {{ width: number, height: number, rgba: Uint8Array }} Capture */
-/** @typedef {{ hit: import('./pick.js').Hit | null, level: number | null, ms: number }} PickResult */
+/** @typedef {{ hit: import('./pick.js').Hit | null, vertex: [number, number, number] | null, level: number | null, ms: number }} PickResult */
 
 /**
  * @typedef {object} RenderHooks
@@ -48,8 +48,8 @@ import { Renderer } from './renderer.js';
  * @property {(source: ImageBitmap, resolution: AtlasResolution) => void} setColourAtlas
  * @property {() => Promise<Capture>} capture draws and reads the pixels (rows bottom-up)
  * @property {(look: import('./program.js').Look) => void} setLook model rotation, light, clay, section
- * @property {(ray: import('./pick.js').Ray) => Promise<PickResult>} pick the surface point of the level
- *   on screen along a ray (model coordinates)
+ * @property {(ray: import('./pick.js').Ray, snap: number) => Promise<PickResult>} pick the surface point of the level
+ *   on screen along a ray (model coordinates), and the vertex nearest to it within `snap` model units
  * @property {(eye: number[], points: number[][], tolerance: number) => Promise<boolean[]>} occlusion which
  *   points the level on screen hides from the eye
  * @property {() => Promise<Blob>} snapshot the view as a PNG
@@ -204,9 +204,9 @@ class MainRenderer {
     this.renderer.setLook(look);
   }
 
-  /** @param {import('./pick.js').Ray} ray */
-  async pick(ray) {
-    return this.renderer.pick(ray);
+  /** @param {import('./pick.js').Ray} ray @param {number} snap */
+  async pick(ray, snap) {
+    return this.renderer.pick(ray, snap);
   }
 
   /** @param {number[]} eye @param {number[][]} points @param {number} tolerance */
@@ -428,9 +428,9 @@ class WorkerRenderer {
     this.worker.postMessage({ type: 'look', look });
   }
 
-  /** @param {import('./pick.js').Ray} ray @returns {Promise<PickResult>} */
-  pick(ray) {
-    return this.#ask({ type: 'pick', ray });
+  /** @param {import('./pick.js').Ray} ray @param {number} snap @returns {Promise<PickResult>} */
+  pick(ray, snap) {
+    return this.#ask({ type: 'pick', ray, snap });
   }
 
   /** @param {number[]} eye @param {number[][]} points @param {number} tolerance @returns {Promise<boolean[]>} */

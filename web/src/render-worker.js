@@ -28,7 +28,7 @@ import { Renderer } from './renderer.js';
  *   | { type: 'size', width: number, height: number }
  *   | { type: 'camera', state: import('./camera.js').OrbitState | null, radius?: number | null }
  *   | { type: 'look', look: import('./program.js').Look }
- *   | { type: 'pick', id: number, ray: import('./pick.js').Ray }
+ *   | { type: 'pick', id: number, ray: import('./pick.js').Ray, snap: number }
  *   | { type: 'occlusion', id: number, eye: number[], points: number[][], tolerance: number }
  *   | { type: 'snapshot', id: number }
  *   | { type: 'wireframe', on: boolean }
@@ -217,7 +217,7 @@ scope.onmessage = (event) => {
       renderer?.setLook(command.look);
       break;
     case 'pick':
-      report({ type: 'answer', id: command.id, value: renderer?.pick(command.ray) ?? { hit: null, level: null, ms: 0 } });
+      report({ type: 'answer', id: command.id, value: renderer?.pick(command.ray, command.snap) ?? { hit: null, vertex: null, level: null, ms: 0 } });
       break;
     case 'occlusion':
       report({ type: 'answer', id: command.id, value: renderer?.occlusion(command.eye, command.points, command.tolerance) ?? [] });

@@ -30,7 +30,7 @@
 
 import { multiply } from './camera.js';
 import { NormalsTask, deriveNormals } from './normals-task.js';
-import { occluded, intersect } from './pick.js';
+import { intersect, nearestVertex, occluded } from './pick.js';
 import { DEFAULT_LOOK, bindCcc, bindLook, bindRelief, createAtlasTexture, createCellTexture, createProgram } from './program.js';
 import { BACKGROUND, CLAY } from './shading.js';
 import {
@@ -359,15 +359,18 @@ export class Renderer {
 
   /**
    * The nearest surface point of the level on screen along a ray in model
-   * coordinates (pick.js), with the time it took.
+   * coordinates (pick.js), the vertex of the level nearest to it within
+   * `snap` model units (null: none that near), and the time it took.
    * @param {import('./pick.js').Ray} ray
-   * @returns {{ hit: import('./pick.js').Hit | null, level: number | null, ms: number }}
+   * @param {number} [snap]
+   * @returns {import('./render-host.js').PickResult}
    */
-  pick(ray) {
+  pick(ray, snap = 0) {
     const mesh = this.current;
     const t0 = performance.now();
     const hit = mesh ? intersect(this.#store.positions, mesh.source.indices, ray) : null;
-    return { hit, level: mesh?.source.level ?? null, ms: performance.now() - t0 };
+    const vertex = mesh && hit && snap > 0 ? nearestVertex(this.#store.positions, mesh.source.vertices, hit.point, snap) : null;
+    return { hit, vertex, level: mesh?.source.level ?? null, ms: performance.now() - t0 };
   }
 
   /**

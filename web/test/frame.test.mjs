@@ -7,6 +7,15 @@ import { UP_AXES, corners, fitDistance, frameBox, rotate, rotateBounds, unrotate
 import { OrbitCamera } from '../src/camera.js';
 import { projectPoint } from '../src/pick.js';
 
+/**
+ * @param {number[]} min
+ * @param {number[]} max
+ * @returns {import('../src/geometry.js').Bounds}
+ */
+function box(min, max) {
+  return { min: [min[0], min[1], min[2]], max: [max[0], max[1], max[2]] };
+}
+
 /** @param {number[]} m column-major 3×3 */
 function det(m) {
   return m[0] * (m[4] * m[8] - m[7] * m[5]) - m[3] * (m[1] * m[8] - m[7] * m[2]) + m[6] * (m[1] * m[5] - m[4] * m[2]);
@@ -27,26 +36,26 @@ test('each up axis is turned onto +Y by a proper rotation', () => {
 });
 
 test('a Z-up box stands on its end after the rotation', () => {
-  const box = { min: [0, 0, 0], max: [1, 2, 10] };
-  const upright = rotateBounds(box, upRotation('z'));
+  const b = box([0, 0, 0], [1, 2, 10]);
+  const upright = rotateBounds(b, upRotation('z'));
   assert.deepEqual(upright.max.map((v, k) => v - upright.min[k]), [1, 10, 2], 'the tall axis is Y');
 });
 
 test('manifest bounds are used only when they are valid', () => {
-  const fallback = { min: [0, 0, 0], max: [1, 1, 1] };
-  assert.deepEqual(validBounds({ min: [-1, -2, -3], max: [1, 2, 3] }, fallback), { min: [-1, -2, -3], max: [1, 2, 3] });
+  const fallback = box([0, 0, 0], [1, 1, 1]);
+  assert.deepEqual(validBounds(box([-1, -2, -3], [1, 2, 3]), fallback), box([-1, -2, -3], [1, 2, 3]));
   for (const bad of [null, {}, { min: [0, 0], max: [1, 1, 1] }, { min: [2, 0, 0], max: [1, 1, 1] }, { min: [0, 0, NaN], max: [1, 1, 1] }]) {
     assert.equal(validBounds(bad, fallback), fallback, JSON.stringify(bad));
   }
-  const look = { model: upRotation('z'), bounds: { min: [0, 0, 0], max: [1, 2, 3] } };
+  const look = { model: upRotation('z'), bounds: box([0, 0, 0], [1, 2, 3]) };
   assert.deepEqual(frameBox(look, fallback).max.map((v, k) => v - frameBox(look, fallback).min[k]), [1, 3, 2]);
 });
 
 test('the home view fills most of the view, in landscape and in portrait', () => {
-  const box = { min: [-1, -0.5, -0.25], max: [1, 0.5, 0.25] };
+  const b = box([-1, -0.5, -0.25], [1, 0.5, 0.25]);
   for (const [width, height] of [[1920, 1080], [390, 844], [320, 568], [800, 800]]) {
-    const camera = new OrbitCamera(box, width / height);
-    const ps = corners(box).map((c) => projectPoint(camera, [1, 0, 0, 0, 1, 0, 0, 0, 1], c, width, height));
+    const camera = new OrbitCamera(b, width / height);
+    const ps = corners(b).map((c) => projectPoint(camera, [1, 0, 0, 0, 1, 0, 0, 0, 1], c, width, height));
     const xs = ps.map((p) => p.x);
     const ys = ps.map((p) => p.y);
     for (const p of ps) {
@@ -60,10 +69,10 @@ test('the home view fills most of the view, in landscape and in portrait', () =>
 });
 
 test('fitDistance grows for a narrower view and never puts the eye inside the box', () => {
-  const box = { min: [-1, -1, -1], max: [1, 1, 1] };
+  const b = box([-1, -1, -1], [1, 1, 1]);
   const view = { yaw: 0.5, pitch: 0.4, fovY: (40 * Math.PI) / 180 };
-  const wide = fitDistance(box, [0, 0, 0], { ...view, aspect: 2 });
-  const narrow = fitDistance(box, [0, 0, 0], { ...view, aspect: 0.4 });
+  const wide = fitDistance(b, [0, 0, 0], { ...view, aspect: 2 });
+  const narrow = fitDistance(b, [0, 0, 0], { ...view, aspect: 0.4 });
   assert.ok(narrow > wide * 1.5, `${narrow} vs ${wide}`);
-  assert.ok(fitDistance(box, [0, 0, 0], { ...view, aspect: 1, fill: 50 }) >= 1.05 * Math.sqrt(3));
+  assert.ok(fitDistance(b, [0, 0, 0], { ...view, aspect: 1, fill: 50 }) >= 1.05 * Math.sqrt(3));
 });

@@ -1,12 +1,12 @@
 // @ts-check
 // Node tests of pick.js: rays through pixels, ray–triangle hits,
-// occlusion, snapping and projection, on meshes whose answers are known,
+// occlusion, snapping to vertices and projection, on meshes whose answers are known,
 // and its speed on a million triangles.
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
 import { OrbitCamera } from '../src/camera.js';
 import { upRotation } from '../src/frame.js';
-import { intersect, occluded, projectPoint, snap, viewRay } from '../src/pick.js';
+import { intersect, nearestVertex, occluded, projectPoint, viewRay } from '../src/pick.js';
 
 const IDENTITY = [1, 0, 0, 0, 1, 0, 0, 0, 1];
 
@@ -54,12 +54,11 @@ test('the ray through a projected point hits that point (any up axis)', () => {
   }
 });
 
-test('snap takes the nearest corner within the radius, else the hit', () => {
-  /** @type {import('../src/pick.js').Hit} */
-  const hit = { t: 1, face: 0, point: [0.4, 0.4, 0], triangle: [[0, 0, 0], [1, 0, 0], [0, 1, 0]] };
-  const toScreen = (/** @type {number[]} */ p) => ({ x: 100 * p[0], y: 100 * p[1] });
-  assert.deepEqual(snap(hit, toScreen, { x: 3, y: 4 }, 8), [0, 0, 0]);
-  assert.deepEqual(snap(hit, toScreen, { x: 40, y: 40 }, 8), [0.4, 0.4, 0]);
+test('nearestVertex snaps within the radius only', () => {
+  const { positions } = cube();
+  assert.deepEqual(nearestVertex(positions, 8, [0.05, 0.98, 1.02], 0.1), [0, 1, 1]);
+  assert.equal(nearestVertex(positions, 8, [0.5, 0.5, 1], 0.1), null);
+  assert.equal(nearestVertex(positions, 1, [0.05, 0.98, 1.02], 0.1), null, 'only the first `count` vertices');
 });
 
 test('a million triangles are picked in well under a second', () => {

@@ -17,12 +17,14 @@ export const webDist = join(root, 'web', 'dist');
  * @property {string} slug
  * @property {string} title
  * @property {string} [description]
- * @property {'torus' | 'sphere' | 'plate'} kind
- * @property {number} kiloVertices
+ * @property {'torus' | 'sphere' | 'plate' | 'file'} kind a generated sample, or `file` (a mesh the test wrote)
+ * @property {string} [file] with `kind: 'file'`, the mesh to ingest
+ * @property {number} [kiloVertices] the sample's detail
  * @property {boolean} [colour] paint a procedural pattern on the vertices
  * @property {'vertex' | 'ccc' | 'none'} [colourMode] how `vitrine ingest` stores the colour (default vertex)
  * @property {string} [policy] exhibition, open or researchers
  * @property {boolean} [quality] measure every level at ingest (`vitrine ingest --quality`)
+ * @property {string[]} [ingestArgs] more `vitrine ingest` arguments
  */
 
 /**
@@ -36,13 +38,16 @@ export async function startService({ models, serveArgs = [] }) {
   const db = `sqlite:${join(dir, 'vitrine.db')}`;
   const env = { ...process.env, NO_COLOR: '1', RUST_LOG: process.env.RUST_LOG ?? 'warn,vitrine=info' };
   for (const m of models) {
-    const mesh = join(dir, `${m.slug}.ply`);
-    const sample = ['sample', m.kind, '-o', mesh, '--kilo-vertices', String(m.kiloVertices)];
-    execFileSync(vitrine, m.colour ? [...sample, '--colour'] : sample, { stdio: 'pipe' });
+    const mesh = m.kind === 'file' ? String(m.file) : join(dir, `${m.slug}.ply`);
+    if (m.kind !== 'file') {
+      const sample = ['sample', m.kind, '-o', mesh, '--kilo-vertices', String(m.kiloVertices ?? 10)];
+      execFileSync(vitrine, m.colour ? [...sample, '--colour'] : sample, { stdio: 'pipe' });
+    }
     const ingest = ['ingest', mesh, '--db', db, '--slug', m.slug, '--title', m.title];
     ingest.push('--description', m.description ?? '', '--policy', m.policy ?? 'open');
     if (m.colourMode) ingest.push('--colour', m.colourMode);
     if (m.quality) ingest.push('--quality');
+    if (m.ingestArgs) ingest.push(...m.ingestArgs);
     execFileSync(vitrine, ingest, { stdio: 'pipe', env });
   }
   // Chromium on SwiftShader keeps both cores of a small machine busy, which
