@@ -502,9 +502,12 @@ test('ccc: every level shows the painted colours: each matches a CPU rendering o
     // vertices the silhouette and the checks' borders move with the coarse
     // geometry (10 % of the pixels cross a border at this torus's base), so
     // only the mean is bounded there; the comparison above with each level's
-    // own rendering is what checks where its colours land.
+    // own rendering is what checks where its colours land. The home view
+    // fits the model's box to the view (issue 22), so the torus covers ~40 %
+    // more pixels than with the old bounding-sphere fit, and the base's
+    // mean went from 0.029 to 0.032: the coarse levels' mean gets 0.035.
     const coarse = manifest.levels[k].vertices < 0.02 * manifest.levels[n].vertices;
-    assert.ok(score.mean < 0.03 && (coarse || score.far < 0.05), `level ${k} vs final: ${JSON.stringify(score)}`);
+    assert.ok(score.mean < (coarse ? 0.035 : 0.03) && (coarse || score.far < 0.05), `level ${k} vs final: ${JSON.stringify(score)}`);
   }
 });
 

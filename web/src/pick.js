@@ -15,6 +15,39 @@ import { rotate, unrotate } from './frame.js';
 /** @typedef {[number, number, number]} Vec3 */
 /** @typedef {{ origin: Vec3, direction: Vec3 }} Ray */
 /** @typedef {{ t: number, face: number, point: Vec3, triangle: [Vec3, Vec3, Vec3] }} Hit */
+/**
+ * A level to pick on: positions of every vertex received (at least `vertices`), its triangles.
+ * @typedef {{ positions: Float32Array, vertices: number, indices: Uint32Array, level: number }} Surface
+ */
+/** @typedef {{ hit: Hit | null, vertex: Vec3 | null, level: number | null, ms: number }} PickResult */
+
+/**
+ * The nearest surface point of a level along a ray (model coordinates),
+ * the vertex nearest to it within `snap` model units (null: none that
+ * near), and the time it took.
+ * @param {Surface | null} surface
+ * @param {Ray} ray
+ * @param {number} snap
+ * @returns {PickResult}
+ */
+export function pickLevel(surface, ray, snap) {
+  const t0 = performance.now();
+  if (!surface) return { hit: null, vertex: null, level: null, ms: 0 };
+  const hit = intersect(surface.positions, surface.indices, ray);
+  const vertex = hit && snap > 0 ? nearestVertex(surface.positions, surface.vertices, hit.point, snap) : null;
+  return { hit, vertex, level: surface.level, ms: performance.now() - t0 };
+}
+
+/**
+ * Which of `points` a level hides from `eye` (model coordinates; see occluded).
+ * @param {Surface | null} surface
+ * @param {ArrayLike<number>} eye
+ * @param {ReadonlyArray<ArrayLike<number>>} points
+ * @param {number} tolerance
+ */
+export function occludedPoints(surface, eye, points, tolerance) {
+  return points.map((p) => (surface ? occluded(surface.positions, surface.indices, eye, p, tolerance) : false));
+}
 
 /**
  * The ray from the eye through a point of the view, in model coordinates.

@@ -11,12 +11,13 @@
  * context, pending uploads).
  */
 
+import { occludedPoints, pickLevel } from './pick.js';
 import { Renderer } from './renderer.js';
 
 /** @typedef {import('./reconstruction.js').LevelMessage} LevelMessage */
 /** @typedef {import('./renderer.js').AtlasResolution} AtlasResolution */
 /** @typedef {{ width: number, height: number, rgba: Uint8Array }} Capture */
-/** @typedef {{ hit: import('./pick.js').Hit | null, vertex: [number, number, number] | null, level: number | null, ms: number }} PickResult */
+/** @typedef {import('./pick.js').PickResult} PickResult */
 
 /**
  * @typedef {object} RenderHooks
@@ -206,12 +207,12 @@ class MainRenderer {
 
   /** @param {import('./pick.js').Ray} ray @param {number} snap */
   async pick(ray, snap) {
-    return this.renderer.pick(ray, snap);
+    return pickLevel(this.renderer.surface(), ray, snap);
   }
 
   /** @param {number[]} eye @param {number[][]} points @param {number} tolerance */
   async occlusion(eye, points, tolerance) {
-    return this.renderer.occlusion(eye, points, tolerance);
+    return occludedPoints(this.renderer.surface(), eye, points, tolerance);
   }
 
   snapshot() {

@@ -19,6 +19,7 @@
 
 import { OrbitCamera } from './camera.js';
 import { frameBox } from './frame.js';
+import { occludedPoints, pickLevel } from './pick.js';
 import { Renderer } from './renderer.js';
 
 /**
@@ -217,10 +218,10 @@ scope.onmessage = (event) => {
       renderer?.setLook(command.look);
       break;
     case 'pick':
-      report({ type: 'answer', id: command.id, value: renderer?.pick(command.ray, command.snap) ?? { hit: null, vertex: null, level: null, ms: 0 } });
+      report({ type: 'answer', id: command.id, value: pickLevel(renderer?.surface() ?? null, command.ray, command.snap) });
       break;
     case 'occlusion':
-      report({ type: 'answer', id: command.id, value: renderer?.occlusion(command.eye, command.points, command.tolerance) ?? [] });
+      report({ type: 'answer', id: command.id, value: occludedPoints(renderer?.surface() ?? null, command.eye, command.points, command.tolerance) });
       break;
     case 'snapshot': {
       const id = command.id;

@@ -30,7 +30,6 @@
 
 import { multiply } from './camera.js';
 import { NormalsTask, deriveNormals } from './normals-task.js';
-import { intersect, nearestVertex, occluded } from './pick.js';
 import { DEFAULT_LOOK, bindCcc, bindLook, bindRelief, createAtlasTexture, createCellTexture, createProgram } from './program.js';
 import { BACKGROUND, CLAY } from './shading.js';
 import {
@@ -358,32 +357,14 @@ export class Renderer {
   }
 
   /**
-   * The nearest surface point of the level on screen along a ray in model
-   * coordinates (pick.js), the vertex of the level nearest to it within
-   * `snap` model units (null: none that near), and the time it took.
-   * @param {import('./pick.js').Ray} ray
-   * @param {number} [snap]
-   * @returns {import('./render-host.js').PickResult}
+   * The level on screen as the picking code reads it (pick.js pickLevel,
+   * occludedPoints): every vertex received, its triangles; null before one is drawn.
+   * @returns {import('./pick.js').Surface | null}
    */
-  pick(ray, snap = 0) {
+  surface() {
     const mesh = this.current;
-    const t0 = performance.now();
-    const hit = mesh ? intersect(this.#store.positions, mesh.source.indices, ray) : null;
-    const vertex = mesh && hit && snap > 0 ? nearestVertex(this.#store.positions, mesh.source.vertices, hit.point, snap) : null;
-    return { hit, vertex, level: mesh?.source.level ?? null, ms: performance.now() - t0 };
-  }
-
-  /**
-   * Which of `points` the level on screen hides from `eye` (model coordinates).
-   * @param {ArrayLike<number>} eye
-   * @param {ReadonlyArray<ArrayLike<number>>} points
-   * @param {number} tolerance model units
-   * @returns {boolean[]}
-   */
-  occlusion(eye, points, tolerance) {
-    const mesh = this.current;
-    if (!mesh) return points.map(() => false);
-    return points.map((p) => occluded(this.#store.positions, mesh.source.indices, eye, p, tolerance));
+    if (!mesh) return null;
+    return { positions: this.#store.positions, vertices: mesh.source.vertices, indices: mesh.source.indices, level: mesh.source.level };
   }
 
   /**
