@@ -148,7 +148,7 @@ async function markersAt(page, level) {
   const placed = await page.evaluate(() => /** @type {any} */ (document.querySelector('vitrine-viewer')).viewer.annotations.placed);
   const image = await capture(page);
   const mask = foreground(image.rgba);
-  const ratio = image.width / WIDTH;
+  const ratio = image.width / (await page.evaluate(() => /** @type {any} */ (document.querySelector('vitrine-viewer')).viewer.ui.canvas.clientWidth));
   const onModel = placed.map((p) => mask[(image.height - 1 - Math.round(p.y * ratio)) * image.width + Math.round(p.x * ratio)] === 1);
   return { placed, onModel };
 }
@@ -192,6 +192,32 @@ test('annotations (served by a stub of the route) sit on the same surface point 
   await page.route('**/api/models/box/annotations', (route) => route.fulfill({ json: NOTES }));
   const shown = await checkAnnotations(page);
   assert.equal(shown.em, 'front', 'the server\'s HTML is rendered');
+  assert.deepEqual(problems, []);
+  await page.close();
+});
+
+test('a Z-up manifest stands the model on its end; the notes stay on its surface', async () => {
+  const { page, problems } = await open('/', WIDE);
+  await page.route('**/api/models/box/annotations', (route) => route.fulfill({ json: NOTES }));
+  // The manifest as the curators-server branch sends it: up axis, unit, bounds.
+  await page.route(
+    (url) => url.pathname === '/api/models/box',
+    async (route) => {
+      const json = await (await route.fetch()).json();
+      await route.fulfill({ json: { ...json, up: 'z', unit: 'mm', bounds: { min: [0, 0, 0], max: SIZE } } });
+    },
+  );
+  const seen = await markersAt(page, manifest.last_level);
+  const box = await page.evaluate(() => /** @type {any} */ (document.querySelector('vitrine-viewer')).viewer.camera.box);
+  assert.deepEqual(box.max.map((/** @type {number} */ v, /** @type {number} */ k) => v - box.min[k]), [40, 20, 30], 'model z is up');
+  // Front (+z) is now the top, seen from above; Top (+y) faces away; Behind is under the box.
+  assert.deepEqual(seen.placed.map((p) => p.visible), [true, false, false], JSON.stringify(seen.placed));
+  assert.ok(seen.onModel[0], 'the marker is on the model');
+  await zoomOut(page);
+  // The front vertical edge: model z, now upright.
+  const reading = await measureBetween(page, [40, 0, 0], [40, 0, 20]);
+  assert.ok(Math.abs(reading.reading.value - 20) <= step, `edge ${reading.reading.value}: ${JSON.stringify(reading.reading.points)}`);
+  assert.match(reading.text, /^20\.0+ mm ± 0\.0+\d mm at this level$/);
   assert.deepEqual(problems, []);
   await page.close();
 });
@@ -241,6 +267,18 @@ async function view(page) {
 }
 
 /**
+ * Zooms out a little, so that no panel covers the model's corners.
+ * @param {Page} page
+ */
+function zoomOut(page) {
+  return page.evaluate(() => {
+    const v = /** @type {any} */ (document.querySelector('vitrine-viewer')).viewer;
+    v.camera.state.distance *= 1.5;
+    v.renderer.requestFrame();
+  });
+}
+
+/**
  * Clicks two model points (each moved `inset` px towards the box's centre on screen) in the measure mode.
  * @param {Page} page
  * @param {number[]} a
@@ -277,12 +315,7 @@ test('a measurement of the box\'s edge reads 40 within one quantization step, wi
   const { page, problems, go } = await open('/m/box', WIDE);
   await go();
   await until(page, `s.status === 'complete'`);
-  // Zoomed out a little, so that no panel covers the corners.
-  await page.evaluate(() => {
-    const v = /** @type {any} */ (document.querySelector('vitrine-viewer')).viewer;
-    v.camera.state.distance *= 1.5;
-    v.renderer.requestFrame();
-  });
+  await zoomOut(page);
   // The top front edge, (0, 30, 20) to (40, 30, 20): both corners in view from the home view.
   const seen = await measureBetween(page, [0, 30, 20], [40, 30, 20]);
   const { value, level, surface } = seen.reading;
@@ -376,6 +409,22 @@ test('raking light changes the shading; the section hides the cut half; the snap
   assert.deepEqual([...png.subarray(0, 8)], [137, 80, 78, 71, 13, 10, 26, 10], 'PNG signature');
   assert.equal(png.subarray(12, 16).toString('latin1'), 'IHDR');
   assert.deepEqual([png.readUInt32BE(16), png.readUInt32BE(20)], [cut.width, cut.height], 'the canvas\'s size');
+  assert.deepEqual(problems, []);
+  await page.close();
+});
+
+test('on the main thread (?offscreen=off) the snapshot is a PNG of the canvas too', async () => {
+  const { page, problems, go } = await open('/m/box?offscreen=off');
+  await go();
+  await until(page, `s.status === 'complete' && v.renderer?.thread === 'main'`);
+  const [download] = await Promise.all([page.waitForEvent('download'), tool(page, 'snapshot').click()]);
+  const png = readFileSync(/** @type {string} */ (await download.path()));
+  const size = await page.evaluate(() => {
+    const c = /** @type {any} */ (document.querySelector('vitrine-viewer')).viewer.ui.canvas;
+    return [c.width, c.height];
+  });
+  assert.deepEqual([...png.subarray(0, 8)], [137, 80, 78, 71, 13, 10, 26, 10], 'PNG signature');
+  assert.deepEqual([png.readUInt32BE(16), png.readUInt32BE(20)], size);
   assert.deepEqual(problems, []);
   await page.close();
 });

@@ -120,10 +120,8 @@ export class Inspection {
     const height = canvas.clientHeight;
     const model = this.viewer.look.model;
     const ray = viewRay(camera, model, x, y, width, height);
-    // Snap radius: SNAP_PX at the depth of the model's centre.
-    const { eye } = camera.basis();
-    const depth = Math.hypot(...[0, 1, 2].map((k) => camera.state.target[k] - eye[k]));
-    const { hit, vertex, level, ms } = await renderer.pick(ray, SNAP_PX * pixelSize(camera, depth, height));
+    // Snap radius: SNAP_PX at the hit's depth (see pickLevel).
+    const { hit, vertex, level, ms } = await renderer.pick(ray, SNAP_PX * pixelSize(camera, 1, height));
     this.pickMs = ms;
     if (!hit || level === null) {
       this.measure.status.textContent = 'No surface there: click on the model.';

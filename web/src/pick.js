@@ -23,8 +23,11 @@ import { rotate, unrotate } from './frame.js';
 
 /**
  * The nearest surface point of a level along a ray (model coordinates),
- * the vertex nearest to it within `snap` model units (null: none that
- * near), and the time it took.
+ * the vertex nearest to it within `snap` × t model units (null: none that
+ * near), and the time it took. With a ray from viewRay (its direction's
+ * forward component is 1, so t is the hit's depth), `snap` is the snapping
+ * radius in pixels times pixelSize(camera, 1, height): the same number of
+ * pixels at any depth.
  * @param {Surface | null} surface
  * @param {Ray} ray
  * @param {number} snap
@@ -34,7 +37,7 @@ export function pickLevel(surface, ray, snap) {
   const t0 = performance.now();
   if (!surface) return { hit: null, vertex: null, level: null, ms: 0 };
   const hit = intersect(surface.positions, surface.indices, ray);
-  const vertex = hit && snap > 0 ? nearestVertex(surface.positions, surface.vertices, hit.point, snap) : null;
+  const vertex = hit && snap > 0 ? nearestVertex(surface.positions, surface.vertices, hit.point, snap * hit.t) : null;
   return { hit, vertex, level: surface.level, ms: performance.now() - t0 };
 }
 

@@ -50,7 +50,7 @@ import { Renderer } from './renderer.js';
  * @property {() => Promise<Capture>} capture draws and reads the pixels (rows bottom-up)
  * @property {(look: import('./program.js').Look) => void} setLook model rotation, light, clay, section
  * @property {(ray: import('./pick.js').Ray, snap: number) => Promise<PickResult>} pick the surface point of the level
- *   on screen along a ray (model coordinates), and the vertex nearest to it within `snap` model units
+ *   on screen along a ray (model coordinates), and the vertex nearest to it within `snap` × depth model units (pick.js pickLevel)
  * @property {(eye: number[], points: number[][], tolerance: number) => Promise<boolean[]>} occlusion which
  *   points the level on screen hides from the eye
  * @property {() => Promise<Blob>} snapshot the view as a PNG
