@@ -191,7 +191,10 @@ export class Annotations {
       const n = rotate(model, a.normal);
       const facing = n[0] * (eye[0] - world[0]) + n[1] * (eye[1] - world[1]) + n[2] * (eye[2] - world[2]) > 0;
       const onScreen = p.inFront && p.x >= 0 && p.y >= 0 && p.x <= width && p.y <= height;
-      const visible = onScreen && facing && !this.#occluded.has(a.id) && this.viewer.state.shownLevel >= 0;
+      // A point the section plane cuts away goes with it.
+      const section = this.viewer.look.section;
+      const cut = section !== null && world[0] * section[0] + world[1] * section[1] + world[2] * section[2] > section[3] + 1e-6 * diagonal(camera.box);
+      const visible = onScreen && facing && !cut && !this.#occluded.has(a.id) && this.viewer.state.shownLevel >= 0;
       const marker = this.#markers[k];
       marker.hidden = !visible;
       marker.style.transform = `translate(${p.x}px, ${p.y}px) translate(-50%, -50%)`;

@@ -100,9 +100,10 @@ export function projectPoint(camera, model, point, width, height) {
  * @param {Uint32Array} indices three per triangle
  * @param {Ray} ray
  * @param {number} [tMax]
+ * @param {boolean} [any] stop at the first hit (an occlusion test), not the nearest
  * @returns {Hit | null}
  */
-export function intersect(positions, indices, ray, tMax = Infinity) {
+export function intersect(positions, indices, ray, tMax = Infinity, any = false) {
   const [ox, oy, oz] = ray.origin;
   const [dx, dy, dz] = ray.direction;
   let best = tMax;
@@ -144,6 +145,7 @@ export function intersect(positions, indices, ray, tMax = Infinity) {
     if (t > 1e-9 && t < best) {
       best = t;
       face = f / 3;
+      if (any) break;
     }
   }
   if (face < 0) return null;
@@ -176,7 +178,7 @@ export function occluded(positions, indices, eye, point, tolerance) {
   const length = Math.hypot(...direction);
   if (length <= tolerance) return false;
   const ray = { origin: /** @type {Vec3} */ ([eye[0], eye[1], eye[2]]), direction };
-  return intersect(positions, indices, ray, 1 - tolerance / length) !== null;
+  return intersect(positions, indices, ray, 1 - tolerance / length, true) !== null;
 }
 
 /**

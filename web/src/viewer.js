@@ -234,6 +234,7 @@ export class Viewer {
   setLook(patch) {
     this.#look = { ...this.#look, ...patch };
     this.renderer?.setLook(this.#look);
+    this.annotations.place();
   }
 
   /** The camera moved or the view was resized: what is anchored to the model follows. */
