@@ -120,8 +120,9 @@ pub(super) fn parse_document<'a>(
     if json.iter().all(|b| b.is_ascii_whitespace()) {
         return Err(Error::input(what, "is empty"));
     }
-    let root = gltf::json::Root::from_slice(json)
+    let mut root = gltf::json::Root::from_slice(json)
         .map_err(|e| gltf_error(gltf::Error::Deserialize(e), what))?;
+    super::extensions::accept_required(&mut root, what)?;
     check_attribute_accessors(&root, what)?;
     let doc = gltf::Document::from_json(root).map_err(|e| gltf_error(e, what))?;
     Ok((doc, bin))

@@ -15,12 +15,18 @@
 //!
 //! [`read_textured`] also reads the primitives' `baseColorTexture` image and
 //! their `TEXCOORD_n` (the `texCoord` of the texture reference); only then
-//! are images decoded, through [`super::texture`]. `KHR_texture_transform`
-//! is ignored.
+//! are images decoded, through [`super::texture`], and the reference's
+//! `KHR_texture_transform` applied to the coordinates.
+//!
+//! [`extensions`] says which required extensions are read, which are
+//! accepted because they only change how a material looks, and which are
+//! refused by name. Sparse accessors and `KHR_mesh_quantization`'s integer
+//! attributes are read by [`accessor`]; custom attributes (`_FOO`) are
+//! ignored.
 //!
 //! The reader is split by what it reads: [`document`] (the GLB container
 //! and the JSON), [`buffers`] (buffer bytes and URIs), [`accessor`]
-//! (checked accessor views), [`scene`] (node transforms), [`primitive`] and
+//! (checked accessor views, sparse or not), [`scene`] (node transforms), [`primitive`] and
 //! [`triangles`] (the combined mesh), [`material`] and [`surface`] (the
 //! base colour texture), [`colour`] (linear ↔ sRGB).
 
@@ -33,6 +39,7 @@ mod accessor;
 mod buffers;
 mod colour;
 mod document;
+mod extensions;
 mod material;
 mod primitive;
 mod scene;

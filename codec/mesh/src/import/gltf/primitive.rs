@@ -5,7 +5,7 @@
 use gltf::mesh::{Mode, Semantic};
 
 use super::super::ImportOptions;
-use super::accessor::open;
+use super::accessor::{self, open};
 use super::buffers::Buffers;
 use super::colour::linear_to_srgb_u8;
 use super::material::{base_colour, read_uvs, BaseColour};
@@ -77,9 +77,7 @@ impl Combined {
             .into_iter()
             .flatten()
         {
-            if let Some(view) = acc.view() {
-                r.buffers.load(&view.buffer())?;
-            }
+            accessor::load(acc, r.buffers)?;
         }
         let base = self.positions.len();
         let n = self.push_positions(r, &pos_acc, world, &ctx)?;
@@ -87,7 +85,7 @@ impl Combined {
         // Unreadable texture coordinates cost the texture, not the geometry.
         let uvs = texture.as_ref().and_then(|t| {
             let acc = t.uvs.as_ref()?;
-            Some(read_uvs(acc, r.buffers, r.what, &ctx, t.set, n))
+            Some(read_uvs(acc, r.buffers, r.what, &ctx, t, n))
         });
         let placed = Placed {
             ctx,
