@@ -138,10 +138,16 @@ fn lod_of_an_md2_is_one_valid_glb_with_msft_lod_and_its_animation() {
         5
     );
     assert_eq!(json["extensionsUsed"], serde_json::json!(["MSFT_lod"]));
+    // A GLB vertex is a (vertex, texture coordinate) pair: the level's
+    // vertices are its distinct positions (the torus has no two alike).
+    let base = floats(&json, &bin, 0);
     for (i, p) in [100usize, 80, 60, 40, 20].iter().enumerate() {
         let prim = &json["meshes"][i]["primitives"][0];
         let idx = indices(&json, &bin, prim["indices"].as_u64().unwrap() as usize);
-        let mut used = idx.clone();
+        let mut used: Vec<[u32; 3]> = idx
+            .iter()
+            .map(|&v| std::array::from_fn(|c| base[3 * v as usize + c].to_bits()))
+            .collect();
         used.sort_unstable();
         used.dedup();
         assert_eq!(used.len(), 384 * p / 100, "level {p} %");
@@ -150,7 +156,6 @@ fn lod_of_an_md2_is_one_valid_glb_with_msft_lod_and_its_animation() {
     // Frame midpoints: the animation's LINEAR weights at (k + ½)/fps give
     // the linear interpolation of frames k and k + 1.
     let frames: Vec<Vec<[f32; 3]>> = model.frames.iter().map(|f| f.positions()).collect();
-    let base = floats(&json, &bin, 0);
     let anim = &json["animations"][0];
     let sampler = &anim["samplers"][0];
     assert_eq!(sampler["interpolation"], "LINEAR");
@@ -167,16 +172,20 @@ fn lod_of_an_md2_is_one_valid_glb_with_msft_lod_and_its_animation() {
         let t = (k as f32 + 0.5) / 10.0;
         let s = (t - times[k]) / (times[k + 1] - times[k]);
         let weight = |j: usize| keys[k * 5 + j] * (1.0 - s) + keys[(k + 1) * 5 + j] * s;
-        for v in 0..384 {
+        for g in 0..base.len() / 3 {
+            // The model vertex of GLB vertex g: the one at its frame 0 position.
+            let v = (0..384)
+                .find(|&v| (0..3).all(|c| frames[0][v][c] == base[3 * g + c]))
+                .expect("every GLB vertex is a model vertex");
             for c in 0..3 {
-                let morphed: f32 = base[3 * v + c]
+                let morphed: f32 = base[3 * g + c]
                     + (0..5)
-                        .map(|j| weight(j) * targets[j][3 * v + c])
+                        .map(|j| weight(j) * targets[j][3 * g + c])
                         .sum::<f32>();
                 let midpoint = (frames[k][v][c] + frames[k + 1][v][c]) / 2.0;
                 assert!(
                     (morphed - midpoint).abs() <= 1e-5 * midpoint.abs().max(1.0),
-                    "frame {k}+½ vertex {v}: {morphed} vs {midpoint}"
+                    "frame {k}+½ GLB vertex {g}: {morphed} vs {midpoint}"
                 );
             }
         }
@@ -282,4 +291,156 @@ fn an_md2_frame_encodes_and_decodes_to_md2() {
     let missing = vitrine(&["encode", text(&input), "--frame", "6", "-o", text(&stream)]);
     assert!(!missing.status.success());
     assert!(String::from_utf8_lossy(&missing.stderr).contains("has 6 frames"));
+}
+
+/// Writes `name` (an RGB test pattern of `w × h`) into `dir`.
+fn write_png(dir: &Path, name: &str, (w, h): (u32, u32)) {
+    image::RgbImage::from_fn(w, h, |x, y| image::Rgb([(x * 4) as u8, (y * 8) as u8, 77]))
+        .save(dir.join(name))
+        .unwrap();
+}
+
+/// Accessor `a` of a primitive's attribute `name`.
+fn attribute(json: &Value, level: usize, name: &str) -> usize {
+    json["meshes"][level]["primitives"][0]["attributes"][name]
+        .as_u64()
+        .unwrap_or_else(|| panic!("level {level} has no {name}")) as usize
+}
+
+#[test]
+fn lod_glbs_carry_the_md2_skin_and_its_texture_coordinates() {
+    let dir = tempfile::tempdir().unwrap();
+    let (input, model) = md2_file(dir.path());
+    write_png(dir.path(), "skin.png", (64, 32));
+    let out = dir.path().join("skinned.glb");
+    succeeds(&["lod", text(&input), "--levels", "100,30", "-o", text(&out)]);
+    assert_valid_gltf(std::slice::from_ref(&out));
+    let (json, bin) = glb(&out);
+    assert_eq!(json["images"][0]["mimeType"], "image/png");
+    let material = &json["materials"][0]["pbrMetallicRoughness"]["baseColorTexture"];
+    assert_eq!(material["index"], 0);
+    let base = floats(&json, &bin, 0);
+    let uvs = floats(&json, &bin, attribute(&json, 0, "TEXCOORD_0"));
+    assert_eq!(uvs.len() / 2, base.len() / 3);
+    // Every GLB vertex is a (vertex, st) pair of the model's triangles:
+    // positions and coordinates carry over per kept vertex, and a seam
+    // vertex keeps one GLB vertex per side.
+    let frame = model.frames[0].positions();
+    let pairs: std::collections::HashSet<[u32; 5]> = model
+        .triangles
+        .iter()
+        .flat_map(|t| (0..3).map(move |c| (t.vertex[c] as usize, t.st[c] as usize)))
+        .map(|(v, st)| {
+            let [s, t] = model.st[st];
+            let uv = [f32::from(s) / 64.0, f32::from(t) / 32.0];
+            [frame[v][0], frame[v][1], frame[v][2], uv[0], uv[1]].map(f32::to_bits)
+        })
+        .collect();
+    for g in 0..uvs.len() / 2 {
+        let pair = [
+            base[3 * g],
+            base[3 * g + 1],
+            base[3 * g + 2],
+            uvs[2 * g],
+            uvs[2 * g + 1],
+        ]
+        .map(f32::to_bits);
+        assert!(
+            pairs.contains(&pair),
+            "GLB vertex {g} is no vertex of the model"
+        );
+    }
+    assert!(uvs.len() / 2 > 384, "the seam's vertices are split");
+    // The coarse level uses the same material.
+    assert_eq!(json["meshes"][1]["primitives"][0]["material"], 0);
+}
+
+#[test]
+fn lod_glbs_of_a_textured_and_of_a_coloured_scan() {
+    let dir = tempfile::tempdir().unwrap();
+    // A textured OBJ: a 12 × 12 grid, texture coordinates from its plan.
+    let grid = vitrine_samples::grid(12);
+    let mut obj = String::from("mtllib grid.mtl\nusemtl skin\n");
+    for p in &grid.positions {
+        obj += &format!(
+            "v {} {} {}\nvt {} {}\n",
+            p[0],
+            p[1],
+            p[2],
+            p[0] / 12.0,
+            p[1] / 12.0
+        );
+    }
+    for t in &grid.triangles {
+        let [a, b, c] = t.map(|v| v + 1);
+        obj += &format!("f {a}/{a} {b}/{b} {c}/{c}\n");
+    }
+    std::fs::write(dir.path().join("grid.obj"), obj).unwrap();
+    std::fs::write(dir.path().join("grid.mtl"), "newmtl skin\nmap_Kd tex.png\n").unwrap();
+    write_png(dir.path(), "tex.png", (16, 8));
+    let out = dir.path().join("grid.glb");
+    let input = dir.path().join("grid.obj");
+    succeeds(&[
+        "lod",
+        text(&input),
+        "--levels",
+        "100,50",
+        "--split",
+        "-o",
+        text(&out),
+    ]);
+    let files = [
+        dir.path().join("grid-100.glb"),
+        dir.path().join("grid-50.glb"),
+    ];
+    assert_valid_gltf(&files);
+    for f in &files {
+        let (json, bin) = glb(f);
+        let base = floats(&json, &bin, 0);
+        let uvs = floats(&json, &bin, attribute(&json, 0, "TEXCOORD_0"));
+        for g in 0..uvs.len() / 2 {
+            // The OBJ's own coordinate of the kept vertex (v = 1 − y / 12:
+            // OBJ's rows count from the bottom, glTF's from the top).
+            let want = [base[3 * g] / 12.0, 1.0 - base[3 * g + 1] / 12.0];
+            assert!(
+                (uvs[2 * g] - want[0]).abs() < 1e-6 && (uvs[2 * g + 1] - want[1]).abs() < 1e-6,
+                "{}: GLB vertex {g}",
+                f.display()
+            );
+        }
+        assert!(json["images"][0]["bufferView"].is_u64());
+    }
+    // A coloured PLY: COLOR_0 holds each kept vertex's colour, linear.
+    let mut plate = vitrine_samples::plate_with_tunnels(2, 5);
+    vitrine_samples::paint(&mut plate);
+    let input = dir.path().join("plate.ply");
+    let file = std::fs::File::create(&input).unwrap();
+    vitrine_mesh::export::write_ply(&plate, &mut std::io::BufWriter::new(file)).unwrap();
+    let out = dir.path().join("plate.glb");
+    succeeds(&["lod", text(&input), "--levels", "100,40", "-o", text(&out)]);
+    assert_valid_gltf(std::slice::from_ref(&out));
+    let (json, bin) = glb(&out);
+    let base = floats(&json, &bin, 0);
+    let colours = floats(&json, &bin, attribute(&json, 1, "COLOR_0"));
+    let srgb = |l: f32| {
+        let s = if l <= 0.003_130_8 {
+            12.92 * l
+        } else {
+            1.055 * l.powf(1.0 / 2.4) - 0.055
+        };
+        (s * 255.0).round() as u8
+    };
+    let colour_of = |p: [f32; 3]| {
+        let v = plate
+            .positions
+            .iter()
+            .position(|q| *q == p)
+            .expect("a plate vertex");
+        plate.colors.as_ref().unwrap()[v]
+    };
+    for g in 0..base.len() / 3 {
+        let p = [base[3 * g], base[3 * g + 1], base[3 * g + 2]];
+        let got = [0, 1, 2].map(|c| srgb(colours[3 * g + c]));
+        assert_eq!(got, colour_of(p), "GLB vertex {g}");
+    }
 }

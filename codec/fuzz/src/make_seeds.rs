@@ -138,4 +138,38 @@ fn main() {
         "polygons",
         b"v 0 0 0 1 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt 0 0\nf 1/1 2/1 3/1 4/1\nf -1 -2 -3\n",
     );
+    write("import_gltf", "extensions", extension_seed().as_bytes());
+}
+
+/// glTF as tools write it: quantized short positions (`KHR_mesh_quantization`
+/// required, with a material-only extension), a sparse accessor without a
+/// base view, a custom attribute and a texture transform, in one file.
+fn extension_seed() -> String {
+    let mut bin = Vec::new();
+    for v in [0i16, 0, 0, 300, 0, 0, 300, 300, 0, 0, 300, 0] {
+        bin.extend_from_slice(&v.to_le_bytes()); // 24 bytes of positions
+    }
+    for i in [0u16, 1, 2, 0, 2, 3] {
+        bin.extend_from_slice(&i.to_le_bytes()); // 12 bytes of indices
+    }
+    bin.extend_from_slice(&[1, 2, 3, 0]); // 4 bytes of sparse indices
+    for v in [1f32, 0.0, 0.0, 1.0, 1.0, 0.0, 0.0, 1.0, 0.0] {
+        bin.extend_from_slice(&v.to_le_bytes()); // 36 bytes of sparse values
+    }
+    format!(
+        r#"{{"asset":{{"version":"2.0"}},"extensionsUsed":["KHR_mesh_quantization","KHR_materials_unlit","KHR_texture_transform"],
+"extensionsRequired":["KHR_mesh_quantization","KHR_materials_unlit"],"scene":0,"scenes":[{{"nodes":[0]}}],
+"nodes":[{{"mesh":0,"scale":[0.01,0.01,0.01]}}],
+"materials":[{{"extensions":{{"KHR_materials_unlit":{{}}}},"pbrMetallicRoughness":{{"baseColorTexture":{{"index":0,"extensions":{{"KHR_texture_transform":{{"scale":[2,2]}}}}}}}}}}],
+"textures":[{{"source":0}}],"images":[{{"uri":"missing.png"}}],
+"meshes":[{{"primitives":[{{"attributes":{{"POSITION":0,"_BATCHID":0}},"indices":1,"material":0}},{{"attributes":{{"POSITION":2}},"indices":1}}]}}],
+"buffers":[{{"byteLength":76,"uri":"data:application/octet-stream;base64,{}"}}],
+"bufferViews":[{{"buffer":0,"byteOffset":0,"byteLength":24}},{{"buffer":0,"byteOffset":24,"byteLength":12}},
+{{"buffer":0,"byteOffset":36,"byteLength":4}},{{"buffer":0,"byteOffset":40,"byteLength":36}}],
+"accessors":[{{"bufferView":0,"componentType":5122,"count":4,"type":"VEC3","min":[0,0,0],"max":[300,300,0]}},
+{{"bufferView":1,"componentType":5123,"count":6,"type":"SCALAR"}},
+{{"componentType":5126,"count":4,"type":"VEC3","min":[0,0,0],"max":[1,1,0],
+"sparse":{{"count":3,"indices":{{"bufferView":2,"componentType":5121}},"values":{{"bufferView":3}}}}}}]}}"#,
+        base64(&bin)
+    )
 }

@@ -10,10 +10,18 @@
 //! animation per level node steps the weights through the frames at `fps`,
 //! so at time `k / fps` the mesh is frame `k` and between two key times it
 //! is their linear interpolation.
+//!
+//! What the model has goes out with it: `TEXCOORD_0` and the texture as an
+//! embedded PNG (the base colour texture of one material every level
+//! uses), and `COLOR_0` (linear, as glTF defines it) for per-vertex colour.
+//! A texture seam needs two GLB vertices where the model has one:
+//! [`corner_vertices`] makes them from the levels' per-corner texture
+//! coordinate ids.
 
 use std::fmt::Write as _;
 use std::io::Write;
 
+use crate::import::srgb_u8_to_linear;
 use crate::{Error, Result};
 
 /// What [`write_lod_glb`] writes.
@@ -25,6 +33,63 @@ pub struct LodGlb<'a> {
     pub levels: &'a [Vec<[u32; 3]>],
     /// Key frames per second of the animation (ignored with one frame).
     pub fps: f32,
+    /// Texture coordinates, one per vertex (glTF's: row 0 is the image's top).
+    pub uvs: Option<&'a [[f32; 2]]>,
+    /// The base colour texture (needs `uvs`), embedded as PNG.
+    pub texture: Option<&'a image::RgbImage>,
+    /// sRGB vertex colours, one per vertex.
+    pub colors: Option<&'a [[u8; 3]]>,
+}
+
+/// GLB vertices for levels whose corners carry texture coordinate ids.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct CornerVertices {
+    /// Per GLB vertex: the model's vertex…
+    pub vertex: Vec<u32>,
+    /// …and the texture coordinate id its corners have.
+    pub uv: Vec<u32>,
+    /// Each level's triangles in GLB vertices.
+    pub levels: Vec<Vec<[u32; 3]>>,
+}
+
+/// A level's triangles and, per triangle, its corners' texture coordinate ids.
+pub type LevelCorners<'a> = (&'a [[u32; 3]], &'a [[u32; 3]]);
+
+/// One GLB vertex per distinct (vertex, texture coordinate id) pair that
+/// any level's corners use, numbered in order of first use; `levels` are
+/// `(triangles, corner_uvs)` of the same length.
+pub fn corner_vertices(levels: &[LevelCorners<'_>]) -> Result<CornerVertices> {
+    let mut index = std::collections::HashMap::new();
+    let (mut vertex, mut uv) = (Vec::new(), Vec::new());
+    let mut out = Vec::with_capacity(levels.len());
+    for &(triangles, corners) in levels {
+        if triangles.len() != corners.len() {
+            return Err(Error::Parameter(format!(
+                "{} triangles but {} corner texture coordinates",
+                triangles.len(),
+                corners.len()
+            )));
+        }
+        let level = triangles
+            .iter()
+            .zip(corners)
+            .map(|(t, c)| {
+                std::array::from_fn(|k| {
+                    *index.entry((t[k], c[k])).or_insert_with(|| {
+                        vertex.push(t[k]);
+                        uv.push(c[k]);
+                        (vertex.len() - 1) as u32
+                    })
+                })
+            })
+            .collect();
+        out.push(level);
+    }
+    Ok(CornerVertices {
+        vertex,
+        uv,
+        levels: out,
+    })
 }
 
 /// The screen coverage hint of level `i` of `n`: halved at each level, 0
@@ -74,6 +139,26 @@ fn check(g: &LodGlb<'_>) -> Result<usize> {
     {
         return Err(Error::Parameter("a level refers past the vertices".into()));
     }
+    if g.uvs.is_some_and(|u| u.len() != n) || g.colors.is_some_and(|c| c.len() != n) {
+        return Err(Error::Parameter(
+            "texture coordinates and colours need one value per vertex".into(),
+        ));
+    }
+    if g.uvs
+        .into_iter()
+        .flatten()
+        .flatten()
+        .any(|x| !x.is_finite())
+    {
+        return Err(Error::Parameter(
+            "a texture coordinate is not finite".into(),
+        ));
+    }
+    if g.texture.is_some() && g.uvs.is_none() {
+        return Err(Error::Parameter(
+            "a texture needs texture coordinates".into(),
+        ));
+    }
     if g.frames.len() > 1 && !(g.fps.is_finite() && g.fps > 0.0) {
         return Err(Error::Parameter(format!(
             "fps must be positive, got {}",
@@ -90,7 +175,9 @@ struct Bin {
 }
 
 impl Bin {
+    /// Appends a view, 4-byte aligned (an image's length need not be).
     fn view(&mut self, bytes: impl IntoIterator<Item = u8>, target: Option<u32>) -> usize {
+        self.data.resize(self.data.len().next_multiple_of(4), 0);
         let start = self.data.len();
         self.data.extend(bytes);
         self.views.push((start, self.data.len() - start, target));
@@ -125,6 +212,22 @@ pub fn write_lod_glb(g: &LodGlb<'_>, w: &mut impl Write) -> Result<()> {
         vec3(lo),
         vec3(hi)
     ));
+    let mut attributes = r#""POSITION":0"#.to_string();
+    if let Some(uvs) = g.uvs {
+        let view = bin.view(f32s(uvs.iter().flatten().copied()), ARRAY);
+        let _ = write!(attributes, r#","TEXCOORD_0":{}"#, accessors.len());
+        accessors.push(format!(
+            r#"{{"bufferView":{view},"componentType":5126,"count":{n},"type":"VEC2"}}"#
+        ));
+    }
+    if let Some(colors) = g.colors {
+        let linear = colors.iter().flatten().map(|&c| srgb_u8_to_linear(c));
+        let view = bin.view(f32s(linear), ARRAY);
+        let _ = write!(attributes, r#","COLOR_0":{}"#, accessors.len());
+        accessors.push(format!(
+            r#"{{"bufferView":{view},"componentType":5126,"count":{n},"type":"VEC3"}}"#
+        ));
+    }
     let mut targets = Vec::new();
     for frame in &g.frames[1..] {
         let delta: Vec<[f32; 3]> = frame
@@ -211,8 +314,11 @@ pub fn write_lod_glb(g: &LodGlb<'_>, w: &mut impl Write) -> Result<()> {
         }
         let _ = write!(
             json,
-            r#"{{"primitives":[{{"attributes":{{"POSITION":0}},"indices":{idx},"mode":4"#
+            r#"{{"primitives":[{{"attributes":{{{attributes}}},"indices":{idx},"mode":4"#
         );
+        if g.texture.is_some() {
+            json += r#","material":0"#;
+        }
         if !targets.is_empty() {
             let _ = write!(json, r#","targets":[{}]"#, target_list.join(","));
         }
@@ -238,6 +344,18 @@ pub fn write_lod_glb(g: &LodGlb<'_>, w: &mut impl Write) -> Result<()> {
             channels.join(",")
         );
     }
+    if let Some(image) = g.texture {
+        let mut png = std::io::Cursor::new(Vec::new());
+        image
+            .write_to(&mut png, image::ImageFormat::Png)
+            .map_err(|e| Error::Parameter(format!("the texture cannot be written as PNG: {e}")))?;
+        let view = bin.view(png.into_inner(), None);
+        let _ = write!(
+            json,
+            r#","materials":[{{"pbrMetallicRoughness":{{"baseColorTexture":{{"index":0}},"metallicFactor":0}}}}],"textures":[{{"sampler":0,"source":0}}],"samplers":[{{"magFilter":9729,"minFilter":9729}}],"images":[{{"bufferView":{view},"mimeType":"image/png"}}]"#
+        );
+    }
+    bin.data.resize(bin.data.len().next_multiple_of(4), 0);
     let _ = write!(
         json,
         r#","buffers":[{{"byteLength":{}}}],"bufferViews":["#,
@@ -260,7 +378,7 @@ pub fn write_lod_glb(g: &LodGlb<'_>, w: &mut impl Write) -> Result<()> {
     while json.len() % 4 != 0 {
         json.push(' ');
     }
-    // Every view is 4-byte aligned: all elements are 4 bytes.
+    // Every view starts 4-byte aligned (all elements are 4 bytes).
     let total = 12 + 8 + json.len() + 8 + bin.data.len();
     let total = u32::try_from(total)
         .map_err(|_| Error::Limit(format!("GLB would be {total} bytes, over 4 GiB")))?;

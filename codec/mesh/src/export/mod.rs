@@ -10,7 +10,9 @@ pub mod md2;
 mod md2_sample;
 mod normal_table;
 
-pub use lod_glb::{screen_coverage, write_lod_glb, LodGlb};
+pub use lod_glb::{
+    corner_vertices, screen_coverage, write_lod_glb, CornerVertices, LevelCorners, LodGlb,
+};
 pub use md2::{mesh_to_md2, write_md2, write_mesh_md2};
 pub use md2_sample::{sample_md2, SAMPLE_SKIN};
 pub use normal_table::{nearest_normal, normal_table, NORMAL_COUNT};

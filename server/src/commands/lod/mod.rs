@@ -4,17 +4,29 @@
 //! per level with `--split`, or one MD2 per level with `--format md2`. An
 //! MD2 input keeps its frames (morph targets and a LINEAR animation in GLB,
 //! every frame in MD2) and its texture coordinates (seams never collapse).
+//!
+//! GLB levels carry what the model has: its texture (an MD2's skin, a
+//! scan's base colour texture) as an embedded PNG with `TEXCOORD_0`, and
+//! its per-vertex colour as `COLOR_0`. Melax keeps a subset of the model's
+//! vertices and every corner keeps one of its vertex's texture
+//! coordinates, so each attribute carries over per kept vertex; a GLB
+//! vertex is a (vertex, texture coordinate) pair, two where a seam runs.
 
 use anyhow::{bail, Context};
 use clap::{Args, ValueEnum};
 use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
-use vitrine_mesh::export::{mesh_to_md2, write_lod_glb, write_md2, LodGlb};
+use vitrine_mesh::export::{
+    corner_vertices, mesh_to_md2, write_lod_glb, write_md2, LevelCorners, LodGlb,
+};
 use vitrine_mesh::import::md2::{Md2, Md2Triangle};
 use vitrine_mesh::import::{ImportOptions, MeshFormat as InputFormat};
-use vitrine_simplify::melax::{compact, melax_chain, MelaxLevel, MelaxModel};
+use vitrine_simplify::melax::{compact, melax_chain, MelaxChain, MelaxLevel, MelaxModel};
 
 use crate::source::{describe_repair, load_coloured_mesh};
+
+mod texture;
+use texture::{md2_texture, weld, Texture};
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
 pub enum LodFormat {
@@ -51,6 +63,18 @@ enum Source {
         frames: Vec<Vec<[f32; 3]>>,
         triangles: Vec<[u32; 3]>,
         corner_uvs: Vec<[u32; 3]>,
+        /// The skin, when one is found beside the file.
+        texture: Option<Texture>,
+    },
+    /// A scan with a base colour texture: its textured surface welded by
+    /// position, each corner's texture coordinate id the surface vertex.
+    Textured {
+        positions: Vec<[f32; 3]>,
+        triangles: Vec<[u32; 3]>,
+        corner_uvs: Vec<[u32; 3]>,
+        texture: Texture,
+        /// The repaired mesh, should Melax refuse the welded surface.
+        fallback: vitrine_codec::IndexedMesh,
     },
     Mesh(vitrine_codec::IndexedMesh),
 }
@@ -68,44 +92,88 @@ fn load(path: &Path) -> anyhow::Result<Source> {
             .iter()
             .map(|t| [t.st[0], t.st[2], t.st[1]].map(u32::from))
             .collect();
+        let texture = md2_texture(path, &model)?;
         return Ok(Source::Md2 {
             model,
             frames,
             triangles,
             corner_uvs,
+            texture,
         });
     }
     let source = load_coloured_mesh(path)?;
     if let Some(text) = describe_repair(&source.repair) {
         eprintln!("repair: {text}");
     }
+    if let Some(surface) = source.texture {
+        let (positions, triangles, corner_uvs) = weld(&surface);
+        return Ok(Source::Textured {
+            texture: Texture {
+                uvs: surface.uvs.clone(),
+                surface,
+            },
+            positions,
+            triangles,
+            corner_uvs,
+            fallback: source.mesh,
+        });
+    }
     Ok(Source::Mesh(source.mesh))
+}
+
+/// The Melax model of a source: frames, triangles, corner texture ids.
+fn model_of(source: &Source) -> MelaxModelOwned<'_> {
+    match source {
+        Source::Md2 {
+            frames,
+            triangles,
+            corner_uvs,
+            ..
+        } => (frames.clone(), triangles, Some(corner_uvs)),
+        Source::Textured {
+            positions,
+            triangles,
+            corner_uvs,
+            ..
+        } => (vec![positions.clone()], triangles, Some(corner_uvs)),
+        Source::Mesh(m) => (vec![m.positions.clone()], &m.triangles, None),
+    }
+}
+
+type MelaxModelOwned<'s> = (Vec<Vec<[f32; 3]>>, &'s [[u32; 3]], Option<&'s [[u32; 3]]>);
+
+fn chain_of(source: &Source) -> vitrine_codec::Result<MelaxChain> {
+    let (frames, triangles, corner_uvs) = model_of(source);
+    melax_chain(&MelaxModel {
+        triangles,
+        frames: &frames,
+        corner_uvs,
+    })
 }
 
 pub fn run(args: LodArgs) -> anyhow::Result<()> {
     if args.levels.is_empty() {
         bail!("--levels needs at least one percentage");
     }
-    let source = load(&args.input)?;
-    let (frames, triangles, corner_uvs) = match &source {
-        Source::Md2 {
-            frames,
-            triangles,
-            corner_uvs,
-            ..
-        } => (
-            frames.clone(),
-            triangles.as_slice(),
-            Some(corner_uvs.as_slice()),
-        ),
-        Source::Mesh(m) => (vec![m.positions.clone()], m.triangles.as_slice(), None),
-    };
+    let mut source = load(&args.input)?;
     let started = std::time::Instant::now();
-    let chain = melax_chain(&MelaxModel {
-        triangles,
-        frames: &frames,
-        corner_uvs,
-    })
+    let chain = match (chain_of(&source), source) {
+        (Ok(chain), s) => {
+            source = s;
+            Ok(chain)
+        }
+        // Melax needs an oriented manifold: a textured surface that is not
+        // one after the weld is cut from the repaired mesh, untextured.
+        (Err(e), Source::Textured { fallback, .. }) => {
+            eprintln!("warning: the levels leave the texture out: {e}");
+            source = Source::Mesh(fallback);
+            chain_of(&source)
+        }
+        (Err(e), s) => {
+            source = s;
+            Err(e)
+        }
+    }
     .with_context(|| format!("simplifying {}", args.input.display()))?;
     let levels: Vec<MelaxLevel> = args
         .levels
@@ -130,18 +198,12 @@ pub fn run(args: LodArgs) -> anyhow::Result<()> {
     );
     match args.format {
         LodFormat::Glb if !args.split => {
-            let all: Vec<Vec<[u32; 3]>> = levels.iter().map(|l| l.triangles.clone()).collect();
-            write_glb(&args.output, &frames, &all, args.fps)?;
+            write_glb(&args.output, &source, &levels, args.fps)?;
         }
         LodFormat::Glb => {
             for (level, p) in levels.iter().zip(&args.levels) {
                 let out = level_path(&args.output, *p, "glb");
-                write_glb(
-                    &out,
-                    &frames,
-                    std::slice::from_ref(&level.triangles),
-                    args.fps,
-                )?;
+                write_glb(&out, &source, std::slice::from_ref(level), args.fps)?;
             }
         }
         LodFormat::Md2 => {
@@ -178,18 +240,60 @@ fn write_file(
     Ok(())
 }
 
-fn write_glb(
-    path: &Path,
-    frames: &[Vec<[f32; 3]>],
-    levels: &[Vec<[u32; 3]>],
-    fps: f32,
-) -> anyhow::Result<()> {
+/// Writes `levels` of `source` as one GLB, with the source's texture and
+/// texture coordinates (one GLB vertex per vertex and coordinate pair the
+/// levels use) or its vertex colours.
+fn write_glb(path: &Path, source: &Source, levels: &[MelaxLevel], fps: f32) -> anyhow::Result<()> {
+    let (frames, _, _) = model_of(source);
+    let texture = match source {
+        Source::Md2 { texture, .. } => texture.as_ref(),
+        Source::Textured { texture, .. } => Some(texture),
+        Source::Mesh(_) => None,
+    };
+    let corners: Option<Vec<LevelCorners<'_>>> = levels
+        .iter()
+        .map(|l| Some((l.triangles.as_slice(), l.corner_uvs.as_deref()?)))
+        .collect();
+    if let (Some(texture), Some(corners)) = (texture, corners) {
+        let split = corner_vertices(&corners)?;
+        let frames: Vec<Vec<[f32; 3]>> = frames
+            .iter()
+            .map(|f| split.vertex.iter().map(|&v| f[v as usize]).collect())
+            .collect();
+        let uvs = split
+            .uv
+            .iter()
+            .map(|&id| texture.uvs.get(id as usize).copied())
+            .collect::<Option<Vec<_>>>()
+            .context("a texture coordinate id past the model's coordinates")?;
+        return write_file(path, |w| {
+            Ok(write_lod_glb(
+                &LodGlb {
+                    frames: &frames,
+                    levels: &split.levels,
+                    fps,
+                    uvs: Some(&uvs),
+                    texture: Some(&texture.surface.image),
+                    colors: None,
+                },
+                w,
+            )?)
+        });
+    }
+    let colors = match source {
+        Source::Mesh(m) => m.colors.as_deref(),
+        _ => None,
+    };
+    let triangles: Vec<Vec<[u32; 3]>> = levels.iter().map(|l| l.triangles.clone()).collect();
     write_file(path, |w| {
         Ok(write_lod_glb(
             &LodGlb {
-                frames,
-                levels,
+                frames: &frames,
+                levels: &triangles,
                 fps,
+                uvs: None,
+                texture: None,
+                colors,
             },
             w,
         )?)
@@ -213,6 +317,15 @@ fn level_md2(source: &Source, level: &MelaxLevel) -> anyhow::Result<Md2> {
                 })
                 .collect();
             Ok(model.with_triangles(&triangles))
+        }
+        // The levels index the welded surface's positions.
+        Source::Textured { positions, .. } => {
+            let welded = vitrine_codec::IndexedMesh {
+                positions: positions.clone(),
+                colors: None,
+                triangles: Vec::new(),
+            };
+            Ok(mesh_to_md2(&compact(&welded, &level.triangles).0)?)
         }
         Source::Mesh(mesh) => Ok(mesh_to_md2(&compact(mesh, &level.triangles).0)?),
     }
