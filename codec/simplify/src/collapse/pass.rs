@@ -110,7 +110,7 @@ impl<'a> Pass<'a> {
     fn cheapest(&mut self, v: u32) -> f64 {
         let merges = match self.collapse {
             Collapse::Edge | Collapse::Triangle => self.quadric_edges(v),
-            Collapse::HalfEdge => self.into_neighbours(v),
+            Collapse::HalfEdge => self.merges_into_neighbours(v),
         };
         merges.first().map_or(f64::INFINITY, |m| self.cost(m))
     }
@@ -143,7 +143,7 @@ impl<'a> Pass<'a> {
 
     /// `v` into each unfrozen neighbour, which stays where it is: nearest
     /// first, or cheapest first with quadric placement.
-    fn into_neighbours(&mut self, v: u32) -> Vec<Merge> {
+    fn merges_into_neighbours(&mut self, v: u32) -> Vec<Merge> {
         let partners = self.partners(v, |s, w| !s.frozen[w as usize]);
         let mut merges: Vec<Merge> = partners.iter().map(|&w| self.stay(w, v)).collect();
         if self.placement == Placement::Quadric {
@@ -203,7 +203,7 @@ impl<'a> Pass<'a> {
     /// `v` into a neighbour, which stays where it is (it may be a border
     /// or feature vertex: it does not move).
     fn half_edge(&mut self, v: u32) -> Option<(u32, usize)> {
-        let merges = self.into_neighbours(v);
+        let merges = self.merges_into_neighbours(v);
         Some((self.first_allowed(merges)?, 1))
     }
 
