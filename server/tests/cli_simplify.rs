@@ -221,6 +221,7 @@ fn simplify_reports_as_json() {
     let report: serde_json::Value = serde_json::from_str(&stdout).expect("JSON on stdout");
     assert_eq!(report["method"], "normal-deviation");
     assert_eq!(report["collapse"], "edge");
+    assert_eq!(report["placement"], "quadric");
     assert_eq!(report["input"]["vertices"], 5504);
     assert_eq!(report["output"]["vertices"], 1376);
     assert_eq!(report["stopped"], "target");
@@ -229,6 +230,45 @@ fn simplify_reports_as_json() {
     assert!(hausdorff > 0.0 && hausdorff < 0.1, "{hausdorff}");
     assert!(report["seconds"].as_f64().unwrap() >= 0.0);
     assert_eq!(read(&output).vertex_count(), 1376);
+}
+
+#[test]
+fn features_go_last_unless_kept() {
+    // The genus plate at 5 %: its feature vertices (the tunnels' rims)
+    // stop the seed's rule short; the default lets them go last.
+    let dir = tempfile::tempdir().unwrap();
+    let input = plate(dir.path());
+    let run = |extra: &[&str]| {
+        let output = dir.path().join("out.ply");
+        let mut args = vec![
+            "simplify",
+            text(&input),
+            "--method",
+            "normal-deviation",
+            "--target-fraction",
+            "0.05",
+            "--hausdorff-samples",
+            "5000",
+            "--json",
+            "-o",
+            text(&output),
+        ];
+        args.extend_from_slice(extra);
+        let (stdout, _) = succeeds(&args);
+        serde_json::from_str::<serde_json::Value>(&stdout).expect("JSON on stdout")
+    };
+    let kept = run(&["--features", "keep", "--placement", "seed"]);
+    assert_eq!(kept["stopped"], "no-candidate", "{kept}");
+    assert!(kept["output"]["vertices"].as_u64().unwrap() > 275);
+    assert_eq!(kept["placement"], "seed");
+    let last = run(&[]);
+    assert_eq!(last["stopped"], "target", "{last}");
+    assert_eq!(last["output"]["vertices"], 275);
+    let (first, end) = (
+        last["feature_threshold_degrees"].as_f64().unwrap(),
+        last["final_feature_threshold_degrees"].as_f64().unwrap(),
+    );
+    assert!(end > first, "{first} → {end}");
 }
 
 #[test]

@@ -1,6 +1,7 @@
-//! The normal-deviation simplifier (each collapse variant) at 10 % and 2 %
-//! of the faces, beside a quadric-error peer on the very same repaired mesh:
-//! symmetric Hausdorff over the bounding-box diagonal, and time.
+//! The normal-deviation simplifier (each collapse variant, with the seed's
+//! placement and with quadric placement) at 10 % and 2 % of the faces,
+//! beside a quadric-error peer on the very same repaired mesh: symmetric
+//! Hausdorff over the bounding-box diagonal, and time.
 //!
 //!     pip install fast-simplification plyfile numpy
 //!     cargo run --release -p vitrine-simplify --example simplify_bench -- \
@@ -14,15 +15,21 @@ use vitrine_mesh::export::write_ply;
 use vitrine_mesh::import::{import_path, ImportOptions};
 use vitrine_mesh::repair::{prepare, RepairOptions};
 use vitrine_quality::metrics::hausdorff;
-use vitrine_simplify::{simplify, Collapse, SimplifyOptions, StopReason, Target};
+use vitrine_simplify::{simplify, Collapse, Placement, SimplifyOptions, StopReason, Target};
 
 const FRACTIONS: [f64; 2] = [0.10, 0.02];
 const SAMPLES: usize = 200_000;
 
 /// One simplifier's result: faces, Hausdorff over the diagonal, seconds, how it stopped.
-fn ours(mesh: &IndexedMesh, collapse: Collapse, fraction: f64) -> (usize, f64, f64, &'static str) {
+fn ours(
+    mesh: &IndexedMesh,
+    collapse: Collapse,
+    placement: Placement,
+    fraction: f64,
+) -> (usize, f64, f64, &'static str) {
     let options = SimplifyOptions {
         collapse,
+        placement,
         target: Target::Fraction(fraction),
         ..SimplifyOptions::default()
     };
@@ -79,9 +86,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         paths.drain(..2);
     }
     println!(
-        "| scan | faces | kept | edge: faces, H/diag, s | half-edge | triangle | quadric peer |"
+        "| scan | faces | kept | placement | edge: faces, H/diag, s | half-edge | triangle | quadric peer |"
     );
-    println!("|---|---:|---:|---|---|---|---|");
+    println!("|---|---:|---:|---|---|---|---|---|");
     for path in &paths {
         let mesh = import_path(path.as_ref(), &ImportOptions::default())?;
         let (mesh, _) = prepare(mesh, &RepairOptions::default())?;
@@ -90,28 +97,30 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             .and_then(|n| n.to_str())
             .unwrap_or(path);
         for fraction in FRACTIONS {
-            let mut row = format!(
-                "| {name} | {} | {:.0} % |",
-                mesh.triangles.len(),
-                100.0 * fraction
-            );
-            for collapse in [Collapse::Edge, Collapse::HalfEdge, Collapse::Triangle] {
-                let (faces, h, s, stopped) = ours(&mesh, collapse, fraction);
-                let note = if stopped == "target" {
-                    String::new()
-                } else {
-                    format!(" ({stopped})")
-                };
-                row += &format!(" {faces}, {h:.5}, {s:.2}{note} |");
-            }
-            match &script {
+            let peer = match &script {
                 Some(script) => {
                     let (faces, h, s) = peer(script, &mesh, fraction)?;
-                    row += &format!(" {faces}, {h:.5}, {s:.2} |");
+                    format!(" {faces}, {h:.5}, {s:.2} |")
                 }
-                None => row += " – |",
+                None => " – |".to_string(),
+            };
+            for (placement, label) in [(Placement::Seed, "seed"), (Placement::Quadric, "quadric")] {
+                let mut row = format!(
+                    "| {name} | {} | {:.0} % | {label} |",
+                    mesh.triangles.len(),
+                    100.0 * fraction
+                );
+                for collapse in [Collapse::Edge, Collapse::HalfEdge, Collapse::Triangle] {
+                    let (faces, h, s, stopped) = ours(&mesh, collapse, placement, fraction);
+                    let note = if stopped == "target" {
+                        String::new()
+                    } else {
+                        format!(" ({stopped})")
+                    };
+                    row += &format!(" {faces}, {h:.5}, {s:.2}{note} |");
+                }
+                println!("{row}{peer}");
             }
-            println!("{row}");
         }
     }
     Ok(())

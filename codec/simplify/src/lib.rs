@@ -40,8 +40,8 @@ pub mod melax;
 pub mod voronoi;
 
 pub use collapse::{
-    simplify, simplify_with, Cleanup, Collapse, PassReport, Simplified, SimplifyOptions,
-    StopReason, Target,
+    simplify, simplify_with, Cleanup, Collapse, Features, PassReport, Placement, Simplified,
+    SimplifyOptions, StopReason, Target,
 };
 pub use deviation::{border_vertices, normal_deviation, one_ring_max, VertexFaces};
 pub use feature_guard::{FeatureGuard, FeatureThreshold, DEFAULT_FEATURE_SHARE};

@@ -14,11 +14,18 @@ use vitrine_samples::{
     add_noise, grid, icosphere, merge, paint, plate_with_tunnels, punch_holes, torus,
 };
 use vitrine_simplify::{
-    border_vertices, simplify, simplify_with, Cleanup, Collapse, FeatureThreshold, SimplifyOptions,
-    StopReason, Target,
+    border_vertices, simplify, simplify_with, Cleanup, Collapse, FeatureThreshold, Features,
+    Placement, SimplifyOptions, StopReason, Target,
 };
 
 const VARIANTS: [Collapse; 3] = [Collapse::Edge, Collapse::HalfEdge, Collapse::Triangle];
+
+/// Every collapse variant with each placement.
+fn settings() -> impl Iterator<Item = (Collapse, Placement)> {
+    VARIANTS
+        .into_iter()
+        .flat_map(|c| [Placement::Seed, Placement::Quadric].map(|p| (c, p)))
+}
 
 fn holed_grid() -> IndexedMesh {
     punch_holes(&grid(40), &[[10.0, 12.0, 0.0], [28.0, 26.0, 0.0]], 4.5)
@@ -50,6 +57,13 @@ fn options(collapse: Collapse, target: Target) -> SimplifyOptions {
         collapse,
         target,
         ..SimplifyOptions::default()
+    }
+}
+
+fn options_at(collapse: Collapse, placement: Placement, target: Target) -> SimplifyOptions {
+    SimplifyOptions {
+        placement,
+        ..options(collapse, target)
     }
 }
 
@@ -130,12 +144,12 @@ fn topology(mesh: &IndexedMesh) -> (i64, usize, usize) {
 fn every_pass_leaves_a_sound_manifold_and_the_clean_up_finds_nothing() {
     for (name, mesh) in corpus() {
         let surface = Surface::new(&mesh);
-        for collapse in VARIANTS {
-            let name = format!("{name}, {collapse:?}");
+        for (collapse, placement) in settings() {
+            let name = format!("{name}, {collapse:?}, {placement:?}");
             let (mut passes, mut checked) = (0, HashSet::new());
             let out = simplify_with(
                 &mesh,
-                &options(collapse, Target::Fraction(0.1)),
+                &options_at(collapse, placement, Target::Fraction(0.1)),
                 |r, m, _| {
                     passes += 1;
                     let pass = format!("{name}, pass {passes}");
@@ -158,19 +172,28 @@ fn every_pass_leaves_a_sound_manifold_and_the_clean_up_finds_nothing() {
 #[test]
 fn each_variant_stops_exactly_at_its_target() {
     let mesh = torus(64, 32, 1.0, 0.35);
-    for collapse in VARIANTS {
+    for (collapse, placement) in settings() {
         for n in [1500, 777, 301] {
-            let out = simplify(&mesh, &options(collapse, Target::Vertices(n))).unwrap();
-            assert_eq!(out.stopped, StopReason::Target, "{collapse:?} {n}");
-            assert_eq!(out.mesh.vertex_count(), n, "{collapse:?}");
+            let out =
+                simplify(&mesh, &options_at(collapse, placement, Target::Vertices(n))).unwrap();
+            assert_eq!(
+                out.stopped,
+                StopReason::Target,
+                "{collapse:?} {placement:?} {n}"
+            );
+            assert_eq!(out.mesh.vertex_count(), n, "{collapse:?} {placement:?}");
             assert_eq!(out.origin.len(), n);
             assert_eq!(
                 out.mesh.face_count(),
                 2 * n,
-                "{collapse:?}: a torus has F = 2V"
+                "{collapse:?} {placement:?}: a torus has F = 2V"
             );
         }
-        let out = simplify(&icosphere(4), &options(collapse, Target::Fraction(0.25))).unwrap();
+        let out = simplify(
+            &icosphere(4),
+            &options_at(collapse, placement, Target::Fraction(0.25)),
+        )
+        .unwrap();
         assert_eq!(out.mesh.vertex_count(), (2562.0f64 * 0.25).round() as usize);
     }
 }
@@ -179,8 +202,12 @@ fn each_variant_stops_exactly_at_its_target() {
 fn genus_components_and_border_loops_survive() {
     for (name, mesh) in corpus() {
         let before = topology(&mesh);
-        for collapse in VARIANTS {
-            let out = simplify(&mesh, &options(collapse, Target::Fraction(0.15))).unwrap();
+        for (collapse, placement) in settings() {
+            let out = simplify(
+                &mesh,
+                &options_at(collapse, placement, Target::Fraction(0.15)),
+            )
+            .unwrap();
             assert_eq!(topology(&out.mesh), before, "{name}, {collapse:?}");
         }
     }
@@ -214,27 +241,43 @@ fn borders_of_a_holed_grid_are_found_exactly_and_left_bit_for_bit() {
         .collect();
     assert_eq!(found, expected);
     assert!(expected.len() > 4 * 40, "outline and two holes");
-    for collapse in VARIANTS {
-        let out = simplify(&mesh, &options(collapse, Target::Fraction(0.3))).unwrap();
-        assert_eq!(out.stopped, StopReason::Target, "{collapse:?}");
+    for (collapse, placement) in settings() {
+        let out = simplify(
+            &mesh,
+            &options_at(collapse, placement, Target::Fraction(0.3)),
+        )
+        .unwrap();
+        assert_eq!(
+            out.stopped,
+            StopReason::Target,
+            "{collapse:?} {placement:?}"
+        );
         let target = (0.3 * mesh.vertex_count() as f64).round() as usize;
-        assert_eq!(out.mesh.vertex_count(), target, "{collapse:?}");
+        assert_eq!(
+            out.mesh.vertex_count(),
+            target,
+            "{collapse:?} {placement:?}"
+        );
         let kept: HashSet<u32> = out.origin.iter().copied().collect();
         for (o, &v) in out.origin.iter().enumerate() {
             if expected.contains(&v) {
                 let (a, b) = (out.mesh.positions[o], mesh.positions[v as usize]);
-                assert_eq!(a.map(f32::to_bits), b.map(f32::to_bits), "{collapse:?}");
+                assert_eq!(
+                    a.map(f32::to_bits),
+                    b.map(f32::to_bits),
+                    "{collapse:?} {placement:?}"
+                );
             }
         }
         assert!(
             expected.is_subset(&kept),
-            "{collapse:?}: a border vertex went"
+            "{collapse:?} {placement:?}: a border vertex went"
         );
         let output_border: HashSet<u32> = open_edge_vertices(&out.mesh)
             .into_iter()
             .map(|o| out.origin[o as usize])
             .collect();
-        assert_eq!(output_border, expected, "{collapse:?}");
+        assert_eq!(output_border, expected, "{collapse:?} {placement:?}");
     }
 }
 
@@ -260,7 +303,11 @@ fn a_flat_region_simplifies_far_more_than_a_ridge() {
     let near: &dyn Fn(f32) -> bool = &|d| d <= 1.0;
     let flat: &dyn Fn(f32) -> bool = &|d| (6.0..19.0).contains(&d);
     for collapse in VARIANTS {
-        let out = simplify(&mesh, &options(collapse, Target::Fraction(0.2))).unwrap();
+        let o = SimplifyOptions {
+            features: Features::Keep,
+            ..options(collapse, Target::Fraction(0.2))
+        };
+        let out = simplify(&mesh, &o).unwrap();
         let kept_near = count(&out.mesh, near) / count(&mesh, near);
         let kept_flat = count(&out.mesh, flat) / count(&mesh, flat);
         assert!(kept_near >= 0.95, "{collapse:?}: ridge kept {kept_near}");
@@ -359,4 +406,91 @@ fn bad_parameters_and_non_manifold_input_are_refused() {
         assert!(bad.parse::<Target>().is_err(), "{bad}");
     }
     assert!("vertex".parse::<Collapse>().is_err());
+}
+
+#[test]
+fn features_go_last_when_the_target_needs_them() {
+    // The ridge at 12 % (the 160 border vertices are 9.5 %, the border
+    // and the ridge band 16 %): keeping every feature vertex stops short;
+    // letting them go last reaches the target exactly, the flat sides gone
+    // first.
+    let mesh = ridge();
+    let target = (0.12 * mesh.vertex_count() as f64).round() as usize;
+    for collapse in VARIANTS {
+        let keep = SimplifyOptions {
+            features: Features::Keep,
+            ..options(collapse, Target::Fraction(0.12))
+        };
+        let kept = simplify(&mesh, &keep).unwrap();
+        assert_eq!(kept.stopped, StopReason::NoCandidate, "{collapse:?}");
+        assert!(kept.mesh.vertex_count() > target, "{collapse:?}");
+        assert_eq!(kept.final_threshold_radians, kept.threshold_radians);
+        let last = simplify(&mesh, &options(collapse, Target::Fraction(0.12))).unwrap();
+        assert_eq!(last.stopped, StopReason::Target, "{collapse:?}");
+        assert_eq!(last.mesh.vertex_count(), target, "{collapse:?}");
+        assert!(last.final_threshold_radians > last.threshold_radians);
+        let border = border_vertices(&mesh);
+        let interior = last
+            .origin
+            .iter()
+            .filter(|&&v| !border[v as usize])
+            .map(|&v| (mesh.positions[v as usize][0] - 20.0).abs());
+        let (near, far) = interior.fold(
+            (0, 0),
+            |(n, f), d| {
+                if d <= 1.0 {
+                    (n + 1, f)
+                } else {
+                    (n, f + 1)
+                }
+            },
+        );
+        // Shares of the interior's 3 ridge columns and 36 others (39 rows).
+        let (near, far) = (f64::from(near) / 117.0, f64::from(far) / 1404.0);
+        assert!(
+            near > 4.0 * far,
+            "{collapse:?}: {near} of the ridge, {far} of the rest"
+        );
+    }
+}
+
+#[test]
+fn quadric_placement_stays_closer_to_a_smooth_surface() {
+    // A sphere at 5 %: the seed's midpoints cut inside the surface, the
+    // quadric optimum hugs it. Distance to the unit sphere, RMS over 15
+    // points per output face (corners, edge thirds, centroid and more).
+    let mesh = icosphere(5);
+    let rms = |m: &IndexedMesh| {
+        let (mut sum, mut n) = (0.0, 0.0);
+        for t in &m.triangles {
+            let p = corners(m, t);
+            for i in 0..=4 {
+                for j in 0..=4 - i {
+                    let (a, b) = (f64::from(i) / 4.0, f64::from(j) / 4.0);
+                    let x = p[0] + (p[1] - p[0]) * a + (p[2] - p[0]) * b;
+                    sum += (x.length() - 1.0).powi(2);
+                    n += 1.0;
+                }
+            }
+        }
+        (sum / n).sqrt()
+    };
+    for collapse in VARIANTS {
+        let seed = simplify(&mesh, &options(collapse, Target::Fraction(0.05))).unwrap();
+        let quadric = simplify(
+            &mesh,
+            &options_at(collapse, Placement::Quadric, Target::Fraction(0.05)),
+        )
+        .unwrap();
+        assert_eq!(seed.mesh.vertex_count(), quadric.mesh.vertex_count());
+        let (s, q) = (rms(&seed.mesh), rms(&quadric.mesh));
+        // Half-edge collapses keep input positions (only their order
+        // moves); triangle collapses choose among the face's own points.
+        let bound = if collapse == Collapse::Edge {
+            0.5
+        } else {
+            0.75
+        };
+        assert!(q < bound * s, "{collapse:?}: quadric {q}, seed {s}");
+    }
 }

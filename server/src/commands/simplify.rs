@@ -13,7 +13,9 @@ use vitrine_codec::IndexedMesh;
 use vitrine_colour::vertex_colours_from_texture;
 use vitrine_quality::metrics::hausdorff;
 use vitrine_simplify::melax::melax_simplify;
-use vitrine_simplify::{simplify, Collapse, FeatureThreshold, SimplifyOptions, StopReason, Target};
+use vitrine_simplify::{
+    simplify, Collapse, FeatureThreshold, Features, Placement, SimplifyOptions, StopReason, Target,
+};
 
 /// A simplifier.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -43,6 +45,25 @@ impl Method {
             Method::Voronoi => "voronoi",
         }
     }
+}
+
+/// Where `normal-deviation` puts a merged vertex.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum PlacementKind {
+    /// The seed's midpoints and centroids, vertices in ascending θ.
+    Seed,
+    /// The least error under the merged patch's quadric (Garland–Heckbert),
+    /// cheapest merges first.
+    Quadric,
+}
+
+/// What `normal-deviation` does with feature vertices.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum FeaturesKind {
+    /// Never removed (the seed): may stop short of the target.
+    Keep,
+    /// Removed last, least sharp first, once nothing else can go.
+    Last,
 }
 
 /// How `normal-deviation` removes vertices.
@@ -75,6 +96,13 @@ pub struct SimplifyArgs {
     /// angle in degrees (`12` or `12deg`) or a percentile (`p95`).
     #[arg(long, value_name = "mean+2sigma|DEG|pP", default_value = "mean+2sigma")]
     pub feature_threshold: FeatureThreshold,
+    /// normal-deviation: where a merged vertex goes.
+    #[arg(long, value_enum, default_value_t = PlacementKind::Quadric)]
+    pub placement: PlacementKind,
+    /// normal-deviation: whether feature vertices may go once nothing else
+    /// can (the target is then always met, borders permitting).
+    #[arg(long, value_enum, default_value_t = FeaturesKind::Last)]
+    pub features: FeaturesKind,
     #[command(flatten)]
     pub voronoi: super::simplify_voronoi::VoronoiArgs,
     /// Area samples per mesh for the Hausdorff distance (plus every vertex).
@@ -146,6 +174,11 @@ pub struct SimplifyReport {
     pub collapse: Option<&'static str>,
     #[serde(skip_serializing_if = "Option::is_none")]
     pub feature_threshold_degrees: Option<f64>,
+    /// τ at the end, above the first when features had to go.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub final_feature_threshold_degrees: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub placement: Option<&'static str>,
     /// voronoi's parameters and counts.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub voronoi: Option<super::simplify_voronoi::VoronoiReport>,
@@ -173,6 +206,8 @@ struct Outcome {
     stopped: &'static str,
     collapse: Option<&'static str>,
     feature_threshold_degrees: Option<f64>,
+    final_feature_threshold_degrees: Option<f64>,
+    placement: Option<&'static str>,
     voronoi: Option<super::simplify_voronoi::VoronoiReport>,
 }
 
@@ -217,10 +252,19 @@ fn normal_deviation(mesh: &IndexedMesh, args: &SimplifyArgs) -> anyhow::Result<O
         CollapseKind::HalfEdge => (Collapse::HalfEdge, "half-edge"),
         CollapseKind::Triangle => (Collapse::Triangle, "triangle"),
     };
+    let (placement, placement_name) = match args.placement {
+        PlacementKind::Seed => (Placement::Seed, "seed"),
+        PlacementKind::Quadric => (Placement::Quadric, "quadric"),
+    };
     let options = SimplifyOptions {
         collapse,
         target: args.target.target()?,
         threshold: args.feature_threshold,
+        placement,
+        features: match args.features {
+            FeaturesKind::Keep => Features::Keep,
+            FeaturesKind::Last => Features::Last,
+        },
         ..SimplifyOptions::default()
     };
     let out = simplify(mesh, &options)?;
@@ -234,6 +278,8 @@ fn normal_deviation(mesh: &IndexedMesh, args: &SimplifyArgs) -> anyhow::Result<O
         },
         collapse: Some(name),
         feature_threshold_degrees: Some(out.threshold_radians.to_degrees()),
+        final_feature_threshold_degrees: Some(out.final_threshold_radians.to_degrees()),
+        placement: Some(placement_name),
         voronoi: None,
     })
 }
@@ -252,6 +298,8 @@ fn voronoi(mesh: &IndexedMesh, args: &SimplifyArgs) -> anyhow::Result<Outcome> {
         stopped: out.stopped,
         collapse: None,
         feature_threshold_degrees: None,
+        final_feature_threshold_degrees: None,
+        placement: None,
         voronoi: Some(out.report),
     })
 }
@@ -268,6 +316,8 @@ fn melax(mesh: &IndexedMesh, args: &SimplifyArgs) -> anyhow::Result<Outcome> {
         },
         collapse: None,
         feature_threshold_degrees: None,
+        final_feature_threshold_degrees: None,
+        placement: None,
         voronoi: None,
     })
 }
@@ -290,6 +340,8 @@ fn measure(
         seconds,
         collapse: outcome.collapse,
         feature_threshold_degrees: outcome.feature_threshold_degrees,
+        final_feature_threshold_degrees: outcome.final_feature_threshold_degrees,
+        placement: outcome.placement,
         voronoi: outcome.voronoi,
     }
 }
@@ -305,7 +357,16 @@ fn print_report(r: &SimplifyReport, output: &Path) {
         r.seconds,
     );
     let parameters = match (r.collapse, r.feature_threshold_degrees) {
-        (Some(c), Some(t)) => format!(" ({c} collapses, feature threshold {t:.2}°)"),
+        (Some(c), Some(t)) => {
+            let placement = r.placement.unwrap_or("seed");
+            let raised = r
+                .final_feature_threshold_degrees
+                .filter(|&f| f > t)
+                .map_or_else(String::new, |f| {
+                    format!(", raised to {f:.2}° to meet the target")
+                });
+            format!(" ({c} collapses, {placement} placement, feature threshold {t:.2}°{raised})")
+        }
         _ => r
             .voronoi
             .as_ref()

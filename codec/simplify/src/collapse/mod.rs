@@ -15,9 +15,19 @@
 //! pass or two and the target could never be met; and features are those
 //! of the scan, not of its approximation. Flip rejection, not θ, guards
 //! the coarse surface's shape. It also spares recomputing θ every pass.
+//!
+//! **What the seed lacks, as options.** [`Placement::Quadric`] puts a
+//! merged vertex where the Garland–Heckbert quadric of the patch it stands
+//! for is least and tries the cheapest merges first, instead of the seed's
+//! midpoints and centroids, which drift the surface pass after pass.
+//! [`Features::Last`] lets features go once nothing else can: when a pass
+//! finds no candidate above the target, τ rises to free the least sharp
+//! of the protected vertices, so a target is always met unless only
+//! borders are left; [`Features::Keep`] is the seed's rule (never).
 
 mod cleanup;
 mod pass;
+mod quadric;
 pub(crate) mod topology;
 pub(crate) mod working;
 
@@ -55,6 +65,46 @@ impl FromStr for Collapse {
             ))),
         }
     }
+}
+
+/// Where a merged vertex goes, and which merges go first.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Placement {
+    /// The seed's: the midpoint of an edge, the centroid of a triangle;
+    /// vertices in ascending θ, each to its nearest neighbour.
+    #[default]
+    Seed,
+    /// The least squared distance to the planes of the input faces the
+    /// merged vertices stand for (Garland–Heckbert); within a pass the
+    /// cheapest merges first.
+    Quadric,
+}
+
+impl FromStr for Placement {
+    type Err = Error;
+
+    /// `seed` or `quadric`.
+    fn from_str(s: &str) -> Result<Self> {
+        match s.trim() {
+            "seed" => Ok(Placement::Seed),
+            "quadric" => Ok(Placement::Quadric),
+            _ => Err(Error::Parameter(format!(
+                "placement must be seed or quadric, got {s:?}"
+            ))),
+        }
+    }
+}
+
+/// What happens to feature vertices (θ above τ) on the way to the target.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Features {
+    /// Never removed nor moved (the seed): simplification may stop short.
+    Keep,
+    /// Removed last: when nothing else can go, τ rises to free the half of
+    /// the remaining protected vertices (or twice the vertices still to
+    /// remove, if fewer) with the lowest θ.
+    #[default]
+    Last,
 }
 
 /// Where to stop.
@@ -123,6 +173,8 @@ pub struct SimplifyOptions {
     pub threshold: FeatureThreshold,
     /// Passes at most (each one freezes the neighbours of its merges).
     pub max_passes: usize,
+    pub placement: Placement,
+    pub features: Features,
 }
 
 impl Default for SimplifyOptions {
@@ -131,7 +183,9 @@ impl Default for SimplifyOptions {
             collapse: Collapse::Edge,
             target: Target::default(),
             threshold: FeatureThreshold::MeanPlusTwoSigma,
-            max_passes: 100,
+            max_passes: 200,
+            placement: Placement::Seed,
+            features: Features::Last,
         }
     }
 }
@@ -143,7 +197,8 @@ pub enum StopReason {
     /// no more than that).
     Target,
     /// No removable vertex could be merged without breaking a check: the
-    /// rest are borders, features, or locked by the topology.
+    /// rest are borders, features ([`Features::Keep`]), or locked by the
+    /// topology.
     NoCandidate,
     /// `max_passes` passes ran.
     MaxPasses,
@@ -184,6 +239,9 @@ pub struct Simplified {
     pub stopped: StopReason,
     /// τ in radians, from the full resolution.
     pub threshold_radians: f64,
+    /// τ at the end: above `threshold_radians` when [`Features::Last`]
+    /// had to free feature vertices to reach the target.
+    pub final_threshold_radians: f64,
 }
 
 /// Simplifies `mesh` (an oriented 2-manifold, borders allowed: what
@@ -212,7 +270,12 @@ fn run(
     mut on_pass: Option<OnPass<'_>>,
 ) -> Result<Simplified> {
     options.target.validate()?;
-    let (mut working, threshold) = WorkingMesh::new(mesh, options.threshold)?;
+    let (working, mut threshold) = WorkingMesh::new(mesh, options.threshold)?;
+    let first_threshold = threshold;
+    let mut working = match options.placement {
+        Placement::Seed => working,
+        Placement::Quadric => working.with_quadrics(),
+    };
     let target = options.target.vertices(working.live_vertices);
     let mut passes = Vec::new();
     let stopped = loop {
@@ -222,10 +285,19 @@ fn run(
         if passes.len() >= options.max_passes {
             break StopReason::MaxPasses;
         }
-        let merges = Pass::new(&mut working, options.collapse, threshold, target).run();
+        let merges = Pass::new(&mut working, options, threshold, target).run();
         let cleanup = cleanup::clean(&mut working, threshold, target);
         if merges == 0 && cleanup == Cleanup::default() {
-            break StopReason::NoCandidate;
+            match options.features {
+                Features::Last => match release(&working, threshold, target) {
+                    Some(raised) => {
+                        threshold = raised;
+                        continue;
+                    }
+                    None => break StopReason::NoCandidate,
+                },
+                Features::Keep => break StopReason::NoCandidate,
+            }
         }
         let report = PassReport {
             merges,
@@ -245,6 +317,25 @@ fn run(
         origin,
         passes,
         stopped,
-        threshold_radians: threshold,
+        threshold_radians: first_threshold,
+        final_threshold_radians: threshold,
     })
+}
+
+/// The τ that frees the lowest-θ half of the live, off-border vertices
+/// above `threshold` (or twice as many as are still to go, if fewer);
+/// `None` when there are none (only borders are left).
+fn release(working: &WorkingMesh, threshold: f64, target: usize) -> Option<f64> {
+    let mut protected: Vec<f64> = (0..working.positions.len())
+        .filter(|&v| !working.border[v] && !working.faces_of[v].is_empty())
+        .map(|v| working.theta[v])
+        .filter(|&t| t > threshold)
+        .collect();
+    if protected.is_empty() {
+        return None;
+    }
+    protected.sort_by(f64::total_cmp);
+    let still = working.live_vertices.saturating_sub(target);
+    let count = (protected.len() / 2).min(2 * still).max(1);
+    Some(protected[count - 1])
 }

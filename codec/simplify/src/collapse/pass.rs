@@ -1,15 +1,19 @@
 //! One decimation pass (seed 004, Alg. 4): removable vertices in ascending
-//! θ, ties by index; each merge freezes its survivor and the survivor's
-//! neighbours for the rest of the pass, so a pass touches the surface
-//! evenly, like an independent set, instead of eating one region.
+//! θ, ties by index (or, with quadric placement, cheapest merge first);
+//! each merge freezes its survivor and the survivor's neighbours for the
+//! rest of the pass, so a pass touches the surface evenly, like an
+//! independent set, instead of eating one region.
+
+use glam::DVec3;
 
 use super::topology::{allows, Scratch};
 use super::working::{Merge, WorkingMesh};
-use super::Collapse;
+use super::{Collapse, Placement, SimplifyOptions};
 
 pub(super) struct Pass<'a> {
     mesh: &'a mut WorkingMesh,
     collapse: Collapse,
+    placement: Placement,
     threshold: f64,
     target: usize,
     frozen: Vec<bool>,
@@ -20,14 +24,15 @@ pub(super) struct Pass<'a> {
 impl<'a> Pass<'a> {
     pub fn new(
         mesh: &'a mut WorkingMesh,
-        collapse: Collapse,
+        options: &SimplifyOptions,
         threshold: f64,
         target: usize,
     ) -> Self {
         let frozen = vec![false; mesh.positions.len()];
         Pass {
             mesh,
-            collapse,
+            collapse: options.collapse,
+            placement: options.placement,
             threshold,
             target,
             frozen,
@@ -41,10 +46,19 @@ impl<'a> Pass<'a> {
         let mut candidates: Vec<u32> = (0..self.mesh.positions.len() as u32)
             .filter(|&v| self.mesh.removable(v, self.threshold))
             .collect();
-        let theta = &self.mesh.theta;
+        let order: Vec<f64> = match self.placement {
+            Placement::Seed => self.mesh.theta.clone(),
+            Placement::Quadric => {
+                let mut cost = vec![f64::INFINITY; self.mesh.positions.len()];
+                for &v in &candidates {
+                    cost[v as usize] = self.cheapest(v);
+                }
+                cost
+            }
+        };
         candidates.sort_by(|&a, &b| {
-            theta[a as usize]
-                .total_cmp(&theta[b as usize])
+            order[a as usize]
+                .total_cmp(&order[b as usize])
                 .then(a.cmp(&b))
         });
         let mut merges = 0;
@@ -91,6 +105,76 @@ impl<'a> Pass<'a> {
         out
     }
 
+    /// With quadric placement, the cost of `v`'s cheapest merge this pass
+    /// could make (the order of the candidates).
+    fn cheapest(&mut self, v: u32) -> f64 {
+        let merges = match self.collapse {
+            Collapse::Edge | Collapse::Triangle => self.quadric_edges(v),
+            Collapse::HalfEdge => self.merges_into_neighbours(v),
+        };
+        merges.first().map_or(f64::INFINITY, |m| self.cost(m))
+    }
+
+    /// The error of a merge's placement under the two quadrics it sums.
+    fn cost(&self, m: &Merge) -> f64 {
+        let q = self.mesh.quadric(m.keep) + self.mesh.quadric(m.gone);
+        q.error(DVec3::from(m.to.map(f64::from)))
+    }
+
+    /// Quadric edge merges of `v`, cheapest first: with a removable
+    /// neighbour both go to the best point of the edge; a neighbour that
+    /// may not move (border, feature) takes `v` where it stands.
+    fn quadric_edges(&mut self, v: u32) -> Vec<Merge> {
+        let partners = self.partners(v, |s, w| !s.frozen[w as usize]);
+        let mut merges: Vec<(f64, Merge)> = partners
+            .iter()
+            .map(|&w| {
+                let m = if self.usable(w) {
+                    self.quadric_point(w, v)
+                } else {
+                    self.stay(w, v)
+                };
+                (self.cost(&m), m)
+            })
+            .collect();
+        merges.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.keep.cmp(&b.1.keep)));
+        merges.into_iter().map(|(_, m)| m).collect()
+    }
+
+    /// `v` into each unfrozen neighbour, which stays where it is: nearest
+    /// first, or cheapest first with quadric placement.
+    fn merges_into_neighbours(&mut self, v: u32) -> Vec<Merge> {
+        let partners = self.partners(v, |s, w| !s.frozen[w as usize]);
+        let mut merges: Vec<Merge> = partners.iter().map(|&w| self.stay(w, v)).collect();
+        if self.placement == Placement::Quadric {
+            let mut costed: Vec<(f64, Merge)> =
+                merges.into_iter().map(|m| (self.cost(&m), m)).collect();
+            costed.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.keep.cmp(&b.1.keep)));
+            merges = costed.into_iter().map(|(_, m)| m).collect();
+        }
+        merges
+    }
+
+    /// `gone` into `keep`, which does not move.
+    fn stay(&self, keep: u32, gone: u32) -> Merge {
+        Merge {
+            keep,
+            gone,
+            to: self.mesh.positions[keep as usize],
+            colour: self.mesh.colour(keep),
+        }
+    }
+
+    /// Both to the least-error point of their edge; colour averaged.
+    fn quadric_point(&self, keep: u32, gone: u32) -> Merge {
+        let q = self.mesh.quadric(keep) + self.mesh.quadric(gone);
+        let to = q.best_on(self.mesh.point(keep), self.mesh.point(gone));
+        Merge {
+            to: to.as_vec3().to_array(),
+            ..self.midpoint(keep, gone)
+        }
+    }
+
     /// Tries each merge in turn; applies the first the checks allow and
     /// returns its survivor.
     fn first_allowed(&mut self, merges: impl IntoIterator<Item = Merge>) -> Option<u32> {
@@ -103,26 +187,23 @@ impl<'a> Pass<'a> {
         None
     }
 
-    /// Both ends to the midpoint (−1 vertex, −2 faces); both must be removable.
+    /// Both ends to the midpoint (−1 vertex, −2 faces); both must be
+    /// removable. With quadric placement: see [`Self::quadric_edges`].
     fn edge(&mut self, v: u32) -> Option<(u32, usize)> {
-        let partners = self.partners(v, |s, w| s.usable(w));
-        let merges: Vec<Merge> = partners.iter().map(|&w| self.midpoint(v, w)).collect();
+        let merges = match self.placement {
+            Placement::Seed => {
+                let partners = self.partners(v, |s, w| s.usable(w));
+                partners.iter().map(|&w| self.midpoint(v, w)).collect()
+            }
+            Placement::Quadric => self.quadric_edges(v),
+        };
         Some((self.first_allowed(merges)?, 1))
     }
 
     /// `v` into a neighbour, which stays where it is (it may be a border
     /// or feature vertex: it does not move).
     fn half_edge(&mut self, v: u32) -> Option<(u32, usize)> {
-        let partners = self.partners(v, |s, w| !s.frozen[w as usize]);
-        let merges: Vec<Merge> = partners
-            .iter()
-            .map(|&w| Merge {
-                keep: w,
-                gone: v,
-                to: self.mesh.positions[w as usize],
-                colour: self.mesh.colour(w),
-            })
-            .collect();
+        let merges = self.merges_into_neighbours(v);
         Some((self.first_allowed(merges)?, 1))
     }
 
@@ -175,10 +256,25 @@ impl<'a> Pass<'a> {
         }
     }
 
+    /// The centroid, or with quadric placement whichever of the centroid
+    /// and the three corners the summed quadric prefers (the free minimum
+    /// can leave the face's patch on sharp creases and fold a face there:
+    /// tests/simplifier.rs, the genus-3 plate); colour averaged.
     fn centroid(&self, t: &[u32; 3]) -> ([f32; 3], Option<[f32; 3]>) {
-        let to = (t.iter().map(|&w| self.mesh.point(w)).sum::<glam::DVec3>() / 3.0)
-            .as_vec3()
-            .to_array();
+        let centroid = t.iter().map(|&w| self.mesh.point(w)).sum::<DVec3>() / 3.0;
+        let best = match self.placement {
+            Placement::Seed => None,
+            Placement::Quadric => {
+                let q = t
+                    .iter()
+                    .map(|&w| self.mesh.quadric(w))
+                    .fold(super::quadric::Quadric::default(), |a, b| a + b);
+                std::iter::once(centroid)
+                    .chain(t.iter().map(|&w| self.mesh.point(w)))
+                    .min_by(|a, b| q.error(*a).total_cmp(&q.error(*b)))
+            }
+        };
+        let to = best.unwrap_or(centroid).as_vec3().to_array();
         let colour = self
             .mesh
             .colours

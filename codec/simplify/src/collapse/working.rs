@@ -6,6 +6,7 @@
 use glam::DVec3;
 use vitrine_codec::{Error, IndexedMesh, Result};
 
+use super::quadric::{vertex_quadrics, Quadric};
 use crate::deviation::{border_vertices, normal_deviation, one_ring_max};
 use crate::FeatureThreshold;
 
@@ -35,6 +36,9 @@ pub(crate) struct WorkingMesh {
     /// replaces, which faces around it must keep (per-merge turn limits
     /// alone let a face drift over in several steps).
     pub reference: Vec<DVec3>,
+    /// Each survivor's error quadric (the sum over the input vertices it
+    /// stands for), when the placement uses them.
+    pub quadrics: Option<Vec<Quadric>>,
     pub live_vertices: usize,
 }
 
@@ -76,10 +80,24 @@ impl WorkingMesh {
             border: border_vertices(mesh),
             theta: ring,
             reference: vertex_normals(mesh),
+            quadrics: None,
             live_vertices,
         };
         working.check_fans()?;
         Ok(working)
+    }
+
+    /// Starts carrying error quadrics through the merges.
+    pub fn with_quadrics(mut self) -> Self {
+        self.quadrics = Some(vertex_quadrics(&self.positions, &self.triangles));
+        self
+    }
+
+    /// The quadric `v` carries (zero without quadrics).
+    pub fn quadric(&self, v: u32) -> Quadric {
+        self.quadrics
+            .as_ref()
+            .map_or(Quadric::default(), |q| q[v as usize])
     }
 
     pub fn live_faces(&self) -> usize {
@@ -153,6 +171,10 @@ impl WorkingMesh {
         self.theta[keep] = self.theta[keep].max(self.theta[gone]);
         let absorbed = self.reference[gone];
         self.reference[keep] += absorbed;
+        if let Some(q) = &mut self.quadrics {
+            let absorbed = q[gone];
+            q[keep] += absorbed;
+        }
     }
 
     /// Kills a face; a vertex left without faces stops counting.
