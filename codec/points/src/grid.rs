@@ -24,6 +24,8 @@ pub struct Grid<'a> {
     starts: Vec<u32>,
     /// Point indices sorted by cell key.
     order: Vec<u32>,
+    /// The points in that order (queries scan these contiguously).
+    sorted: Vec<[f32; 3]>,
 }
 
 /// Most cells per axis (keys must fit a u64: 3 × 21 bits).
@@ -52,6 +54,7 @@ impl<'a> Grid<'a> {
             keys: Vec::new(),
             starts: Vec::new(),
             order: Vec::new(),
+            sorted: Vec::new(),
         };
         let mut keyed: Vec<(u64, u32)> = points
             .iter()
@@ -60,6 +63,7 @@ impl<'a> Grid<'a> {
             .collect();
         radsort::sort_by_key(&mut keyed, |k| k.0);
         grid.order = keyed.iter().map(|k| k.1).collect();
+        grid.sorted = grid.order.iter().map(|&i| points[i as usize]).collect();
         for (i, k) in keyed.iter().enumerate() {
             if grid.keys.last() != Some(&k.0) {
                 grid.keys.push(k.0);
@@ -81,13 +85,16 @@ impl<'a> Grid<'a> {
         // cells of diag / √n hold a few each; refine if they hold many.
         let n = points.len().max(1) as f32;
         let mut cell = (diag / n.sqrt()).max(f32::MIN_POSITIVE) * 2.0;
+        // Aim for 3–8 points per occupied cell, so that one ring of cells
+        // usually holds the nearest few.
         for _ in 0..6 {
             let g = Grid::new(points, cell);
             let per_cell = n / g.keys.len().max(1) as f32;
-            if per_cell <= 8.0 {
+            if (3.0..=8.0).contains(&per_cell) || g.keys.len() == 1 {
                 return g;
             }
-            cell *= (4.0 / per_cell).cbrt().max(0.25);
+            // Occupied cells of a surface scale with the cell's area.
+            cell *= (5.0 / per_cell).sqrt().clamp(0.25, 4.0);
         }
         Grid::new(points, cell)
     }
@@ -107,27 +114,87 @@ impl<'a> Grid<'a> {
         (c[2] * self.dims[1] + c[1]) * self.dims[0] + c[0]
     }
 
-    /// Calls `f(j)` for every point in the cells within `reach` cells (per
-    /// axis) of the cell of `p`.
-    #[inline]
-    pub fn for_each_near(&self, p: [f32; 3], reach: u64, mut f: impl FnMut(u32)) {
-        let c = self.coords(p);
+    fn cell_coords(&self, key: u64) -> [u64; 3] {
+        let x = key % self.dims[0];
+        let yz = key / self.dims[0];
+        [x, yz % self.dims[1], yz / self.dims[1]]
+    }
+
+    /// The ranges (into the sorted order) of the cells within `reach` cells
+    /// (per axis) of cell `c`: one range per (y, z) row.
+    fn rows(&self, c: [u64; 3], reach: u64, out: &mut Vec<(u32, u32)>) {
+        out.clear();
         let lo = c.map(|v| v.saturating_sub(reach));
         let hi = [0, 1, 2].map(|a| (c[a] + reach).min(self.dims[a] - 1));
         for z in lo[2]..=hi[2] {
             for y in lo[1]..=hi[1] {
                 let first = self.key([lo[0], y, z]);
                 let last = self.key([hi[0], y, z]);
-                let mut k = self.keys.partition_point(|&key| key < first);
-                while k < self.keys.len() && self.keys[k] <= last {
-                    let (s, e) = (self.starts[k] as usize, self.starts[k + 1] as usize);
-                    for &j in &self.order[s..e] {
-                        f(j);
-                    }
-                    k += 1;
+                let a = self.keys.partition_point(|&key| key < first);
+                let b = a + self.keys[a..].partition_point(|&key| key <= last);
+                if a < b {
+                    out.push((self.starts[a], self.starts[b]));
                 }
             }
         }
+    }
+
+    /// Calls `f(j)` for every point in the cells within `reach` cells (per
+    /// axis) of the cell of `p`.
+    pub fn for_each_near(&self, p: [f32; 3], reach: u64, mut f: impl FnMut(u32)) {
+        let mut rows = Vec::new();
+        self.rows(self.coords(p), reach, &mut rows);
+        for (s, e) in rows {
+            for &j in &self.order[s as usize..e as usize] {
+                f(j);
+            }
+        }
+    }
+
+    /// Visits every point, cell by cell: `f(i, p_i, near)` where `near`
+    /// yields (index, position) of every point within `reach(cell's points)`
+    /// cells of the point's cell, the point included. Cell by cell, so the
+    /// rows are looked up once per cell and the scans stay in cache.
+    pub fn for_each_point_near(
+        &self,
+        reach: impl Fn(&[u32]) -> u64,
+        mut f: impl FnMut(u32, [f32; 3], &Near<'_>),
+    ) {
+        let mut near = Near {
+            grid: self,
+            rows: Vec::new(),
+        };
+        for (k, &key) in self.keys.iter().enumerate() {
+            let (s, e) = (self.starts[k] as usize, self.starts[k + 1] as usize);
+            let r = reach(&self.order[s..e]);
+            self.rows(self.cell_coords(key), r, &mut near.rows);
+            for t in s..e {
+                f(self.order[t], self.sorted[t], &near);
+            }
+        }
+    }
+
+    /// Calls `f(i, neighbours)` for every point with its `k` nearest other
+    /// points (ascending (squared distance, index)), cell by cell.
+    pub fn knn_each(&self, k: usize, mut f: impl FnMut(usize, &[(f32, u32)])) {
+        let mut best = Vec::with_capacity(k + 1);
+        let covered = self.cell * self.cell;
+        self.for_each_point_near(
+            |_| 1,
+            |i, p, near| {
+                best.clear();
+                for (j, q) in near.iter() {
+                    if j != i {
+                        insert_best(&mut best, k, (dist2(p, q), j));
+                    }
+                }
+                // Everything outside one ring of cells is farther than a cell.
+                if best.len() < k || best[k - 1].0 > covered {
+                    self.knn(i as usize, k, &mut best);
+                }
+                f(i as usize, &best);
+            },
+        );
     }
 
     /// The `k` nearest other points of point `i` (ascending distance; ties by
@@ -137,13 +204,18 @@ impl<'a> Grid<'a> {
         let p = self.points[i];
         let max_reach = self.dims.iter().copied().max().unwrap_or(1);
         let mut reach = 1;
+        let mut rows = Vec::new();
         loop {
             out.clear();
-            self.for_each_near(p, reach, |j| {
-                if j as usize != i {
-                    insert_best(out, k, (dist2(p, self.points[j as usize]), j));
+            self.rows(self.coords(p), reach, &mut rows);
+            for &(a, b) in &rows {
+                let (a, b) = (a as usize, b as usize);
+                for (&j, &q) in self.order[a..b].iter().zip(&self.sorted[a..b]) {
+                    if j as usize != i {
+                        insert_best(out, k, (dist2(p, q), j));
+                    }
                 }
-            });
+            }
             // Every point outside the searched cells is farther than this.
             let covered = reach as f32 * self.cell;
             let done = out.len() == k && out[k - 1].0 <= covered * covered;
@@ -152,6 +224,27 @@ impl<'a> Grid<'a> {
             }
             reach *= 2;
         }
+    }
+}
+
+/// The points of some rows of cells (see [`Grid::for_each_point_near`]).
+pub struct Near<'g> {
+    grid: &'g Grid<'g>,
+    rows: Vec<(u32, u32)>,
+}
+
+impl Near<'_> {
+    /// (index, position) of each point.
+    #[inline]
+    pub fn iter(&self) -> impl Iterator<Item = (u32, [f32; 3])> + '_ {
+        self.rows.iter().flat_map(|&(a, b)| {
+            let (a, b) = (a as usize, b as usize);
+            let g = self.grid;
+            g.order[a..b]
+                .iter()
+                .copied()
+                .zip(g.sorted[a..b].iter().copied())
+        })
     }
 }
 
@@ -206,6 +299,13 @@ mod tests {
         let mut out = Vec::new();
         for i in (0..pts.len()).step_by(37) {
             g.knn(i, 8, &mut out);
+            let mut each = Vec::new();
+            g.knn_each(8, |j, b| {
+                if j == i {
+                    each = b.to_vec();
+                }
+            });
+            assert_eq!(each, out, "point {i}");
             let mut all: Vec<(f32, u32)> = (0..pts.len())
                 .filter(|&j| j != i)
                 .map(|j| (dist2(pts[i], pts[j]), j as u32))

@@ -23,17 +23,16 @@ pub fn estimate_normals(points: &[[f32; 3]], k: usize) -> Vec<[f32; 3]> {
     }
     let k = k.clamp(3, 64).min(n.saturating_sub(1)).max(1);
     let grid = Grid::for_knn(points);
-    let mut nbrs: Vec<u32> = Vec::with_capacity(n * k);
-    let mut planes = Vec::with_capacity(n);
-    let mut best = Vec::with_capacity(k);
-    for i in 0..n {
-        grid.knn(i, k, &mut best);
-        let start = nbrs.len();
-        nbrs.extend(best.iter().map(|b| b.1));
-        // Pad short lists (tiny clouds) so every row has k entries.
-        nbrs.resize(start + k, i as u32);
-        planes.push(pca_plane(points, i, &nbrs[start..]));
-    }
+    // Rows of k neighbours; short rows (tiny clouds) padded with the point.
+    let mut nbrs: Vec<u32> = (0..n * k).map(|e| (e / k) as u32).collect();
+    grid.knn_each(k, |i, best| {
+        for (slot, b) in nbrs[i * k..].iter_mut().zip(best) {
+            *slot = b.1;
+        }
+    });
+    let planes: Vec<Plane> = (0..n)
+        .map(|i| pca_plane(points, i, &nbrs[i * k..(i + 1) * k]))
+        .collect();
     let mut normals: Vec<[f32; 3]> = (0..n)
         .map(|i| {
             // The point's own plane and those of its neighbours and theirs.
