@@ -33,7 +33,7 @@ if ! cargo +nightly fuzz --version >/dev/null 2>&1; then
     cargo install cargo-fuzz --locked || skip "cargo-fuzz could not be installed"
 fi
 
-all=(decode_stream decode_batch import_ply import_obj import_off import_gltf import_md2 repair)
+all=(decode_stream decode_points decode_batch import_ply import_obj import_off import_gltf import_md2 repair)
 if [ "$#" -gt 0 ]; then
     targets=("$@")
 else

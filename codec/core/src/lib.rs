@@ -19,7 +19,7 @@ mod contexts;
 mod decoder;
 pub mod edges;
 mod encoder;
-mod entropy;
+pub mod entropy;
 mod error;
 mod format;
 mod frenet;

@@ -64,6 +64,23 @@ fn main() {
     );
     write("decode_stream", "coarse", &coarse.unwrap().bytes);
 
+    // decode_points: small point streams, with and without attributes.
+    for (i, (n, attrs)) in [(40usize, false), (300, true)].into_iter().enumerate() {
+        let (pos, nrm) = vitrine_points::testing::sphere(n, [0.0; 3], 1.0, i as u64);
+        let cloud = vitrine_points::PointCloud {
+            colours: attrs.then(|| pos.iter().map(|p| p.map(|v| (v * 90.0 + 128.0) as u8)).collect()),
+            normals: attrs.then_some(nrm),
+            ..vitrine_points::PointCloud::from_positions(pos)
+        };
+        let opts = vitrine_points::stream::EncodeOptions {
+            bits: 10,
+            base_points: 16,
+            ..Default::default()
+        };
+        let s = vitrine_points::stream::encode(&cloud, &opts).unwrap();
+        write("decode_points", &format!("sphere-{i}"), &s.bytes);
+    }
+
     // decode_batch: selector byte, then batch 1's payload or whole chunk.
     for (i, s) in sample_streams().iter().enumerate() {
         let index = StreamIndex::parse(s).unwrap();

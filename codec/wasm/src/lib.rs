@@ -13,19 +13,21 @@
 //! 4. On error `error_ptr()` / `error_len()` give a UTF-8 message.
 //!
 //! [`geodesic`] adds distance along the surface of a decoded level, for
-//! the viewer's measurement tool.
+//! the viewer's measurement tool; [`points`] decodes point streams and
+//! preprocesses splats.
 //!
 //! Exported symbols need `#[no_mangle]`, which the `unsafe_code` lint flags;
 //! nothing here dereferences a raw pointer: all memory is Rust-owned `Vec`s.
 #![deny(unsafe_code)]
 
 pub mod geodesic;
+pub mod points;
 
 use std::cell::RefCell;
 use vitrine_codec::{Decoder, Limits};
 
 thread_local! {
-    static INPUT: RefCell<Vec<u8>> = const { RefCell::new(Vec::new()) };
+    pub(crate) static INPUT: RefCell<Vec<u8>> = const { RefCell::new(Vec::new()) };
     static ERROR: RefCell<String> = const { RefCell::new(String::new()) };
     static DECODERS: RefCell<Vec<Option<Decoder>>> = const { RefCell::new(Vec::new()) };
 }

@@ -27,6 +27,7 @@ mod ply;
 mod texture;
 
 pub(crate) use gltf::srgb_u8_to_linear;
+pub use ply::points::{import_ply_points, PlyPoints};
 
 /// The mesh file formats [`import_path`] and [`import_bytes`] read.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]

@@ -18,6 +18,10 @@ use crate::{Error, IndexedMesh, Result};
 
 const WHAT: &str = "PLY file";
 
+// The point-cloud reader, a child so that it shares the private parser.
+#[path = "ply_points.rs"]
+pub(super) mod points;
+
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum Ty {
     I8,
