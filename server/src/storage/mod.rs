@@ -7,6 +7,7 @@
 //! they connect, migrate and classify errors.
 
 mod backend;
+mod curator;
 mod postgres;
 mod sql;
 mod sqlite;
@@ -20,6 +21,7 @@ pub use study::{
     for_analysis, AnswerRecord, InvitationRecord, NewSession, SessionRecord, StudyRecord,
     StudyStorage, ViewEvent,
 };
+pub use curator::CuratorStorage;
 pub use types::*;
 
 use async_trait::async_trait;
@@ -79,7 +81,7 @@ pub(crate) fn is_connection_error(e: &sqlx::Error) -> bool {
 
 /// The one interface the service and the ingest command use.
 #[async_trait]
-pub trait Storage: StudyStorage + Send + Sync + 'static {
+pub trait Storage: StudyStorage + CuratorStorage + Send + Sync + 'static {
     /// Which backend, for logs and metrics: `"sqlite"` or `"postgres"`.
     fn backend(&self) -> &'static str;
 

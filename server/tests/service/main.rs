@@ -5,6 +5,7 @@
 mod broken;
 mod caps;
 mod colour;
+mod curators;
 mod download;
 mod harness;
 mod http;
@@ -74,6 +75,9 @@ on_both_backends!(
     study::scripted_participants,
     study::bad_study_requests,
     download::glb_download_of_a_level,
+    curators::annotations_and_scopes,
+    curators::uploads_as_jobs,
+    curators::curation_in_manifest_and_thumbnail,
 );
 
 /// `server/openapi.json` is the served description, committed for reviewers

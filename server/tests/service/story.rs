@@ -57,6 +57,7 @@ pub async fn token_for(db: &TestDb, slug: Option<&str>) -> String {
     let token = new_token();
     let new = NewToken {
         token_sha256: sha256_hex(token.as_bytes()),
+        scope: vitrine::storage::TokenScope::Researcher,
         label: "test".into(),
         model_slug: slug.map(str::to_owned),
         expires_at_ms: None,
@@ -192,6 +193,7 @@ pub async fn storage_round_trip(db: TestDb) {
     assert!(grant.covers("torus") && !grant.covers("other"));
     let expired = NewToken {
         token_sha256: sha256_hex(b"old"),
+        scope: vitrine::storage::TokenScope::Researcher,
         label: "old".into(),
         model_slug: None,
         expires_at_ms: Some(now_ms() - 1),
