@@ -186,6 +186,12 @@ fn print_report(slug: &str, report: &IngestReport) {
         report.stream_bytes,
         report.encode_time.as_secs_f64(),
     );
+    if let Some(t) = report.curation_time {
+        println!(
+            "Hausdorff distance of every level (sampled) and thumbnail in {:.2} s",
+            t.as_secs_f64()
+        );
+    }
     if let Some(ccc) = &report.ccc {
         println!(
             "colour: {} cells, {} tiles, {:.1} % of covered texels ambiguous; cell texture {} bytes, colour texture {} bytes ({} low-resolution)",

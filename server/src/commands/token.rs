@@ -54,7 +54,9 @@ pub async fn run(args: TokenArgs) -> anyhow::Result<()> {
     match (args.action, args.researcher) {
         (Some(TokenAction::Create(create)), _) => create_token(create.scope, create.token).await,
         (None, Some(token)) => create_token(TokenScope::Researcher, token).await,
-        (None, None) => anyhow::bail!("use `vitrine token create --scope curator|researcher --label …`"),
+        (None, None) => {
+            anyhow::bail!("use `vitrine token create --scope curator|researcher --label …`")
+        }
     }
 }
 

@@ -13,8 +13,7 @@ use vitrine_codec::{Decoder, IndexedMesh, Limits, StreamIndex};
 use vitrine_colour::ccc::CellComplex;
 use vitrine_quality::metrics::views::{bounding_sphere, FOV_Y};
 use vitrine_quality::metrics::{
-    render, Camera, ConstantColour, HausdorffReference, RenderOptions, SurfaceShader,
-    VertexColours,
+    render, Camera, ConstantColour, HausdorffReference, RenderOptions, SurfaceShader, VertexColours,
 };
 
 /// Area samples per mesh for the Hausdorff distance measured by default
@@ -199,8 +198,12 @@ mod tests {
         let image = image::load_from_memory(&thumb.bytes).unwrap().to_rgb8();
         // The tall sphere fills most of the picture's height, little of its width.
         let covered = |x: u32, y: u32| image.get_pixel(x, y).0 != [33, 36, 41];
-        let rows = (0..THUMBNAIL_SIZE).filter(|&y| covered(THUMBNAIL_SIZE / 2, y)).count();
-        let cols = (0..THUMBNAIL_SIZE).filter(|&x| covered(x, THUMBNAIL_SIZE / 2)).count();
+        let rows = (0..THUMBNAIL_SIZE)
+            .filter(|&y| covered(THUMBNAIL_SIZE / 2, y))
+            .count();
+        let cols = (0..THUMBNAIL_SIZE)
+            .filter(|&x| covered(x, THUMBNAIL_SIZE / 2))
+            .count();
         assert!(rows > cols * 2, "rows {rows}, columns {cols}: not upright");
     }
 }

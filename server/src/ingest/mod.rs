@@ -13,9 +13,9 @@ pub use guards::{threshold_name, FeatureSummary, GuardOptions, Guards};
 
 use crate::source::{default_colour_mode, read_back, QualityReference};
 use crate::storage::{valid_slug, Bounds, NewThumbnail, OnExisting, Storage, StoredModel, UpAxis};
+use anyhow::{bail, Context};
 use std::path::Path;
 use std::sync::Arc;
-use anyhow::{bail, Context};
 use std::time::{Duration, Instant};
 use store::{store, Product};
 use vitrine_codec::{EncodeOptions, Encoded, IndexedMesh};
@@ -121,6 +121,8 @@ pub struct Curated {
     /// there was an original to measure against.
     pub hausdorff: Option<Vec<f64>>,
     pub thumbnail: Option<NewThumbnail>,
+    /// How long measuring and rendering took.
+    pub time: Duration,
 }
 
 #[derive(Clone, Debug)]
@@ -138,6 +140,8 @@ pub struct IngestReport {
     pub quality: Option<MeasuredQuality>,
     /// What the feature guard kept, when it ran.
     pub features: Option<FeatureSummary>,
+    /// How long the default Hausdorff distances and the thumbnail took.
+    pub curation_time: Option<Duration>,
 }
 
 /// Every level's quality against the original, and how it was measured.
@@ -237,16 +241,14 @@ fn encode_and_measure(
         .context("encoding failed")?;
     let encode_time = started.elapsed();
     options.report("measuring", 0.6);
+    let curating = Instant::now();
     let complex = mapping
         .as_ref()
         .map(read_back)
         .transpose()
         .context("reading back the cell complex")?;
-    let (bounds, hausdorff, full) = curation::measure_levels(
-        &encoded.bytes,
-        &mesh,
-        curation::DEFAULT_HAUSDORFF_SAMPLES,
-    )?;
+    let (bounds, hausdorff, full) =
+        curation::measure_levels(&encoded.bytes, &mesh, curation::DEFAULT_HAUSDORFF_SAMPLES)?;
     options.report("rendering the thumbnail", 0.8);
     let thumbnail = curation::render_thumbnail(&full, complex.as_ref(), up)?;
     let curated = Curated {
@@ -254,6 +256,7 @@ fn encode_and_measure(
         bounds,
         hausdorff: Some(hausdorff),
         thumbnail: Some(thumbnail),
+        time: curating.elapsed(),
     };
     // Before the transaction: measuring takes seconds, and a write
     // transaction should not stay open (SQLite holds its one writer lock).

@@ -74,6 +74,7 @@ pub(super) async fn store(
         ccc,
         quality: product.quality,
         features: product.features,
+        curation_time: curated.map(|c| c.time),
     })
 }
 

@@ -143,8 +143,8 @@ pub fn describe_refusals(description: &mut OpenApi) {
             &mut item.put,
             &mut item.delete,
         ]
-            .into_iter()
-            .flatten()
+        .into_iter()
+        .flatten()
         {
             for (status, text, retry_after) in refusals {
                 let mut response = ResponseBuilder::new().description(text).content(

@@ -2,9 +2,9 @@
 //! description served at `/api/openapi.json` is generated from it (each
 //! handler's `#[utoipa::path]` and its types' `ToSchema`).
 
+use super::curator::{admin, annotations, jobs, thumbnail, upload};
 use super::error::AppError;
 use super::web::{self, Viewer};
-use super::curator::{admin, annotations, jobs, thumbnail, upload};
 use super::{api, download, guard, ops, payload, study, AppState, ServiceConfig};
 use axum::http::{header, HeaderValue};
 use axum::response::{IntoResponse, Response};

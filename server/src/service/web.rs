@@ -4,12 +4,12 @@
 //! gallery so a fresh install shows something.
 
 use super::api::visible_models;
+use super::curator::thumbnail;
 use super::error::{AppError, ErrorBody};
 use super::servable::{PathParams, ServableModel, SlugParam};
 use super::study::StudySlug;
 use super::visitor::{HintQuery, VisitorHints};
 use super::AppState;
-use super::curator::thumbnail;
 use crate::storage::{valid_slug, ModelRecord};
 use axum::extract::{Request, State};
 use axum::http::{header, HeaderMap, HeaderValue};
@@ -122,7 +122,12 @@ pub async fn model_page(
     let viewer = match tokio::fs::read_to_string(&index).await {
         Ok(html) => Some(html),
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => None,
-        Err(e) => return Err(AppError::Internal(format!("reading {}: {e}", index.display()))),
+        Err(e) => {
+            return Err(AppError::Internal(format!(
+                "reading {}: {e}",
+                index.display()
+            )))
+        }
     };
     match (viewer, model) {
         (Some(html), Ok(model)) => {

@@ -54,20 +54,20 @@ macro_rules! sql_storage {
                     mapping: None,
                     textures: Vec::new(),
                     curation: Curation {
-                    up_axis: match row.try_get::<Option<String>, _>("up_axis").map_err(get)? {
-                        Some(name) => Some(UpAxis::parse(&name).ok_or_else(|| {
-                            StorageError::Corrupt(format!("model.up_axis = {name:?}"))
-                        })?),
-                        None => None,
-                    },
-                    unit: row.try_get("unit").map_err(get)?,
-                    bounds: match row.try_get::<Option<String>, _>("bounds").map_err(get)? {
-                        Some(json) => Some(Bounds::from_json(&json).ok_or_else(|| {
-                            StorageError::Corrupt(format!("model.bounds = {json:?}"))
-                        })?),
-                        None => None,
-                    },
-                    thumbnail_sha256: row.try_get("thumbnail_sha256").map_err(get)?,
+                        up_axis: match row.try_get::<Option<String>, _>("up_axis").map_err(get)? {
+                            Some(name) => Some(UpAxis::parse(&name).ok_or_else(|| {
+                                StorageError::Corrupt(format!("model.up_axis = {name:?}"))
+                            })?),
+                            None => None,
+                        },
+                        unit: row.try_get("unit").map_err(get)?,
+                        bounds: match row.try_get::<Option<String>, _>("bounds").map_err(get)? {
+                            Some(json) => Some(Bounds::from_json(&json).ok_or_else(|| {
+                                StorageError::Corrupt(format!("model.bounds = {json:?}"))
+                            })?),
+                            None => None,
+                        },
+                        thumbnail_sha256: row.try_get("thumbnail_sha256").map_err(get)?,
                     },
                 })
             }

@@ -15,13 +15,13 @@ mod stage;
 mod study;
 mod types;
 
+pub use curator::CuratorStorage;
 pub use postgres::PostgresStorage;
 pub use sqlite::SqliteStorage;
 pub use study::{
     for_analysis, AnswerRecord, InvitationRecord, NewSession, SessionRecord, StudyRecord,
     StudyStorage, ViewEvent,
 };
-pub use curator::CuratorStorage;
 pub use types::*;
 
 use async_trait::async_trait;

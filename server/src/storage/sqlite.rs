@@ -4,9 +4,9 @@ use super::backend::sql_storage;
 use super::curator::curator_storage;
 use super::study::study_storage;
 use super::{
-    is_connection_error, AudiencePolicy, ConnectOptions, LevelRecord, MappingRecord, ModelRecord,
-    ModelSummary, NewModel, NewToken, StagedModel, Storage, StorageError, TexturePayload,
-    TextureRef, TokenGrant, TokenScope, UpAxis, Bounds, Curation,
+    is_connection_error, AudiencePolicy, Bounds, ConnectOptions, Curation, LevelRecord,
+    MappingRecord, ModelRecord, ModelSummary, NewModel, NewToken, StagedModel, Storage,
+    StorageError, TexturePayload, TextureRef, TokenGrant, TokenScope, UpAxis,
 };
 use sqlx::sqlite::{SqliteConnectOptions, SqliteJournalMode, SqlitePoolOptions, SqliteSynchronous};
 use sqlx::{Sqlite, SqlitePool, Transaction};

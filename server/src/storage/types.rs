@@ -2,7 +2,10 @@
 
 use serde::Serialize;
 
-pub use super::curator::{AnnotationRecord, Bounds, JobRecord, JobState, NewAnnotation, NewJob, ThumbnailPayload, UpAxis, VersionRecord};
+pub use super::curator::{
+    AnnotationRecord, Bounds, JobRecord, JobState, NewAnnotation, NewJob, ThumbnailPayload, UpAxis,
+    VersionRecord,
+};
 
 /// Who may fetch how much of a model (table `audience_policy`).
 #[derive(Clone, Debug, PartialEq, Serialize)]

@@ -82,7 +82,9 @@ fn present<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Option<Option<u32>>
 
 async fn versions_of(state: &AppState, slug: &str) -> Result<Vec<VersionRecord>, AppError> {
     if !valid_slug(slug) {
-        return Err(AppError::BadRequest(format!("{slug:?} is not a model slug")));
+        return Err(AppError::BadRequest(format!(
+            "{slug:?} is not a model slug"
+        )));
     }
     let versions = state.storage().versions(slug).await?;
     if versions.is_empty() {

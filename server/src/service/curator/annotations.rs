@@ -94,7 +94,12 @@ impl AnnotationInput {
         if self.text.chars().count() > MAX_TEXT_CHARS {
             return bad(format!("text is longer than {MAX_TEXT_CHARS} characters"));
         }
-        if !self.position.iter().chain(&self.normal).all(|v| v.is_finite()) {
+        if !self
+            .position
+            .iter()
+            .chain(&self.normal)
+            .all(|v| v.is_finite())
+        {
             return bad("position and normal must be finite numbers".into());
         }
         let length = self.normal.iter().map(|v| v * v).sum::<f64>().sqrt();
@@ -142,7 +147,9 @@ fn body(input: Result<Json<AnnotationInput>, JsonRejection>) -> Result<NewAnnota
 /// The model must exist (any audience: curators annotate restricted models too).
 async fn existing(state: &AppState, slug: &str) -> Result<(), AppError> {
     if !valid_slug(slug) {
-        return Err(AppError::BadRequest(format!("{slug:?} is not a model slug")));
+        return Err(AppError::BadRequest(format!(
+            "{slug:?} is not a model slug"
+        )));
     }
     state.record_by_slug(slug).await.map(|_| ())
 }

@@ -86,7 +86,14 @@ pub fn spawn(state: AppState, job: JobRecord, place: QueuePlace, input: JobInput
                 let message = format!("{e:#}");
                 tracing::info!(job = job.id, slug = %job.slug, error = %message, "upload failed");
                 storage
-                    .update_job(job.id, JobState::Failed, 1.0, "failed", Some(&message), None)
+                    .update_job(
+                        job.id,
+                        JobState::Failed,
+                        1.0,
+                        "failed",
+                        Some(&message),
+                        None,
+                    )
                     .await
             }
         };
@@ -96,7 +103,8 @@ pub fn spawn(state: AppState, job: JobRecord, place: QueuePlace, input: JobInput
     });
 }
 
-/// Imports, encodes, measures and stores; the new version's number.
+/// Imports, encodes, measures and stores; the new version's number. Every
+/// progress row is written before this returns, so none lands after the end.
 async fn run(state: &AppState, job: &JobRecord, input: JobInput) -> anyhow::Result<u32> {
     let storage = state.storage().clone();
     // Progress goes through a channel so that its rows are written in order.
@@ -115,23 +123,36 @@ async fn run(state: &AppState, job: &JobRecord, input: JobInput) -> anyhow::Resu
             }
         })
     };
-    let report = {
-        let tx = tx.clone();
-        move |stage: &'static str, done: f64| {
-            let _ = tx.send((stage, done));
-        }
-    };
-    report("importing", 0.05);
+    let hook = ProgressHook(Arc::new(move |stage: &'static str, done: f64| {
+        let _ = tx.send((stage, done));
+    }));
+    let result = ingest_upload(&*storage, job, input, hook).await;
+    // The hook (the channel's last sender) is gone with the ingest's options.
+    let _ = writer.await;
+    result
+}
+
+async fn ingest_upload(
+    storage: &dyn crate::storage::Storage,
+    job: &JobRecord,
+    input: JobInput,
+    hook: ProgressHook,
+) -> anyhow::Result<u32> {
+    (hook.0)("importing", 0.05);
     let JobInput {
         file,
         mut meta,
         mut options,
     } = input;
     let source_name = job.source_name.clone();
+    let spooled = file.to_string_lossy().into_owned();
+    let shown = source_name.clone();
     let source = tokio::task::spawn_blocking(move || {
         let source = load_coloured_frame(&file, 0);
         drop(file); // the spooled upload is removed once read
-        source
+                    // The importer's message names the file as the curator sent it,
+                    // not the spool file.
+        source.map_err(|e| anyhow::anyhow!(format!("{e:#}").replace(&spooled, &shown)))
     })
     .await??;
     meta.source = Some(SourceInfo {
@@ -140,12 +161,9 @@ async fn run(state: &AppState, job: &JobRecord, input: JobInput) -> anyhow::Resu
         faces: source.imported_faces as u64,
         repair: Some(source.repair.to_string()),
     });
-    options.progress = Some(ProgressHook(Arc::new(report)));
-    let result = ingest_coloured(&*storage, source.mesh, source.texture, meta, &options).await;
-    drop(options);
-    drop(tx);
-    let _ = writer.await;
-    Ok(result?.stored.version)
+    options.progress = Some(hook);
+    let report = ingest_coloured(storage, source.mesh, source.texture, meta, &options).await?;
+    Ok(report.stored.version)
 }
 
 /// A job as served.

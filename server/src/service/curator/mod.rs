@@ -100,7 +100,9 @@ fn bearer(headers: &HeaderMap) -> Result<Option<String>, AppError> {
         .to_str()
         .map_err(|_| AppError::BadRequest("Authorization is not ASCII".into()))?;
     match text.split_once(' ') {
-        Some((scheme, token)) if scheme.eq_ignore_ascii_case("bearer") && !token.trim().is_empty() => {
+        Some((scheme, token))
+            if scheme.eq_ignore_ascii_case("bearer") && !token.trim().is_empty() =>
+        {
             Ok(Some(token.trim().to_owned()))
         }
         _ => Err(AppError::BadRequest(

@@ -60,7 +60,10 @@ pub async fn thumbnail(
         [
             (header::CONTENT_TYPE, media_type),
             (header::ETAG, etag),
-            (header::CACHE_CONTROL, HeaderValue::from_static(CACHE_CONTROL)),
+            (
+                header::CACHE_CONTROL,
+                HeaderValue::from_static(CACHE_CONTROL),
+            ),
         ],
         image.bytes,
     )

@@ -113,7 +113,16 @@ pub async fn upload(
         job: job.id,
         status_url: format!("/api/jobs/{}", job.id),
     };
-    jobs::spawn(state.clone(), job, place, JobInput { file, meta, options });
+    jobs::spawn(
+        state.clone(),
+        job,
+        place,
+        JobInput {
+            file,
+            meta,
+            options,
+        },
+    );
     Ok((StatusCode::ACCEPTED, Json(accepted)).into_response())
 }
 
@@ -180,7 +189,8 @@ async fn text(mut field: Field<'_>) -> Result<String, AppError> {
         }
         bytes.extend_from_slice(&chunk);
     }
-    String::from_utf8(bytes).map_err(|_| AppError::Unprocessable("a form field is not UTF-8".into()))
+    String::from_utf8(bytes)
+        .map_err(|_| AppError::Unprocessable("a form field is not UTF-8".into()))
 }
 
 /// The text fields of the form.
@@ -213,7 +223,9 @@ impl Fields {
 
     fn validate(self) -> Result<(ModelMeta, IngestOptions), AppError> {
         let bad = |m: String| AppError::Unprocessable(m);
-        let slug = self.slug.ok_or_else(|| bad("the form has no `slug`".into()))?;
+        let slug = self
+            .slug
+            .ok_or_else(|| bad("the form has no `slug`".into()))?;
         if !valid_slug(&slug) {
             return Err(bad(format!(
                 "slug {slug:?} must be 1–64 of a-z, 0-9 and '-', not starting or ending with '-'"
@@ -231,10 +243,11 @@ impl Fields {
         meta.on_existing = OnExisting::NewVersion;
         let colour = match self.colour.as_deref() {
             None | Some("") => None,
-            Some(name) => Some(
-                name.parse::<ColourMode>()
-                    .map_err(|_| bad(format!("colour {name:?} must be ccc, vertex, vertex-metric or none")))?,
-            ),
+            Some(name) => Some(name.parse::<ColourMode>().map_err(|_| {
+                bad(format!(
+                    "colour {name:?} must be ccc, vertex, vertex-metric or none"
+                ))
+            })?),
         };
         let options = IngestOptions {
             colour,

@@ -14,7 +14,9 @@ macro_rules! curator_storage {
                 let vector = |name: &str| -> $crate::storage::Result<[f64; 3]> {
                     let json: String = row.try_get(name).map_err(get)?;
                     serde_json::from_str(&json).map_err(|e| {
-                        StorageError::Corrupt(format!("annotation {id} has an unreadable {name}: {e}"))
+                        StorageError::Corrupt(format!(
+                            "annotation {id} has an unreadable {name}: {e}"
+                        ))
                     })
                 };
                 let view: Option<String> = row.try_get("saved_view").map_err(get)?;
@@ -28,7 +30,9 @@ macro_rules! curator_storage {
                     normal: vector("normal")?,
                     view: match view {
                         Some(json) => Some(serde_json::from_str(&json).map_err(|e| {
-                            StorageError::Corrupt(format!("annotation {id} has an unreadable view: {e}"))
+                            StorageError::Corrupt(format!(
+                                "annotation {id} has an unreadable view: {e}"
+                            ))
                         })?),
                         None => None,
                     },
@@ -55,7 +59,10 @@ macro_rules! curator_storage {
                     progress: row.try_get("progress").map_err(get)?,
                     stage: row.try_get("stage").map_err(get)?,
                     error: row.try_get("error").map_err(get)?,
-                    model_version: match row.try_get::<Option<i64>, _>("model_version").map_err(get)? {
+                    model_version: match row
+                        .try_get::<Option<i64>, _>("model_version")
+                        .map_err(get)?
+                    {
                         Some(v) => Some(narrow(v, "ingest_job.model_version")?),
                         None => None,
                     },
@@ -140,7 +147,11 @@ macro_rules! curator_storage {
                 self.annotation_by_id(slug, id).await
             }
 
-            async fn delete_annotation(&self, slug: &str, id: i64) -> $crate::storage::Result<bool> {
+            async fn delete_annotation(
+                &self,
+                slug: &str,
+                id: i64,
+            ) -> $crate::storage::Result<bool> {
                 let done = sqlx::query($crate::storage::curator::sql::DELETE_ANNOTATION)
                     .bind(slug.to_owned())
                     .bind(id)
