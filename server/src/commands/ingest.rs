@@ -75,6 +75,11 @@ pub struct IngestArgs {
     /// measurements are given in it).
     #[arg(long, value_parser = ["mm", "cm", "m", "in"])]
     pub unit: Option<String>,
+    /// Do not measure every level's Hausdorff distance (sampled, on by
+    /// default: the manifest's `hausdorff`, the viewer's "± error at this
+    /// level"). It costs about levels × vertices point queries.
+    #[arg(long, conflicts_with = "quality")]
+    pub no_hausdorff: bool,
     #[command(flatten)]
     pub ccc: CccArgs,
     #[command(flatten)]
@@ -170,6 +175,7 @@ impl IngestArgs {
                 ..QualityOptions::default()
             }),
             pause_before_commit: self.pause_before_commit_ms.map(Duration::from_millis),
+            skip_hausdorff: self.no_hausdorff,
             progress: None,
         })
     }

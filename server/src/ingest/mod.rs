@@ -18,7 +18,7 @@ use std::path::Path;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 use store::{store, Product};
-use vitrine_codec::{EncodeOptions, Encoded, IndexedMesh};
+use vitrine_codec::{EncodeOptions, Encoded, IndexedMesh, Limits};
 use vitrine_colour::ccc::{CccOptions, CccReport, TextureMapping};
 use vitrine_colour::{encode_coloured, ColourMode};
 use vitrine_mesh::import::TexturedSurface;
@@ -90,6 +90,10 @@ pub struct IngestOptions {
     pub quality: Option<QualityOptions>,
     /// Test hook: wait this long inside the open transaction before committing.
     pub pause_before_commit: Option<Duration>,
+    /// Leave out the sampled Hausdorff distance of every level that ingest
+    /// measures by default (its time grows with levels × vertices: seconds
+    /// at 20k vertices on a small machine); bounds and thumbnail stay.
+    pub skip_hausdorff: bool,
     /// Told each stage as the ingest reaches it (an upload job's progress).
     pub progress: Option<ProgressHook>,
 }
@@ -247,14 +251,22 @@ fn encode_and_measure(
         .map(read_back)
         .transpose()
         .context("reading back the cell complex")?;
-    let (bounds, hausdorff, full) =
-        curation::measure_levels(&encoded.bytes, &mesh, curation::DEFAULT_HAUSDORFF_SAMPLES)?;
+    let (bounds, hausdorff, full) = if options.skip_hausdorff {
+        let full = vitrine_codec::decode(&encoded.bytes, None, Limits::default())
+            .context("reading the stream back")?
+            .to_mesh();
+        (curation::bounds_of(&full), None, full)
+    } else {
+        let (bounds, distances, full) =
+            curation::measure_levels(&encoded.bytes, &mesh, curation::DEFAULT_HAUSDORFF_SAMPLES)?;
+        (bounds, Some(distances), full)
+    };
     options.report("rendering the thumbnail", 0.8);
     let thumbnail = curation::render_thumbnail(&full, complex.as_ref(), up)?;
     let curated = Curated {
         up,
         bounds,
-        hausdorff: Some(hausdorff),
+        hausdorff,
         thumbnail: Some(thumbnail),
         time: curating.elapsed(),
     };
