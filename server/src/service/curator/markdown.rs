@@ -30,13 +30,22 @@ mod tests {
 
     #[test]
     fn scripts_and_javascript_urls_are_removed() {
-        let html = render(
-            "<script>alert(1)</script> <img src=x onerror=alert(2)> [x](javascript:alert(3)) \
+        // An HTML block (the line starts with a tag) and a paragraph with
+        // inline HTML and a Markdown link.
+        for text in [
+            "<script>alert(1)</script> <img src=x onerror=alert(2)> \
              <a href=\"JaVaScRiPt:alert(4)\">y</a> <iframe src=\"https://evil\"></iframe>",
-        );
-        let lower = html.to_ascii_lowercase();
-        for bad in ["<script", "onerror", "javascript:", "<iframe", "alert(1)"] {
-            assert!(!lower.contains(bad), "{bad} survived in {html}");
+            "See [x](javascript:alert(3)) and <b onclick=\"alert(5)\">this</b><script>alert(1)</script>",
+        ] {
+            let html = render(text);
+            let lower = html.to_ascii_lowercase();
+            for bad in ["<script", "onerror", "onclick", "href=\"javascript", "<iframe", "alert(1)"] {
+                assert!(!lower.contains(bad), "{bad} survived in {html}");
+            }
         }
+        assert_eq!(
+            render("See [x](javascript:alert(3))"),
+            "<p>See <a rel=\"noopener noreferrer nofollow\">x</a></p>\n"
+        );
     }
 }
