@@ -106,7 +106,8 @@ pub async fn storage_round_trip(db: TestDb) {
         let stored = s.batch_payload(id, k as u32 + 1).await.unwrap().unwrap();
         assert_eq!(stored, encoded.bytes[range.clone()], "batch {}", k + 1);
         assert_eq!(level.sha256, sha256_hex(&stored));
-        assert_eq!(level.hausdorff, None);
+        // Measured by default at ingest (sampled; issue 22).
+        assert!(level.hausdorff.is_some_and(|h| h.is_finite() && h >= 0.0));
     }
     assert!(s
         .batch_payload(id, index.batches.len() as u32 + 1)
