@@ -69,10 +69,13 @@ fn repaired(mesh: IndexedMesh, path: &Path) -> anyhow::Result<(IndexedMesh, Repa
         .with_context(|| format!("repairing {}", path.display()))
 }
 
-/// How colour travels when not asked: per vertex when the mesh has colour
-/// or a texture, else not at all.
+/// How colour travels when not asked: a textured scan in a cubic cell
+/// complex (the thesis' method, issue 22), per vertex when the mesh has
+/// per-vertex colour only, else not at all.
 pub fn default_colour_mode(mesh: &IndexedMesh, texture: Option<&TexturedSurface>) -> ColourMode {
-    if mesh.colors.is_some() || texture.is_some() {
+    if texture.is_some() {
+        ColourMode::Ccc
+    } else if mesh.colors.is_some() {
         ColourMode::Vertex
     } else {
         ColourMode::None

@@ -15,7 +15,7 @@ const main = /** @type {HTMLElement} */ (document.getElementById('app'));
 const params = new URLSearchParams(location.search);
 const route = location.pathname.match(/^\/(m|embed|study)\/([a-z0-9-]+)\/?$/);
 
-if (!route) void gallery();
+if (!route) void (location.pathname === '/admin' ? import('./admin/page.js').then((admin) => admin.start(main)) : gallery());
 else if (route[1] === 'm') modelPage(route[2]);
 else if (route[1] === 'study') void new StudyPage(main, route[2], params).start();
 else embedPage(route[2]);

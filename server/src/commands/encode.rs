@@ -39,8 +39,8 @@ pub struct EncodeArgs {
     pub no_geometric_guard: bool,
     /// How colour travels: `ccc` (cell-complex texture, written beside the
     /// stream as OUTPUT.ccc.json, .cell.png, .colour.jpg, .colour-low.jpg),
-    /// `vertex`, `vertex-metric` or `none`. Default: `vertex` when the mesh
-    /// has colour or a texture, else `none`.
+    /// `vertex`, `vertex-metric` or `none`. Default: `ccc` for a textured
+    /// scan, `vertex` when the mesh has per-vertex colour only, else `none`.
     #[arg(long)]
     pub colour: Option<ColourMode>,
     #[command(flatten)]

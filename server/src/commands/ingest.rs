@@ -6,7 +6,7 @@ use crate::ingest::{
     ingest_coloured, IngestOptions, IngestReport, MeasuredQuality, ModelMeta, SourceInfo,
 };
 use crate::source::load_coloured_frame;
-use crate::storage::{ConnectOptions, OnExisting};
+use crate::storage::{ConnectOptions, OnExisting, UpAxis};
 use std::path::PathBuf;
 use std::time::Duration;
 use vitrine_codec::EncodeOptions;
@@ -51,8 +51,8 @@ pub struct IngestArgs {
     /// colour texture (OBJ, glTF) or else its per-vertex colour; the stream
     /// carries geometry only), `vertex`, `vertex-metric` (per-vertex colour
     /// in the stream, the latter with the colour-metric decimation guard) or
-    /// `none`. Default: `vertex` when the mesh has colour or a texture, else
-    /// `none`.
+    /// `none`. Default: `ccc` for a textured scan (OBJ+MTL, glTF, MD2 skin),
+    /// `vertex` when the mesh has per-vertex colour only, else `none`.
     #[arg(long)]
     pub colour: Option<ColourMode>,
     /// Measure every level against the original before storing and store the
@@ -66,6 +66,20 @@ pub struct IngestArgs {
     /// default, 256, keeps ingest fast; `vitrine inspect --original` uses 512.
     #[arg(long, default_value_t = 256, value_parser = clap::value_parser!(u32).range(16..=4096))]
     pub quality_image_size: u32,
+    /// Which model axis points up: x, y, z, -x, -y or -z. Default: detected
+    /// (glTF/GLB: y; MD2: z; PLY, OFF, OBJ: z when the box is more than 10 %
+    /// taller along z than along y, else y).
+    #[arg(long, allow_hyphen_values = true)]
+    pub up: Option<UpAxis>,
+    /// The unit of the file's coordinates: mm, cm, m or in (the viewer's
+    /// measurements are given in it).
+    #[arg(long, value_parser = ["mm", "cm", "m", "in"])]
+    pub unit: Option<String>,
+    /// Do not measure every level's Hausdorff distance (sampled, on by
+    /// default: the manifest's `hausdorff`, the viewer's "± error at this
+    /// level"). It costs about levels × vertices point queries.
+    #[arg(long, conflicts_with = "quality")]
+    pub no_hausdorff: bool,
     #[command(flatten)]
     pub ccc: CccArgs,
     #[command(flatten)]
@@ -142,6 +156,8 @@ impl IngestArgs {
                 OnExisting::Refuse
             },
             source: Some(source),
+            up: self.up,
+            unit: self.unit.clone(),
         }
     }
 
@@ -159,6 +175,8 @@ impl IngestArgs {
                 ..QualityOptions::default()
             }),
             pause_before_commit: self.pause_before_commit_ms.map(Duration::from_millis),
+            skip_hausdorff: self.no_hausdorff,
+            progress: None,
         })
     }
 }
@@ -174,6 +192,12 @@ fn print_report(slug: &str, report: &IngestReport) {
         report.stream_bytes,
         report.encode_time.as_secs_f64(),
     );
+    if let Some(t) = report.curation_time {
+        println!(
+            "Hausdorff distance of every level (sampled) and thumbnail in {:.2} s",
+            t.as_secs_f64()
+        );
+    }
     if let Some(ccc) = &report.ccc {
         println!(
             "colour: {} cells, {} tiles, {:.1} % of covered texels ambiguous; cell texture {} bytes, colour texture {} bytes ({} low-resolution)",

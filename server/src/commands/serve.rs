@@ -34,6 +34,20 @@ pub struct ServeArgs {
         value_delimiter = ','
     )]
     pub cors_origins: Vec<String>,
+    /// Uploads (`POST /api/models`) larger than this many MiB get 413.
+    #[arg(long, env = "VITRINE_UPLOAD_LIMIT_MB", default_value_t = 512)]
+    pub upload_limit_mb: u64,
+    /// Where uploads are spooled while they are ingested (default: the
+    /// system's temporary folder).
+    #[arg(long, env = "VITRINE_UPLOAD_DIR")]
+    pub upload_dir: Option<PathBuf>,
+    /// Upload ingests run at once on this instance; up to 8 more wait.
+    #[arg(long, env = "VITRINE_INGEST_JOBS", default_value_t = 1)]
+    pub ingest_jobs: usize,
+    /// Absolute base of links in shared pages (`og:image`), e.g.
+    /// `https://museum.example`; default: the request's Host.
+    #[arg(long, env = "VITRINE_PUBLIC_BASE_URL")]
+    pub public_base_url: Option<String>,
 
     #[arg(long, env = "VITRINE_DB_MAX_CONNECTIONS", default_value_t = 16)]
     pub db_max_connections: u32,
@@ -158,6 +172,13 @@ impl ServeArgs {
             },
             web_dir: self.web_dir.clone(),
             cors_origins: self.cors_origins.clone(),
+            uploads: crate::service::curator::UploadConfig {
+                dir: self.upload_dir.clone().unwrap_or_else(std::env::temp_dir),
+                limit_bytes: self.upload_limit_mb << 20,
+                concurrent_jobs: self.ingest_jobs.max(1),
+                max_queued: 8,
+                public_base_url: self.public_base_url.clone(),
+            },
         }
     }
 

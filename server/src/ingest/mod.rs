@@ -4,6 +4,7 @@
 //! [`IngestOptions::quality`], every level is measured against the original
 //! first (outside the transaction) and the curve is stored in the level rows.
 
+pub mod curation;
 mod guards;
 mod mapping;
 mod store;
@@ -11,11 +12,13 @@ mod store;
 pub use guards::{threshold_name, FeatureSummary, GuardOptions, Guards};
 
 use crate::source::{default_colour_mode, read_back, QualityReference};
-use crate::storage::{valid_slug, OnExisting, Storage, StoredModel};
+use crate::storage::{valid_slug, Bounds, NewThumbnail, OnExisting, Storage, StoredModel, UpAxis};
 use anyhow::{bail, Context};
+use std::path::Path;
+use std::sync::Arc;
 use std::time::{Duration, Instant};
 use store::{store, Product};
-use vitrine_codec::{EncodeOptions, Encoded, IndexedMesh};
+use vitrine_codec::{EncodeOptions, Encoded, IndexedMesh, Limits};
 use vitrine_colour::ccc::{CccOptions, CccReport, TextureMapping};
 use vitrine_colour::{encode_coloured, ColourMode};
 use vitrine_mesh::import::TexturedSurface;
@@ -34,6 +37,10 @@ pub struct ModelMeta {
     pub on_existing: OnExisting,
     /// The file it came from, as imported (before repair).
     pub source: Option<SourceInfo>,
+    /// Which model axis points up; `None`: [`curation::detect_up`].
+    pub up: Option<UpAxis>,
+    /// The unit of model coordinates (`mm`, `cm`, `m`, `in`), if known.
+    pub unit: Option<String>,
 }
 
 impl ModelMeta {
@@ -46,6 +53,8 @@ impl ModelMeta {
             good_enough_level: None,
             on_existing: OnExisting::Refuse,
             source: None,
+            up: None,
+            unit: None,
         }
     }
 }
@@ -81,6 +90,43 @@ pub struct IngestOptions {
     pub quality: Option<QualityOptions>,
     /// Test hook: wait this long inside the open transaction before committing.
     pub pause_before_commit: Option<Duration>,
+    /// Leave out the sampled Hausdorff distance of every level that ingest
+    /// measures by default (its time grows with levels × vertices: seconds
+    /// at 20k vertices on a small machine); bounds and thumbnail stay.
+    pub skip_hausdorff: bool,
+    /// Told each stage as the ingest reaches it (an upload job's progress).
+    pub progress: Option<ProgressHook>,
+}
+
+/// Called with a stage label and the fraction done (0–1).
+#[derive(Clone)]
+pub struct ProgressHook(pub Arc<dyn Fn(&'static str, f64) + Send + Sync>);
+
+impl std::fmt::Debug for ProgressHook {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("ProgressHook")
+    }
+}
+
+impl IngestOptions {
+    fn report(&self, stage: &'static str, done: f64) {
+        if let Some(hook) = &self.progress {
+            (hook.0)(stage, done);
+        }
+    }
+}
+
+/// What [`curation`] measured and rendered, stored with the version.
+#[derive(Clone, Debug)]
+pub struct Curated {
+    pub up: UpAxis,
+    pub bounds: Bounds,
+    /// Every level's sampled Hausdorff distance over the diagonal, when
+    /// there was an original to measure against.
+    pub hausdorff: Option<Vec<f64>>,
+    pub thumbnail: Option<NewThumbnail>,
+    /// How long measuring and rendering took.
+    pub time: Duration,
 }
 
 #[derive(Clone, Debug)]
@@ -98,6 +144,8 @@ pub struct IngestReport {
     pub quality: Option<MeasuredQuality>,
     /// What the feature guard kept, when it ran.
     pub features: Option<FeatureSummary>,
+    /// How long the default Hausdorff distances and the thumbnail took.
+    pub curation_time: Option<Duration>,
 }
 
 /// Every level's quality against the original, and how it was measured.
@@ -133,7 +181,11 @@ pub async fn ingest_coloured(
     options: &IngestOptions,
 ) -> anyhow::Result<IngestReport> {
     check_slug(&meta.slug)?;
+    check_unit(meta.unit.as_deref())?;
     let source = source_info(&meta, &mesh);
+    let up = meta
+        .up
+        .unwrap_or_else(|| curation::detect_up(Some(Path::new(&source.name)), &mesh));
     let mode = options
         .colour
         .unwrap_or_else(|| default_colour_mode(&mesh, texture.as_ref()));
@@ -141,7 +193,7 @@ pub async fn ingest_coloured(
     options.colour = Some(mode);
     let task_options = options.clone();
     let encoding =
-        tokio::task::spawn_blocking(move || encode_and_measure(mesh, texture, &task_options))
+        tokio::task::spawn_blocking(move || encode_and_measure(mesh, texture, up, &task_options))
             .await
             .context("encoder task failed")??;
     let product = Product {
@@ -150,7 +202,9 @@ pub async fn ingest_coloured(
         mapping: encoding.mapping.as_ref(),
         quality: encoding.quality,
         features: encoding.features,
+        curated: Some(encoding.curated),
     };
+    options.report("storing", 0.9);
     store(storage, product, meta, source, &options).await
 }
 
@@ -162,6 +216,7 @@ struct Encoding {
     encode_time: Duration,
     quality: Option<MeasuredQuality>,
     features: Option<FeatureSummary>,
+    curated: Curated,
 }
 
 /// Encodes in `options.colour` (already resolved) under the guards asked
@@ -169,9 +224,11 @@ struct Encoding {
 fn encode_and_measure(
     mesh: IndexedMesh,
     texture: Option<TexturedSurface>,
+    up: UpAxis,
     options: &IngestOptions,
 ) -> anyhow::Result<Encoding> {
     let started = Instant::now();
+    options.report("encoding", 0.2);
     let mode = options.colour.unwrap_or(ColourMode::None);
     let guards = Guards::new(&mesh, &options.guards, options.encode.quantization_bits)
         .context("building the decimation guards")?;
@@ -187,11 +244,37 @@ fn encode_and_measure(
     let (encoded, mapping) = encode_coloured(&mesh, texture.as_ref(), mode, &options.ccc, encoder)
         .context("encoding failed")?;
     let encode_time = started.elapsed();
+    options.report("measuring", 0.6);
+    let curating = Instant::now();
+    let complex = mapping
+        .as_ref()
+        .map(read_back)
+        .transpose()
+        .context("reading back the cell complex")?;
+    let (bounds, hausdorff, full) = if options.skip_hausdorff {
+        let full = vitrine_codec::decode(&encoded.bytes, None, Limits::default())
+            .context("reading the stream back")?
+            .to_mesh();
+        (curation::bounds_of(&full), None, full)
+    } else {
+        let (bounds, distances, full) =
+            curation::measure_levels(&encoded.bytes, &mesh, curation::DEFAULT_HAUSDORFF_SAMPLES)?;
+        (bounds, Some(distances), full)
+    };
+    options.report("rendering the thumbnail", 0.8);
+    let thumbnail = curation::render_thumbnail(&full, complex.as_ref(), up)?;
+    let curated = Curated {
+        up,
+        bounds,
+        hausdorff,
+        thumbnail: Some(thumbnail),
+        time: curating.elapsed(),
+    };
     // Before the transaction: measuring takes seconds, and a write
     // transaction should not stay open (SQLite holds its one writer lock).
     let quality = options
         .quality
-        .map(|q| measure_quality(&encoded.bytes, mapping.as_ref(), mesh, texture, &q))
+        .map(|q| measure_quality(&encoded.bytes, complex, mesh, texture, &q))
         .transpose()
         .context("measuring quality")?;
     Ok(Encoding {
@@ -200,6 +283,7 @@ fn encode_and_measure(
         encode_time,
         quality,
         features,
+        curated,
     })
 }
 
@@ -210,16 +294,12 @@ fn encode_and_measure(
 /// reads them.
 fn measure_quality(
     stream: &[u8],
-    mapping: Option<&TextureMapping>,
+    complex: Option<vitrine_colour::ccc::CellComplex>,
     mesh: IndexedMesh,
     texture: Option<TexturedSurface>,
     options: &QualityOptions,
 ) -> anyhow::Result<MeasuredQuality> {
     let started = Instant::now();
-    let complex = mapping
-        .map(read_back)
-        .transpose()
-        .context("reading back the cell complex")?;
     let reference = QualityReference::new(mesh, texture);
     let levels = reference.measure(stream, complex.as_ref(), options)?;
     Ok(MeasuredQuality {
@@ -243,6 +323,7 @@ pub async fn ingest_encoded(
     options: &IngestOptions,
 ) -> anyhow::Result<IngestReport> {
     check_slug(&meta.slug)?;
+    check_unit(meta.unit.as_deref())?;
     let final_level = encoded.header.final_level();
     let source = meta.source.clone().unwrap_or(SourceInfo {
         name: String::new(),
@@ -256,8 +337,18 @@ pub async fn ingest_encoded(
         mapping,
         quality: None,
         features: None,
+        curated: None,
     };
     store(storage, product, meta, source, options).await
+}
+
+fn check_unit(unit: Option<&str>) -> anyhow::Result<()> {
+    match unit {
+        Some(u) if !curation::UNITS.contains(&u) => {
+            bail!("unit {u:?} must be one of mm, cm, m, in")
+        }
+        _ => Ok(()),
+    }
 }
 
 fn check_slug(slug: &str) -> anyhow::Result<()> {

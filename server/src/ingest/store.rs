@@ -3,8 +3,8 @@
 
 use super::mapping::new_mapping;
 use super::{
-    threshold_name, FeatureSummary, IngestOptions, IngestReport, MeasuredQuality, ModelMeta,
-    SourceInfo,
+    threshold_name, Curated, FeatureSummary, IngestOptions, IngestReport, MeasuredQuality,
+    ModelMeta, SourceInfo,
 };
 use crate::storage::{LevelMetrics, NewCompression, NewLevel, NewModel, Storage, StoredModel};
 use anyhow::{bail, Context};
@@ -24,6 +24,8 @@ pub(super) struct Product<'a> {
     pub mapping: Option<&'a TextureMapping>,
     pub quality: Option<MeasuredQuality>,
     pub features: Option<FeatureSummary>,
+    /// Up axis, bounds, sampled Hausdorff distances and thumbnail.
+    pub curated: Option<Curated>,
 }
 
 pub(super) async fn store(
@@ -42,6 +44,7 @@ pub(super) async fn store(
         .context("encoder produced an unreadable stream")?;
     check_levels(&index, &meta, product.quality.as_ref())?;
     let (mapping, ccc) = mapping.unzip();
+    let curated = product.curated.as_ref();
     let new = NewModel {
         slug: meta.slug.clone(),
         title: meta.title.clone(),
@@ -54,6 +57,10 @@ pub(super) async fn store(
         source_faces: source.faces,
         compression: compression(&product, &index, ccc.as_ref(), &source, options),
         mapping,
+        up_axis: curated.map(|c| c.up),
+        unit: meta.unit.clone(),
+        bounds: curated.map(|c| c.bounds),
+        thumbnail: curated.and_then(|c| c.thumbnail.clone()),
     };
     let stored = stage_and_commit(storage, &new, options.pause_before_commit).await?;
     let levels = &index.header.levels;
@@ -67,6 +74,7 @@ pub(super) async fn store(
         ccc,
         quality: product.quality,
         features: product.features,
+        curation_time: curated.map(|c| c.time),
     })
 }
 
@@ -143,6 +151,11 @@ fn new_level(
             image_rmse: q.levels[k].image_rmse,
             roy_rmse: q.levels[k].roy_rmse,
         }),
+        hausdorff: product
+            .curated
+            .as_ref()
+            .and_then(|c| c.hausdorff.as_ref())
+            .and_then(|h| h.get(k).copied()),
     }
 }
 

@@ -29,6 +29,8 @@ struct ListedModel {
     levels: u32,
     manifest_url: String,
     page_url: String,
+    /// `/api/models/{slug}/thumbnail?v={version}`; null when the version has none.
+    thumbnail: Option<String>,
 }
 
 /// Models this visitor may see, from the cached list.
@@ -73,6 +75,9 @@ pub async fn list(
         .await?
         .into_iter()
         .map(|m| ListedModel {
+            thumbnail: m
+                .has_thumbnail
+                .then(|| super::curator::thumbnail::url(&m.slug, m.version)),
             manifest_url: format!("/api/models/{}", m.slug),
             page_url: format!("/m/{}", m.slug),
             slug: m.slug,

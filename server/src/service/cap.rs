@@ -228,6 +228,7 @@ mod tests {
                 .collect(),
             mapping: None,
             textures: vec![],
+            curation: Default::default(),
         }
     }
 

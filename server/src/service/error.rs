@@ -20,6 +20,9 @@ pub enum AppError {
     BadRequest(String),
     #[error("invalid or expired token")]
     InvalidToken,
+    /// The route needs a token (`Authorization: Bearer …`) and none was sent.
+    #[error("this route needs a curator token (Authorization: Bearer …)")]
+    TokenRequired,
     #[error("{0} not found")]
     NotFound(&'static str),
     /// The batch is above this visitor's level cap.
@@ -87,7 +90,7 @@ impl AppError {
     pub fn status(&self) -> StatusCode {
         match self {
             AppError::BadRequest(_) => StatusCode::BAD_REQUEST,
-            AppError::InvalidToken => StatusCode::UNAUTHORIZED,
+            AppError::InvalidToken | AppError::TokenRequired => StatusCode::UNAUTHORIZED,
             AppError::NotFound(_) => StatusCode::NOT_FOUND,
             AppError::LevelCapped { cap, .. } if cap.reason == Some(CapReason::Load) => {
                 StatusCode::TOO_MANY_REQUESTS
@@ -112,6 +115,7 @@ impl AppError {
         match self {
             AppError::BadRequest(_) => ErrorCode::BadRequest,
             AppError::InvalidToken => ErrorCode::InvalidToken,
+            AppError::TokenRequired => ErrorCode::TokenRequired,
             AppError::NotFound(_) => ErrorCode::NotFound,
             AppError::LevelCapped { .. } => ErrorCode::LevelCapped,
             AppError::Storage(e) if e.is_unavailable() => ErrorCode::DatabaseUnavailable,
@@ -176,6 +180,7 @@ impl AppError {
 pub enum ErrorCode {
     BadRequest,
     InvalidToken,
+    TokenRequired,
     NotFound,
     LevelCapped,
     DatabaseUnavailable,
@@ -236,7 +241,7 @@ impl IntoResponse for AppError {
                 HeaderValue::from(after.as_secs().max(1)),
             );
         }
-        if matches!(self, AppError::InvalidToken) {
+        if matches!(self, AppError::InvalidToken | AppError::TokenRequired) {
             headers.insert(header::WWW_AUTHENTICATE, HeaderValue::from_static("Bearer"));
         }
         response

@@ -23,6 +23,12 @@ use utoipa::openapi::header::HeaderBuilder;
 use utoipa::openapi::schema::{Object, Ref, Type};
 use utoipa::openapi::{Content, OpenApi, ResponseBuilder};
 
+/// How long an upload may take to arrive (the ingest runs after the answer).
+const UPLOAD_TIMEOUT: std::time::Duration = std::time::Duration::from_secs(30 * 60);
+
+/// Room for an upload's multipart boundaries and text fields.
+const UPLOAD_FRAMING_BYTES: u64 = 256 * 1024;
+
 /// Routes that serve data and so count as load; operations routes do not.
 fn is_data_route(route: &str) -> bool {
     !matches!(
@@ -36,6 +42,9 @@ pub async fn admit(State(state): State<AppState>, request: Request, next: Next) 
     let label = Route::of(&request);
     let route = label.as_str();
     let limits = &state.config().limits;
+    let upload = route == "/api/models" && request.method() == Method::POST;
+    // The multipart framing around the file is allowed beside the limit.
+    let upload_limit = state.config().uploads.limit_bytes + UPLOAD_FRAMING_BYTES;
     // A new visit during a surge: refused before anything else is spent on it.
     let admit = if route == "/api/models/{slug}" && request.method() == Method::GET {
         state.admission().admit()
@@ -50,12 +59,22 @@ pub async fn admit(State(state): State<AppState>, request: Request, next: Next) 
                 retry_after: limits.shed_retry_after,
             }
             .into_response(),
-            Ok(_permit) if body_too_large(&request, limits.max_body_bytes) => {
+            Ok(_permit) if !upload && body_too_large(&request, limits.max_body_bytes) => {
+                AppError::PayloadTooLarge.into_response()
+            }
+            // An upload is counted as it streams (413 past the limit); a
+            // declared length already over it is refused at once.
+            Ok(_permit) if upload && declared_over(&request, upload_limit) => {
                 AppError::PayloadTooLarge.into_response()
             }
             Ok(_permit) => {
                 let inflight = is_data_route(route).then(|| state.load().begin());
-                match tokio::time::timeout(limits.timeout, next.run(request)).await {
+                let timeout = if upload {
+                    UPLOAD_TIMEOUT
+                } else {
+                    limits.timeout
+                };
+                match tokio::time::timeout(timeout, next.run(request)).await {
                     // The request stays in flight for the load monitor until its
                     // body has gone out: with a crowd, sending is the load, and a
                     // count that ended when the handler returned never saw it.
@@ -117,9 +136,15 @@ pub fn describe_refusals(description: &mut OpenApi) {
         ),
     ];
     for item in description.paths.paths.values_mut() {
-        for operation in [&mut item.get, &mut item.head, &mut item.post, &mut item.put]
-            .into_iter()
-            .flatten()
+        for operation in [
+            &mut item.get,
+            &mut item.head,
+            &mut item.post,
+            &mut item.put,
+            &mut item.delete,
+        ]
+        .into_iter()
+        .flatten()
         {
             for (status, text, retry_after) in refusals {
                 let mut response = ResponseBuilder::new().description(text).content(
@@ -141,6 +166,15 @@ pub fn describe_refusals(description: &mut OpenApi) {
             }
         }
     }
+}
+
+/// A `Content-Length` over `max`.
+fn declared_over(request: &Request, max: u64) -> bool {
+    request
+        .headers()
+        .get(header::CONTENT_LENGTH)
+        .and_then(|v| v.to_str().ok())
+        .is_some_and(|v| v.parse::<u64>().map_or(true, |n| n > max))
 }
 
 /// No route takes a body: anything declared larger than the limit, or

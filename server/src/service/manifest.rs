@@ -33,6 +33,24 @@ pub struct Manifest<'a> {
     textures: Vec<Texture<'a>>,
     visitor: ManifestVisitor,
     cap: ManifestCap,
+    /// Which model axis points up (`x`, `y`, `z`, `-x`, `-y`, `-z`); `y`
+    /// for versions ingested before it was recorded.
+    #[schema(value_type = String, pattern = "^-?[xyz]$")]
+    up: &'static str,
+    /// The unit of model coordinates (`mm`, `cm`, `m`, `in`), or null.
+    unit: Option<&'a str>,
+    /// Bounds of the decoded positions (model coordinates: those of the
+    /// stream, which annotations and measurements use); null for versions
+    /// ingested before they were recorded.
+    bounds: Option<ManifestBounds>,
+    /// `/api/models/{slug}/thumbnail?v={version}`, or null.
+    thumbnail: Option<String>,
+}
+
+#[derive(Serialize, ToSchema)]
+struct ManifestBounds {
+    min: [f64; 3],
+    max: [f64; 3],
 }
 
 #[derive(Serialize, ToSchema)]
@@ -42,7 +60,8 @@ struct ManifestLevel {
     faces: u32,
     bytes: u64,
     /// Symmetric Hausdorff distance to the original over its bounding-box
-    /// diagonal, when measured at ingest; also in `quality`.
+    /// diagonal, measured at ingest (sampled by default, with `--quality`
+    /// as in `quality`); null for versions ingested before it was.
     hausdorff: Option<f64>,
     /// Lindstrom–Turk image RMSE (luma, 0–255, 24 views) against the
     /// original, when measured at ingest; also in `quality`.
@@ -211,6 +230,17 @@ pub fn build<'a>(
             load_pressure: pressure.level,
             load_steps: pressure.steps,
         },
+        up: record.curation.up_axis.map_or("y", |a| a.name()),
+        unit: record.curation.unit.as_deref(),
+        bounds: record.curation.bounds.map(|b| ManifestBounds {
+            min: b.min,
+            max: b.max,
+        }),
+        thumbnail: record
+            .curation
+            .thumbnail_sha256
+            .is_some()
+            .then(|| super::curator::thumbnail::url(&record.slug, record.version)),
     }
 }
 

@@ -9,6 +9,7 @@ pub mod admission;
 mod api;
 mod cache;
 pub mod cap;
+pub mod curator;
 mod download;
 mod error;
 mod guard;
@@ -30,7 +31,7 @@ pub use layers::RequestLimits;
 pub use routes::{openapi, openapi_json};
 pub use visitor::VisitorHints;
 
-use crate::storage::{sha256_hex, ModelRecord, Storage, TokenGrant};
+use crate::storage::{sha256_hex, ModelRecord, Storage, TokenGrant, TokenScope};
 use admission::{Admission, AdmissionConfig};
 use axum::Router;
 use cache::{through, Caches};
@@ -55,6 +56,8 @@ pub struct ServiceConfig {
     pub web_dir: PathBuf,
     /// Origins allowed by CORS; empty means any.
     pub cors_origins: Vec<String>,
+    /// Uploads, their ingest jobs, and the public base URL of `og:image`.
+    pub uploads: curator::UploadConfig,
 }
 
 impl Default for ServiceConfig {
@@ -67,6 +70,7 @@ impl Default for ServiceConfig {
             limits: RequestLimits::default(),
             web_dir: PathBuf::from("web/dist"),
             cors_origins: Vec::new(),
+            uploads: curator::UploadConfig::default(),
         }
     }
 }
@@ -97,6 +101,8 @@ struct Inner {
     permits: Arc<Semaphore>,
     /// GLB downloads decoded at once.
     downloads: Arc<Semaphore>,
+    /// Upload ingests ([`curator::jobs`]).
+    jobs: curator::jobs::JobRunner,
 }
 
 impl AppState {
@@ -110,6 +116,10 @@ impl AppState {
             metrics: Metrics::default(),
             permits: Arc::new(Semaphore::new(config.limits.max_concurrency)),
             downloads: Arc::new(Semaphore::new(download::MAX_CONCURRENT_DOWNLOADS)),
+            jobs: curator::jobs::JobRunner::new(
+                config.uploads.concurrent_jobs,
+                config.uploads.max_queued,
+            ),
             config,
         }))
     }
@@ -149,6 +159,10 @@ impl AppState {
 
     pub(crate) fn downloads(&self) -> &Arc<Semaphore> {
         &self.0.downloads
+    }
+
+    pub(crate) fn jobs(&self) -> &curator::jobs::JobRunner {
+        &self.0.jobs
     }
 
     /// Forgets cached records, tokens and the model list, so that a new
@@ -223,7 +237,11 @@ impl AppState {
                 Some(grant.ok_or(AppError::InvalidToken)?)
             }
         };
-        let researcher = grant.as_ref().is_some_and(|g| g.covers(slug));
+        // Scopes are separate: a curator token publishes and annotates but
+        // sees what the public sees.
+        let researcher = grant
+            .as_ref()
+            .is_some_and(|g| g.scope == TokenScope::Researcher && g.covers(slug));
         Ok(Visitor {
             audience: if researcher {
                 Audience::Researcher

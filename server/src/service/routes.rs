@@ -2,6 +2,7 @@
 //! description served at `/api/openapi.json` is generated from it (each
 //! handler's `#[utoipa::path]` and its types' `ToSchema`).
 
+use super::curator::{admin, annotations, jobs, thumbnail, upload};
 use super::error::AppError;
 use super::web::{self, Viewer};
 use super::{api, download, guard, ops, payload, study, AppState, ServiceConfig};
@@ -30,7 +31,7 @@ use utoipa_axum::routes;
             the model's good-enough level as server load rises, rises again when it falls). A \
             batch above the cap is refused with 403 (reason `audience` or `device`) or 429 with \
             `Retry-After` (reason `load`).\n\nEvery route may also answer 413 \
-            (`payload_too_large`: a body over 64 KiB; only the study's routes take one), 431 (request headers over the limit), \
+            (`payload_too_large`: a body over 64 KiB, or an upload over `--upload-limit-mb`), 431 (request headers over the limit), \
             500 (`internal`), 503 (`overloaded`: the concurrency limit is full; `Retry-After`) \
             and 504 (`timeout`). Any other path under `/api/` answers 404 (`not_found`)."
     ),
@@ -45,7 +46,11 @@ impl Modify for BearerToken {
     fn modify(&self, openapi: &mut Description) {
         let scheme = HttpBuilder::new()
             .scheme(HttpAuthScheme::Bearer)
-            .description(Some("Researcher token (`vitrine token`)"))
+            .description(Some(
+                "Access token (`vitrine token create --scope researcher|curator`): a researcher \
+                 token opens researcher-only levels; a curator token uploads, annotates and \
+                 changes versions. Only ever sent in this header: no cookies, so no CSRF.",
+            ))
             .build();
         openapi
             .components
@@ -72,8 +77,15 @@ pub fn ops_only() -> axum::Router<AppState> {
 
 fn list(viewer: Option<&Viewer>) -> OpenApiRouter<AppState> {
     OpenApiRouter::with_openapi(Api::openapi())
-        .routes(routes!(api::list))
+        .routes(routes!(api::list, upload::upload))
         .routes(routes!(api::manifest))
+        .routes(routes!(thumbnail::thumbnail))
+        .routes(routes!(annotations::list, annotations::create))
+        .routes(routes!(annotations::update, annotations::delete))
+        .routes(routes!(jobs::list))
+        .routes(routes!(jobs::job))
+        .routes(routes!(admin::versions))
+        .routes(routes!(admin::change))
         .routes(routes!(payload::base))
         .routes(routes!(payload::batch))
         .routes(routes!(payload::texture))
@@ -95,16 +107,19 @@ fn list(viewer: Option<&Viewer>) -> OpenApiRouter<AppState> {
             routes!(web::gallery),
             viewer.map(Viewer::files),
         ))
-        .routes(web::or_viewer(
-            routes!(web::model_page),
-            viewer.map(Viewer::index),
-        ))
+        // The model page is always this handler: it adds the Open Graph
+        // tags to the viewer's index.html.
+        .routes(routes!(web::model_page))
         .routes(web::or_viewer(
             routes!(web::embed_page),
             viewer.map(Viewer::index),
         ))
         .routes(web::or_viewer(
             routes!(web::study_page),
+            viewer.map(Viewer::index),
+        ))
+        .routes(web::or_viewer(
+            routes!(web::admin_page),
             viewer.map(Viewer::index),
         ))
 }

@@ -4,14 +4,15 @@
 //! gallery so a fresh install shows something.
 
 use super::api::visible_models;
+use super::curator::thumbnail;
 use super::error::{AppError, ErrorBody};
 use super::servable::{PathParams, ServableModel, SlugParam};
 use super::study::StudySlug;
 use super::visitor::{HintQuery, VisitorHints};
 use super::AppState;
-use crate::storage::valid_slug;
+use crate::storage::{valid_slug, ModelRecord};
 use axum::extract::{Request, State};
-use axum::http::{header, HeaderValue};
+use axum::http::{header, HeaderMap, HeaderValue};
 use axum::response::{Html, IntoResponse, Response};
 use axum::routing::get_service;
 use std::convert::Infallible;
@@ -96,7 +97,8 @@ pub async fn gallery(
     ))
 }
 
-/// Model page (the viewer's index.html).
+/// Model page (the viewer's index.html), with Open Graph tags (`og:title`,
+/// `og:description`, `og:image`: the thumbnail) so shared links preview.
 #[utoipa::path(
     get,
     path = "/m/{slug}",
@@ -111,8 +113,115 @@ pub async fn gallery(
         (status = 503, description = "Database unavailable or server overloaded", body = ErrorBody),
     )
 )]
-pub async fn model_page(model: ServableModel) -> Response {
-    built_in_page(model)
+pub async fn model_page(
+    State(state): State<AppState>,
+    headers: HeaderMap,
+    model: Result<ServableModel, AppError>,
+) -> Result<Response, AppError> {
+    let index = state.config().web_dir.join("index.html");
+    let viewer = match tokio::fs::read_to_string(&index).await {
+        Ok(html) => Some(html),
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => None,
+        Err(e) => {
+            return Err(AppError::Internal(format!(
+                "reading {}: {e}",
+                index.display()
+            )))
+        }
+    };
+    match (viewer, model) {
+        (Some(html), Ok(model)) => {
+            let tags = open_graph(&state, &headers, &model.record);
+            let html = match html.find("</head>") {
+                Some(at) => format!("{}{tags}{}", &html[..at], &html[at..]),
+                None => format!("{tags}{html}"),
+            };
+            Ok(html_response(html))
+        }
+        // The viewer shows its own message for a model it cannot open.
+        (Some(html), Err(_)) => Ok(html_response(html)),
+        (None, Ok(model)) => {
+            let tags = open_graph(&state, &headers, &model.record);
+            Ok(built_in_page(model, &tags))
+        }
+        (None, Err(e)) => Err(e),
+    }
+}
+
+/// The absolute base of links in the page: `--public-base-url`, else the
+/// request's `Host` (with `X-Forwarded-Proto`'s scheme behind a proxy).
+fn public_base(state: &AppState, headers: &HeaderMap) -> String {
+    if let Some(base) = &state.config().uploads.public_base_url {
+        return base.trim_end_matches('/').to_owned();
+    }
+    let host = headers
+        .get(header::HOST)
+        .and_then(|h| h.to_str().ok())
+        .filter(|h| {
+            h.bytes()
+                .all(|b| b.is_ascii_alphanumeric() || b".-:[]".contains(&b))
+        })
+        .unwrap_or("localhost");
+    let scheme = match headers
+        .get("x-forwarded-proto")
+        .and_then(|h| h.to_str().ok())
+    {
+        Some("https") => "https",
+        _ => "http",
+    };
+    format!("{scheme}://{host}")
+}
+
+/// `og:` meta tags of a model.
+fn open_graph(state: &AppState, headers: &HeaderMap, record: &ModelRecord) -> String {
+    let base = public_base(state, headers);
+    let mut tags = format!(
+        "<meta property=\"og:type\" content=\"website\">\n\
+         <meta property=\"og:title\" content=\"{}\">\n\
+         <meta property=\"og:description\" content=\"{}\">\n\
+         <meta property=\"og:url\" content=\"{}\">\n",
+        escape(&record.title),
+        escape(&record.description),
+        escape(&format!("{base}/m/{}", record.slug)),
+    );
+    if record.curation.thumbnail_sha256.is_some() {
+        tags.push_str(&format!(
+            "<meta property=\"og:image\" content=\"{}\">\n\
+             <meta property=\"og:image:type\" content=\"image/png\">\n",
+            escape(&format!(
+                "{base}{}",
+                thumbnail::url(&record.slug, record.version)
+            ))
+        ));
+    }
+    tags
+}
+
+fn html_response(html: String) -> Response {
+    let mut response = Html(html).into_response();
+    let headers = response.headers_mut();
+    headers.insert(
+        header::HeaderName::from_static("accept-ch"),
+        HeaderValue::from_static("Sec-CH-UA-Mobile"),
+    );
+    headers.insert(header::CACHE_CONTROL, HeaderValue::from_static("no-cache"));
+    response
+}
+
+/// The curators' page (the viewer's index.html, which opens `web/src/admin/`
+/// at this path). Without the viewer's build, a page that says so.
+#[utoipa::path(
+    get,
+    path = "/admin",
+    responses((status = 200, description = "HTML", body = String, content_type = "text/html"))
+)]
+pub async fn admin_page() -> Response {
+    page(
+        "Vitrine admin",
+        "<h1>Vitrine admin</h1>\n<p>The admin page needs the viewer's build, which is not \
+         installed on this server; the API it uses is described at \
+         <a href=\"/api/openapi.json\">/api/openapi.json</a>.</p>",
+    )
 }
 
 /// Embeddable model view (the viewer's index.html).
@@ -131,7 +240,7 @@ pub async fn model_page(model: ServableModel) -> Response {
     )
 )]
 pub async fn embed_page(model: ServableModel) -> Response {
-    built_in_page(model)
+    built_in_page(model, "")
 }
 
 /// Quality study page (the viewer's index.html; the invitation is in its
@@ -160,7 +269,7 @@ pub async fn study_page(
     ))
 }
 
-fn built_in_page(ServableModel { record, .. }: ServableModel) -> Response {
+fn built_in_page(ServableModel { record, .. }: ServableModel, head: &str) -> Response {
     let body = format!(
         "<h1>{title}</h1>\n<p>{description}</p>\n<p>The viewer is not installed on this server; \
          the <a href=\"/api/models/{slug}\">manifest</a> lists the levels it would load.</p>",
@@ -168,14 +277,18 @@ fn built_in_page(ServableModel { record, .. }: ServableModel) -> Response {
         description = escape(&record.description),
         slug = escape(&record.slug),
     );
-    page(&record.title, &body)
+    page_with_head(&record.title, head, &body)
 }
 
 fn page(title: &str, body: &str) -> Response {
+    page_with_head(title, "", body)
+}
+
+fn page_with_head(title: &str, head: &str, body: &str) -> Response {
     let html = format!(
         "<!doctype html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">\
          <meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">\
-         <title>{}</title></head>\n<body>\n{body}\n</body></html>\n",
+         <title>{}</title>\n{head}</head>\n<body>\n{body}\n</body></html>\n",
         escape(title)
     );
     let mut response = Html(html).into_response();

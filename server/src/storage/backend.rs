@@ -53,6 +53,22 @@ macro_rules! sql_storage {
                     levels: Vec::new(),
                     mapping: None,
                     textures: Vec::new(),
+                    curation: Curation {
+                        up_axis: match row.try_get::<Option<String>, _>("up_axis").map_err(get)? {
+                            Some(name) => Some(UpAxis::parse(&name).ok_or_else(|| {
+                                StorageError::Corrupt(format!("model.up_axis = {name:?}"))
+                            })?),
+                            None => None,
+                        },
+                        unit: row.try_get("unit").map_err(get)?,
+                        bounds: match row.try_get::<Option<String>, _>("bounds").map_err(get)? {
+                            Some(json) => Some(Bounds::from_json(&json).ok_or_else(|| {
+                                StorageError::Corrupt(format!("model.bounds = {json:?}"))
+                            })?),
+                            None => None,
+                        },
+                        thumbnail_sha256: row.try_get("thumbnail_sha256").map_err(get)?,
+                    },
                 })
             }
 
@@ -186,6 +202,7 @@ macro_rules! sql_storage {
                                 row.try_get("codec_version").map_err(c)?,
                                 "codec_version",
                             )?,
+                            has_thumbnail: row.try_get("has_thumbnail").map_err(c)?,
                         })
                     })
                     .collect()
@@ -266,6 +283,12 @@ macro_rules! sql_storage {
                         id: row.try_get("id").map_err(c)?,
                         label: row.try_get("label").map_err(c)?,
                         model_slug: row.try_get("model_slug").map_err(c)?,
+                        scope: {
+                            let name: String = row.try_get("scope").map_err(c)?;
+                            TokenScope::parse(&name).ok_or_else(|| {
+                                StorageError::Corrupt(format!("access_token.scope = {name:?}"))
+                            })?
+                        },
                     })
                 })
                 .transpose()
@@ -278,6 +301,7 @@ macro_rules! sql_storage {
                     .bind(token.model_slug.clone())
                     .bind(token.expires_at_ms)
                     .bind($crate::storage::now_ms())
+                    .bind(token.scope.name())
                     .fetch_one(&self.pool)
                     .await
                     .map_err(Self::classify)

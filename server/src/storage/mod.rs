@@ -7,6 +7,7 @@
 //! they connect, migrate and classify errors.
 
 mod backend;
+mod curator;
 mod postgres;
 mod sql;
 mod sqlite;
@@ -14,6 +15,7 @@ mod stage;
 mod study;
 mod types;
 
+pub use curator::CuratorStorage;
 pub use postgres::PostgresStorage;
 pub use sqlite::SqliteStorage;
 pub use study::{
@@ -79,7 +81,7 @@ pub(crate) fn is_connection_error(e: &sqlx::Error) -> bool {
 
 /// The one interface the service and the ingest command use.
 #[async_trait]
-pub trait Storage: StudyStorage + Send + Sync + 'static {
+pub trait Storage: StudyStorage + CuratorStorage + Send + Sync + 'static {
     /// Which backend, for logs and metrics: `"sqlite"` or `"postgres"`.
     fn backend(&self) -> &'static str;
 

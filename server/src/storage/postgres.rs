@@ -1,11 +1,12 @@
 //! The shared backend: PostgreSQL, for several servers on one database.
 
 use super::backend::sql_storage;
+use super::curator::curator_storage;
 use super::study::study_storage;
 use super::{
-    is_connection_error, AudiencePolicy, ConnectOptions, LevelRecord, MappingRecord, ModelRecord,
-    ModelSummary, NewModel, NewToken, StagedModel, Storage, StorageError, TexturePayload,
-    TextureRef, TokenGrant,
+    is_connection_error, AudiencePolicy, Bounds, ConnectOptions, Curation, LevelRecord,
+    MappingRecord, ModelRecord, ModelSummary, NewModel, NewToken, StagedModel, Storage,
+    StorageError, TexturePayload, TextureRef, TokenGrant, TokenScope, UpAxis,
 };
 use sqlx::postgres::{PgConnectOptions, PgPoolOptions};
 use sqlx::{PgPool, Postgres, Transaction};
@@ -67,3 +68,4 @@ impl PostgresStorage {
 
 sql_storage!(PostgresStorage, Postgres, "postgres", MIGRATOR);
 study_storage!(PostgresStorage, Postgres);
+curator_storage!(PostgresStorage, Postgres);

@@ -12,10 +12,12 @@ macro_rules! record_select {
          m.good_enough_level, m.created_at, p.name AS policy_name, p.public_access, \
          p.public_max_vertex_fraction, p.public_full_resolution, p.token_full_resolution, p.downloads, \
          c.id AS compression_id, c.codec_version, c.quantization_bits, c.has_colour, c.mapping_id, \
-         tm.parameters AS mapping_parameters \
+         tm.parameters AS mapping_parameters, m.up_axis, m.unit, m.bounds, \
+         th.sha256 AS thumbnail_sha256 \
          FROM model m JOIN audience_policy p ON p.id = m.policy_id \
          JOIN compression c ON c.model_id = m.id \
-         LEFT JOIN texture_mapping tm ON tm.id = c.mapping_id "
+         LEFT JOIN texture_mapping tm ON tm.id = c.mapping_id \
+         LEFT JOIN thumbnail th ON th.model_id = m.id "
     };
 }
 
@@ -37,8 +39,10 @@ pub(super) const TEXTURES: &str = "SELECT t.id, t.kind, t.media_type, t.byte_len
      FROM texture_mapping tm \
      JOIN texture t ON t.id IN (tm.cell_texture_id, tm.colour_texture_id, tm.colour_low_texture_id) \
      WHERE tm.id = $1 ORDER BY t.id";
-pub(super) const LIST: &str = "SELECT m.slug, m.title, m.version, m.created_at, p.public_access, c.batch_count, c.codec_version \
+pub(super) const LIST: &str = "SELECT m.slug, m.title, m.version, m.created_at, p.public_access, c.batch_count, c.codec_version, \
+     (th.model_id IS NOT NULL) AS has_thumbnail \
      FROM model m JOIN audience_policy p ON p.id = m.policy_id JOIN compression c ON c.model_id = m.id \
+     LEFT JOIN thumbnail th ON th.model_id = m.id \
      WHERE m.status = 'ready' \
      AND m.version = (SELECT MAX(m2.version) FROM model m2 WHERE m2.slug = m.slug AND m2.status = 'ready') \
      AND c.id = (SELECT MAX(c2.id) FROM compression c2 WHERE c2.model_id = m.id) \
@@ -51,17 +55,21 @@ pub(super) const TEXTURE: &str = "SELECT t.media_type, t.sha256, t.bytes, m.slug
      JOIN texture_mapping tm ON t.id IN (tm.cell_texture_id, tm.colour_texture_id, tm.colour_low_texture_id) \
      JOIN model m ON m.id = tm.model_id JOIN audience_policy p ON p.id = m.policy_id \
      WHERE t.id = $1 AND m.status = 'ready' ORDER BY p.public_access DESC LIMIT 1";
-pub(super) const TOKEN: &str = "SELECT id, label, model_slug FROM access_token \
+pub(super) const TOKEN: &str = "SELECT id, label, model_slug, scope FROM access_token \
      WHERE token_sha256 = $1 AND revoked_at IS NULL AND (expires_at IS NULL OR expires_at > $2)";
 pub(super) const INSERT_TOKEN: &str =
-    "INSERT INTO access_token (token_sha256, label, model_slug, expires_at, created_at) \
-     VALUES ($1, $2, $3, $4, $5) RETURNING id";
+    "INSERT INTO access_token (token_sha256, label, model_slug, expires_at, created_at, scope) \
+     VALUES ($1, $2, $3, $4, $5, $6) RETURNING id";
 pub(super) const POLICY_ID: &str = "SELECT id FROM audience_policy WHERE name = $1";
 pub(super) const MAX_VERSION: &str = "SELECT MAX(version) AS v FROM model WHERE slug = $1";
 pub(super) const INSERT_MODEL: &str =
     "INSERT INTO model (slug, version, title, description, policy_id, \
-     good_enough_level, source_name, source_vertices, source_faces, status, created_at) \
-     VALUES ($1, $2, $3, $4, $5, $6, $7, $8, $9, 'ready', $10) RETURNING id";
+     good_enough_level, source_name, source_vertices, source_faces, status, created_at, \
+     up_axis, unit, bounds) \
+     VALUES ($1, $2, $3, $4, $5, $6, $7, $8, $9, 'ready', $10, $11, $12, $13) RETURNING id";
+pub(super) const INSERT_THUMBNAIL: &str = "INSERT INTO thumbnail \
+     (model_id, media_type, width, height, byte_len, sha256, bytes, created_at) \
+     VALUES ($1, $2, $3, $4, $5, $6, $7, $8)";
 pub(super) const INSERT_COMPRESSION: &str = "INSERT INTO compression (model_id, codec_version, options, stats, \
      quantization_bits, has_colour, batch_count, final_vertices, final_faces, stream_bytes, encode_ms, created_at, \
      mapping_id) VALUES ($1, $2, $3, $4, $5, $6, $7, $8, $9, $10, $11, $12, $13) RETURNING id";

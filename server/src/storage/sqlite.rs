@@ -1,11 +1,12 @@
 //! The embedded backend: one SQLite file in WAL mode, created on first run.
 
 use super::backend::sql_storage;
+use super::curator::curator_storage;
 use super::study::study_storage;
 use super::{
-    is_connection_error, AudiencePolicy, ConnectOptions, LevelRecord, MappingRecord, ModelRecord,
-    ModelSummary, NewModel, NewToken, StagedModel, Storage, StorageError, TexturePayload,
-    TextureRef, TokenGrant,
+    is_connection_error, AudiencePolicy, Bounds, ConnectOptions, Curation, LevelRecord,
+    MappingRecord, ModelRecord, ModelSummary, NewModel, NewToken, StagedModel, Storage,
+    StorageError, TexturePayload, TextureRef, TokenGrant, TokenScope, UpAxis,
 };
 use sqlx::sqlite::{SqliteConnectOptions, SqliteJournalMode, SqlitePoolOptions, SqliteSynchronous};
 use sqlx::{Sqlite, SqlitePool, Transaction};
@@ -84,3 +85,4 @@ impl SqliteStorage {
 
 sql_storage!(SqliteStorage, Sqlite, "sqlite", MIGRATOR);
 study_storage!(SqliteStorage, Sqlite);
+curator_storage!(SqliteStorage, Sqlite);

@@ -38,9 +38,26 @@ macro_rules! stage_body {
             .bind($model.source_vertices as i64)
             .bind($model.source_faces as i64)
             .bind(now)
+            .bind($model.up_axis.map(|a| a.name()))
+            .bind($model.unit.clone())
+            .bind($model.bounds.map(|b| b.to_json()))
             .fetch_one(&mut *$tx)
             .await
             .map_err(conflict)?;
+        if let Some(thumbnail) = &$model.thumbnail {
+            sqlx::query(INSERT_THUMBNAIL)
+                .bind(model_id)
+                .bind(thumbnail.media_type)
+                .bind(i64::from(thumbnail.width))
+                .bind(i64::from(thumbnail.height))
+                .bind(thumbnail.bytes.len() as i64)
+                .bind(sha256_hex(&thumbnail.bytes))
+                .bind(thumbnail.bytes.as_slice())
+                .bind(now)
+                .execute(&mut *$tx)
+                .await
+                .map_err(c)?;
+        }
         let mut mapping_id: Option<i64> = None;
         if let Some(mapping) = &$model.mapping {
             let mut ids = [0i64; 3];
@@ -97,7 +114,7 @@ macro_rules! stage_body {
             .bind(comp.base.bytes.len() as i64)
             .bind(sha256_hex(&comp.base.bytes))
             .bind(comp.base.bytes.as_slice())
-            .bind(comp.base.metrics.map(|m| m.hausdorff))
+            .bind(comp.base.metrics.map(|m| m.hausdorff).or(comp.base.hausdorff))
             .bind(comp.base.metrics.map(|m| m.image_rmse))
             .bind(comp.base.metrics.and_then(|m| m.roy_rmse))
             .execute(&mut *$tx)
@@ -112,7 +129,7 @@ macro_rules! stage_body {
                 .bind(batch.bytes.len() as i64)
                 .bind(sha256_hex(&batch.bytes))
                 .bind(batch.bytes.as_slice())
-                .bind(batch.metrics.map(|m| m.hausdorff))
+                .bind(batch.metrics.map(|m| m.hausdorff).or(batch.hausdorff))
                 .bind(batch.metrics.map(|m| m.image_rmse))
                 .bind(batch.metrics.and_then(|m| m.roy_rmse))
                 .execute(&mut *$tx)

@@ -2,6 +2,11 @@
 
 use serde::Serialize;
 
+pub use super::curator::{
+    AnnotationRecord, Bounds, JobRecord, JobState, NewAnnotation, NewJob, ThumbnailPayload, UpAxis,
+    VersionRecord,
+};
+
 /// Who may fetch how much of a model (table `audience_policy`).
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct AudiencePolicy {
@@ -100,8 +105,24 @@ pub struct ModelRecord {
     pub levels: Vec<LevelRecord>,
     /// The CCC colour mapping, if the model has one.
     pub mapping: Option<MappingRecord>,
+    /// Up axis, unit, bounds and thumbnail, when recorded at ingest.
+    pub curation: Curation,
     /// The mapping's images, by id.
     pub textures: Vec<TextureRef>,
+}
+
+/// What an ingest records for curators and the viewer beside the stream:
+/// all `None` for versions ingested before issue 22.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Curation {
+    /// Which model axis points up.
+    pub up_axis: Option<UpAxis>,
+    /// The unit of model coordinates (`mm`, `cm`, `m`, `in`).
+    pub unit: Option<String>,
+    /// Bounds of the stream's (dequantized) positions.
+    pub bounds: Option<Bounds>,
+    /// The thumbnail's digest, when the version has one.
+    pub thumbnail_sha256: Option<String>,
 }
 
 impl ModelRecord {
@@ -129,6 +150,8 @@ pub struct ModelSummary {
     pub created_at_ms: i64,
     /// Stream format version of its payloads (`compression.codec_version`).
     pub stream_format: u8,
+    #[serde(skip)]
+    pub has_thumbnail: bool,
 }
 
 impl ModelSummary {
@@ -148,13 +171,42 @@ pub struct TexturePayload {
     pub public_access: bool,
 }
 
-/// A live researcher token.
+/// A live token.
 #[derive(Clone, Debug, PartialEq)]
 pub struct TokenGrant {
     pub id: i64,
     pub label: String,
     /// `None`: every model.
     pub model_slug: Option<String>,
+    pub scope: TokenScope,
+}
+
+/// What a token lets its holder do (column `access_token.scope`). The scopes
+/// are separate: a researcher token opens researcher-only levels and cannot
+/// publish or annotate; a curator token publishes and annotates but sees
+/// what the public sees.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, serde::Deserialize, clap::ValueEnum)]
+#[serde(rename_all = "lowercase")]
+pub enum TokenScope {
+    Researcher,
+    Curator,
+}
+
+impl TokenScope {
+    pub fn name(self) -> &'static str {
+        match self {
+            TokenScope::Researcher => "researcher",
+            TokenScope::Curator => "curator",
+        }
+    }
+
+    pub fn parse(name: &str) -> Option<TokenScope> {
+        match name {
+            "researcher" => Some(TokenScope::Researcher),
+            "curator" => Some(TokenScope::Curator),
+            _ => None,
+        }
+    }
 }
 
 impl TokenGrant {
@@ -166,6 +218,7 @@ impl TokenGrant {
 #[derive(Clone, Debug)]
 pub struct NewToken {
     pub token_sha256: String,
+    pub scope: TokenScope,
     pub label: String,
     pub model_slug: Option<String>,
     pub expires_at_ms: Option<i64>,
@@ -186,6 +239,9 @@ pub struct NewLevel {
     pub bytes: Vec<u8>,
     /// Quality against the original, when measured before storing.
     pub metrics: Option<LevelMetrics>,
+    /// The sampled Hausdorff distance over the diagonal measured by default
+    /// at ingest, stored when `metrics` is `None`.
+    pub hausdorff: Option<f64>,
 }
 
 /// Everything one ingest writes.
@@ -204,6 +260,21 @@ pub struct NewModel {
     pub compression: NewCompression,
     /// A CCC colour mapping, stored in the same transaction.
     pub mapping: Option<NewTextureMapping>,
+    pub up_axis: Option<UpAxis>,
+    /// `mm`, `cm`, `m` or `in`.
+    pub unit: Option<String>,
+    pub bounds: Option<Bounds>,
+    /// A picture rendered at ingest, stored in the same transaction.
+    pub thumbnail: Option<NewThumbnail>,
+}
+
+/// A rendered picture of a version (table `thumbnail`).
+#[derive(Clone, Debug)]
+pub struct NewThumbnail {
+    pub media_type: &'static str,
+    pub width: u32,
+    pub height: u32,
+    pub bytes: Vec<u8>,
 }
 
 /// An image to store in table `texture`.

@@ -28,6 +28,7 @@ impl BrokenStorage {
 
 #[async_trait]
 impl vitrine::storage::StudyStorage for BrokenStorage {}
+impl vitrine::storage::CuratorStorage for BrokenStorage {}
 
 #[async_trait]
 impl Storage for BrokenStorage {

@@ -5,6 +5,8 @@
 mod broken;
 mod caps;
 mod colour;
+mod curation;
+mod curators;
 mod download;
 mod harness;
 mod http;
@@ -15,6 +17,7 @@ mod slow;
 mod spec;
 mod story;
 mod study;
+mod uploads;
 mod viewer;
 
 use harness::{Backend, TestDb};
@@ -74,6 +77,9 @@ on_both_backends!(
     study::scripted_participants,
     study::bad_study_requests,
     download::glb_download_of_a_level,
+    curators::annotations_and_scopes,
+    uploads::uploads_as_jobs,
+    curation::curation_in_manifest_and_thumbnail,
 );
 
 /// `server/openapi.json` is the served description, committed for reviewers

@@ -41,6 +41,7 @@ impl SlowStorage {
 
 #[async_trait]
 impl vitrine::storage::StudyStorage for SlowStorage {}
+impl vitrine::storage::CuratorStorage for SlowStorage {}
 
 #[async_trait]
 impl Storage for SlowStorage {

@@ -4,6 +4,8 @@
 //! that status, and a JSON body must match the schema, tightened so that an
 //! object carries no property the description does not name.
 
+mod curators;
+
 use super::broken::{BrokenStorage, Failure};
 use super::colour::tiny_mapping;
 use super::harness::{
@@ -371,6 +373,7 @@ pub async fn responses_match_openapi(db: TestDb) {
 
     study_calls(&mut spec, &server, &db).await;
     download_calls(&mut spec, &server, &db).await;
+    curators::curator_calls(&mut spec, &server, &db).await;
     refusals(&mut spec, &db, &m).await;
     spec.assert_every_route_called();
 }
@@ -467,7 +470,8 @@ async fn refusals(spec: &mut Spec, db: &TestDb, m: &Models) {
             .replace("{slug}", "open")
             .replace("{id}", "1")
             .replace("{iteration}", "1")
-            .replace("{step}", "1");
+            .replace("{step}", "1")
+            .replace("{version}", "1");
         let methods: Vec<String> = spec.doc["paths"][&route]
             .as_object()
             .unwrap()

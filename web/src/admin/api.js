@@ -1,0 +1,94 @@
+// @ts-check
+/**
+ * The curators' API as the /admin page calls it: the token from
+ * sessionStorage, sent only as `Authorization: Bearer` (no cookies).
+ */
+
+const TOKEN_KEY = 'vitrine.curatorToken';
+
+/** @returns {string | null} */
+export function savedToken() {
+  return sessionStorage.getItem(TOKEN_KEY);
+}
+
+/** @param {string | null} token */
+export function saveToken(token) {
+  if (token) sessionStorage.setItem(TOKEN_KEY, token);
+  else sessionStorage.removeItem(TOKEN_KEY);
+}
+
+/**
+ * @typedef {{ id: number, slug: string, title: string, source_name: string,
+ *   state: 'queued' | 'running' | 'done' | 'failed', progress: number, stage: string,
+ *   error: string | null, model_version: number | null, model_url: string | null,
+ *   created_at: number, updated_at: number }} Job
+ * @typedef {{ version: number, title: string, status: string, policy: string,
+ *   good_enough_level: number | null, levels: number, created_at: number }} Version
+ */
+
+/** An answer that is not 2xx, with the server's message. */
+export class ApiError extends Error {
+  /** @param {number} status @param {string} message */
+  constructor(status, message) {
+    super(message);
+    this.status = status;
+  }
+}
+
+/**
+ * @param {string} path
+ * @param {RequestInit} [init]
+ * @returns {Promise<any>}
+ */
+export async function call(path, init = {}) {
+  const headers = new Headers(init.headers);
+  const token = savedToken();
+  if (token) headers.set('Authorization', `Bearer ${token}`);
+  const response = await fetch(path, { ...init, headers, cache: 'no-store', credentials: 'omit' });
+  if (!response.ok) {
+    let message = `the server answered ${response.status}`;
+    try {
+      const body = await response.json();
+      if (body && typeof body.message === 'string') message = body.message;
+    } catch {
+      // Not JSON: keep the status.
+    }
+    throw new ApiError(response.status, message);
+  }
+  if (response.status === 204) return null;
+  return response.json();
+}
+
+/** @returns {Promise<Job[]>} */
+export async function jobs() {
+  return (await call('/api/jobs')).jobs;
+}
+
+/** @param {FormData} form @returns {Promise<{ job: number, status_url: string }>} */
+export function upload(form) {
+  return call('/api/models', { method: 'POST', body: form });
+}
+
+/** @returns {Promise<Array<{ slug: string, title: string }>>} */
+export async function models() {
+  return (await call('/api/models')).models;
+}
+
+/** @param {string} slug @returns {Promise<Version[]>} */
+export async function versions(slug) {
+  return (await call(`/api/admin/models/${slug}/versions`)).versions;
+}
+
+/**
+ * @param {string} slug
+ * @param {number} version
+ * @param {{ status?: string, good_enough_level?: number | null }} change
+ * @returns {Promise<Version>}
+ */
+export function changeVersion(slug, version, change) {
+  return call(`/api/admin/models/${slug}/versions/${version}`, {
+    method: 'PUT',
+    headers: { 'Content-Type': 'application/json' },
+    body: JSON.stringify(change),
+  });
+}
