@@ -189,6 +189,8 @@ pub enum ErrorCode {
     TooManyRequests,
     NotAllowed,
     Timeout,
+    /// The instance is shutting down (`/readyz` only): send requests elsewhere.
+    ShuttingDown,
     Internal,
 }
 

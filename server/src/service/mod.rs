@@ -8,7 +8,9 @@
 pub mod admission;
 mod api;
 mod cache;
+mod cache_headers;
 pub mod cap;
+pub mod coherence;
 mod download;
 mod error;
 mod guard;
@@ -28,7 +30,7 @@ pub use cache::CacheConfig;
 pub use error::AppError;
 pub use layers::RequestLimits;
 pub use routes::{openapi, openapi_json};
-pub use visitor::VisitorHints;
+pub use visitor::{client_address, ClientAddr, PeerAddr, VisitorHints};
 
 use crate::storage::{sha256_hex, ModelRecord, Storage, TokenGrant};
 use admission::{Admission, AdmissionConfig};
@@ -55,6 +57,9 @@ pub struct ServiceConfig {
     pub web_dir: PathBuf,
     /// Origins allowed by CORS; empty means any.
     pub cors_origins: Vec<String>,
+    /// Proxies whose `X-Forwarded-For` / `Forwarded` names the visitor
+    /// ([`client_address`]); empty: none is believed.
+    pub trusted_proxies: Vec<ipnet::IpNet>,
 }
 
 impl Default for ServiceConfig {
@@ -67,6 +72,7 @@ impl Default for ServiceConfig {
             limits: RequestLimits::default(),
             web_dir: PathBuf::from("web/dist"),
             cors_origins: Vec::new(),
+            trusted_proxies: Vec::new(),
         }
     }
 }
@@ -97,6 +103,8 @@ struct Inner {
     permits: Arc<Semaphore>,
     /// GLB downloads decoded at once.
     downloads: Arc<Semaphore>,
+    /// Set once shutdown is asked for: `/readyz` answers 503 from then on.
+    draining: std::sync::atomic::AtomicBool,
 }
 
 impl AppState {
@@ -110,6 +118,7 @@ impl AppState {
             metrics: Metrics::default(),
             permits: Arc::new(Semaphore::new(config.limits.max_concurrency)),
             downloads: Arc::new(Semaphore::new(download::MAX_CONCURRENT_DOWNLOADS)),
+            draining: std::sync::atomic::AtomicBool::new(false),
             config,
         }))
     }
@@ -149,6 +158,17 @@ impl AppState {
 
     pub(crate) fn downloads(&self) -> &Arc<Semaphore> {
         &self.0.downloads
+    }
+
+    /// Shutdown has begun: `/readyz` answers 503 (requests are still served).
+    pub fn start_draining(&self) {
+        self.0
+            .draining
+            .store(true, std::sync::atomic::Ordering::Relaxed);
+    }
+
+    pub fn is_draining(&self) -> bool {
+        self.0.draining.load(std::sync::atomic::Ordering::Relaxed)
     }
 
     /// Forgets cached records, tokens and the model list, so that a new
