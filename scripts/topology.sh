@@ -19,7 +19,8 @@
 #
 # Environment: VISITORS (5000; short 300), TOPO_PG_PORT (55432), TOPO_PORT
 # (18200: nginx; +1, +2 the instances), NO_BUILD (use the built binaries),
-# KEEP_WORK (keep the work directory), COHERENCE_BOUND_S (5).
+# KEEP_WORK (keep the work directory), COHERENCE_BOUND_S (5), BIN_DIR
+# (target/release: where vitrine and vitrine-load are).
 # Never touches the shared PostgreSQL on 5432. Needs root for runuser
 # (PostgreSQL refuses to run as root) and installs nginx with apt-get when
 # it is missing.
@@ -30,8 +31,9 @@ short=0
 [ "${1:-}" = --short ] && short=1
 
 export RUST_BACKTRACE=0 RUST_LOG=${RUST_LOG:-warn}
-bin=$root/target/release/vitrine
-load=$root/target/release/vitrine-load
+bin_dir=${BIN_DIR:-$root/target/release}
+bin=$bin_dir/vitrine
+load=$bin_dir/vitrine-load
 if [ -z "${NO_BUILD:-}" ]; then
     cargo build --release -p vitrine -p vitrine-load
 fi
@@ -101,6 +103,8 @@ db=postgres://postgres@127.0.0.1:$pg_port/postgres
 "$bin" sample torus --kilo-vertices 60 -o "$work/v1.ply" >/dev/null
 "$bin" sample torus --kilo-vertices 80 -o "$work/v2.ply" >/dev/null
 "$bin" ingest "$work/v1.ply" --db "$db" --slug topo --title Topology --policy exhibition >/dev/null
+# A model nobody asks for until PostgreSQL is down (check_pg_restart).
+"$bin" ingest "$work/v1.ply" --db "$db" --slug untouched --title Untouched --policy open >/dev/null
 token=$("$bin" token --db "$db" --label topology)
 
 start_instance() { # index
@@ -149,10 +153,11 @@ log_stats() { # from to
     awk -v from="$1" -v to="$2" -v a="127.0.0.1:${ports[0]}" -v b="127.0.0.1:${ports[1]}" '
         $1 >= from && $1 <= to && $4 ~ /^"\/api\// {
             n++; s[$2]++
-            for (i = 7; i <= NF; i++) {
-                if ($i ~ /^cache=/) { c = substr($i, 7); cache[c]++ }
-                if ($i ~ /^upstream=/) { u = substr($i, 10); if (index(u, a)) ua++; if (index(u, b)) ub++ }
-            }
+            c = substr($7, 7); cache[c]++
+            # The instance that answered: the last one tried.
+            k = split(substr($0, index($0, "upstream=") + 9), tried, ", ")
+            if (tried[k] == a) ua++
+            if (tried[k] == b) ub++
         }
         END {
             hits = cache["HIT"] + cache["STALE"] + cache["UPDATING"] + cache["REVALIDATED"]
@@ -248,7 +253,7 @@ check_ingest() {
 check_rolling() {
     local out=$work/rolling.out
     "$load" crowd --url "$proxy" --slug topo --profile "$profile" --visitors "$event_n" \
-        --pattern "steady:$((event_s + 6))" --token "$token" --stay-s 0 --allow 429 >"$out" 2>&1 &
+        --pattern "steady:$((event_s + 12))" --token "$token" --stay-s 0 --allow 429 >"$out" 2>&1 &
     local crowd=$!
     sleep 2
     local i took=()
@@ -259,7 +264,8 @@ check_rolling() {
         wait "${inst[$i]}" 2>/dev/null || true
         start_instance "$i"
         took+=("$(since "$t0")")
-        sleep 3
+        # nginx tries an instance it took out again after fail_timeout (5 s).
+        sleep 6
     done
     local ok=1
     wait "$crowd" || ok=0
@@ -280,9 +286,9 @@ check_pg_restart() {
     local t_down
     t_down=$(now)
     sleep 1.5
-    # Uncached (a URL nobody asked before): 503 with Retry-After.
+    # Uncached anywhere (a model nobody asked for yet): 503 with Retry-After.
     local probe
-    probe=$(curl -s -D - -o /dev/null "$proxy/api/models/topo?device=desktop&probe=pg$RANDOM")
+    probe=$(curl -s -D - -o /dev/null "$proxy/api/models/untouched")
     sleep "$((down - 1))"
     local t_up
     t_up=$(now)
@@ -292,7 +298,7 @@ check_pg_restart() {
     for _ in $(seq 1 300); do
         if [ "$(code "http://127.0.0.1:${ports[0]}/readyz")" = 200 ] &&
             [ "$(code "http://127.0.0.1:${ports[1]}/readyz")" = 200 ] &&
-            [ "$(code "$proxy/api/models/topo?device=desktop&probe=up$RANDOM")" = 200 ]; then
+            [ "$(code "$proxy/api/models/untouched?probe=up$RANDOM")" = 200 ]; then
             recovered=$(since "$t1")
             break
         fi

@@ -9,7 +9,8 @@
 //! - PostgreSQL: `LISTEN vitrine_changes` (sqlx `PgListener`); a
 //!   notification arrives when the writing transaction commits, typically
 //!   within milliseconds. The listener reconnects after PostgreSQL restarts,
-//!   and drops the caches on reconnecting (what was sent meanwhile is lost).
+//!   and drops the caches once it listens again (what was sent meanwhile is
+//!   lost); while the database is away the cached records keep answering.
 //! - Both backends: the counter is read every `poll` (default 2 s), which
 //!   bounds staleness when a notification was missed, and is the only signal
 //!   on SQLite (one machine: a CLI ingest beside a running server).
@@ -98,11 +99,13 @@ async fn listen(state: AppState, url: String) {
                     );
                     state.invalidate();
                 }
-                // The connection was lost; the next call reconnects and
-                // listens again. Notifications in between are lost.
+                // The connection was lost: connect again above, which drops
+                // the caches once it listens (what was sent meanwhile is
+                // lost). Not before: while the database is away the cached
+                // records keep answering, and nothing can change there.
                 Ok(None) => {
-                    state.invalidate();
-                    tokio::time::sleep(Duration::from_millis(100)).await;
+                    tracing::debug!("listening connection lost; reconnecting");
+                    break;
                 }
                 Err(e) => {
                     tracing::debug!(error = %e, "listening connection failed; reconnecting");
