@@ -45,6 +45,7 @@ pub struct ServeArgs {
         env = "VITRINE_CORS_ORIGINS",
         value_delimiter = ','
     )]
+    #[serde(rename = "cors-origin")]
     pub cors_origins: Vec<String>,
 
     #[arg(long, env = "VITRINE_DB_MAX_CONNECTIONS", default_value_t = 16)]
