@@ -14,7 +14,6 @@ cargo test --workspace
 cargo test -p vitrine --features dev-tools --lib # the tools' unit tests (bench's Draco peer)
 (cd web && npm run --silent typecheck && npm test && npm run test:e2e)
 bash scripts/load.sh --short && bash scripts/faults.sh --short # crowd, faults, hostile HTTP (~3 min)
-NO_BUILD=1 bash scripts/topology.sh --short # two instances on PostgreSQL behind nginx (~2 min)
 if [ -x scripts/fuzz.sh ] || [ -f scripts/fuzz.sh ]; then
     bash scripts/fuzz.sh "${FUZZ_SECONDS:-20}"
 fi
