@@ -10,6 +10,8 @@ rustup target list --installed | grep -q '^wasm32-unknown-unknown$' || rustup ta
 need_apt=()
 command -v node >/dev/null 2>&1 || need_apt+=(nodejs npm)
 [ -x /usr/bin/chromium ] || need_apt+=(chromium)
+# The caching proxy of scripts/topology.sh (CI runs its --short version).
+command -v nginx >/dev/null 2>&1 || need_apt+=(nginx-light)
 if [ ${#need_apt[@]} -gt 0 ]; then
     export DEBIAN_FRONTEND=noninteractive
     apt-get update -qq

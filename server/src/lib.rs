@@ -23,6 +23,7 @@
 
 mod ccc_files;
 pub mod commands;
+pub mod config;
 mod connections;
 mod database;
 pub mod ingest;

@@ -1,5 +1,6 @@
-//! `vitrine serve --db … --listen …`: every setting a flag and a `VITRINE_*`
-//! variable; the defaults are those of [`ServiceConfig::default`] and
+//! `vitrine serve --db … --listen …`: every setting a flag, a `VITRINE_*`
+//! variable and a key of the `--config` file ([`crate::config`]); the
+//! defaults are those of [`ServiceConfig::default`] and
 //! [`ServeLimits::default`] (a test keeps them equal).
 
 use crate::connections::{serve, shutdown_signal, ServeLimits};
@@ -14,8 +15,19 @@ use std::path::PathBuf;
 use std::time::Duration;
 use tokio::net::TcpListener;
 
-#[derive(clap::Args, Clone, Debug)]
+#[derive(clap::Args, Clone, Debug, serde::Serialize)]
+#[serde(rename_all = "kebab-case")]
 pub struct ServeArgs {
+    /// A TOML file of these settings, keys named as the flags
+    /// (`db-max-connections = 32`). Precedence: flag > VITRINE_* > file > default.
+    #[arg(long, env = "VITRINE_CONFIG")]
+    #[serde(skip)]
+    pub config: Option<PathBuf>,
+    /// Validate the configuration, print the effective one (secrets
+    /// redacted) and exit: 0 when valid, 1 when not.
+    #[arg(long)]
+    #[serde(skip)]
+    pub check_config: bool,
     /// Database URL: `sqlite:vitrine.db` or `postgres://user@host/db`.
     #[arg(long, env = "VITRINE_DB", default_value = "sqlite:vitrine.db")]
     pub db: String,
@@ -33,6 +45,7 @@ pub struct ServeArgs {
         env = "VITRINE_CORS_ORIGINS",
         value_delimiter = ','
     )]
+    #[serde(rename = "cors-origin")]
     pub cors_origins: Vec<String>,
     /// Uploads (`POST /api/models`) larger than this many MiB get 413.
     #[arg(long, env = "VITRINE_UPLOAD_LIMIT_MB", default_value_t = 512)]
@@ -124,6 +137,26 @@ pub struct ServeArgs {
     pub max_header_bytes: usize,
     #[arg(long, env = "VITRINE_SHUTDOWN_GRACE_MS", default_value_t = 10_000)]
     pub shutdown_grace_ms: u64,
+    /// After SIGTERM, how long `/readyz` answers 503 while requests are
+    /// still served, so a load balancer's health check takes the instance
+    /// out before it stops accepting connections.
+    #[arg(long, env = "VITRINE_SHUTDOWN_DELAY_MS", default_value_t = 0)]
+    pub shutdown_delay_ms: u64,
+
+    /// Proxies whose `X-Forwarded-For` / `Forwarded` is believed
+    /// (comma-separated CIDRs, e.g. `127.0.0.1/32,10.0.0.0/8`); none by default:
+    /// the visitor is then the TCP peer.
+    #[arg(
+        long = "trusted-proxies",
+        env = "VITRINE_TRUSTED_PROXIES",
+        value_delimiter = ','
+    )]
+    pub trusted_proxies: Vec<ipnet::IpNet>,
+    /// How often the database's change counter is read, so that versions
+    /// ingested or withdrawn elsewhere show here (PostgreSQL also notifies at
+    /// once; this is its fallback). 0: never.
+    #[arg(long, env = "VITRINE_COHERENCE_POLL_MS", default_value_t = 2000)]
+    pub coherence_poll_ms: u64,
 }
 
 impl ServeArgs {
@@ -179,6 +212,7 @@ impl ServeArgs {
                 max_queued: 8,
                 public_base_url: self.public_base_url.clone(),
             },
+            trusted_proxies: self.trusted_proxies.clone(),
         }
     }
 
@@ -214,11 +248,26 @@ async fn warn_stale_models(storage: &dyn crate::storage::Storage) {
 /// Runs until Ctrl-C or SIGTERM. A database that is down at start-up is
 /// waited for; one that goes away later gives 503s until it is back.
 pub async fn run(args: ServeArgs) -> anyhow::Result<()> {
+    // The file, when there is one, fills in what flags and variables did not.
+    let args = match args.config {
+        Some(_) => crate::config::resolve(&serve_argv())?,
+        None => args,
+    };
+    if args.check_config {
+        let valid = crate::config::validate(&args);
+        print!("{}", crate::config::effective_toml(&args)?);
+        return valid;
+    }
     super::init_tracing();
     let storage = open_storage(&args.db, &args.connect_options(), true).await?;
     warn_stale_models(storage.as_ref()).await;
     let state = AppState::new(storage, args.service_config());
     let _sampler = state.spawn_load_sampler();
+    let _coherence = crate::service::coherence::spawn(
+        &state,
+        args.db.starts_with("postgres").then(|| args.db.clone()),
+        Duration::from_millis(args.coherence_poll_ms),
+    );
     if args.load_pin {
         state.load().force_pressure(Some(u8::MAX));
         tracing::info!("load caps pinned at every model's good-enough level");
@@ -237,8 +286,30 @@ pub async fn run(args: ServeArgs) -> anyhow::Result<()> {
         tracing::info!(addr = %ops.local_addr()?, "serving metrics");
         tokio::spawn(async move { serve(ops, router, limits, std::future::pending()).await });
     }
-    serve(listener, app(state), args.serve_limits(), shutdown_signal()).await?;
+    let draining = state.clone();
+    let delay = Duration::from_millis(args.shutdown_delay_ms);
+    let shutdown = async move {
+        shutdown_signal().await;
+        // Not ready first; keep serving while the balancer notices; then
+        // stop accepting and let open requests finish.
+        draining.start_draining();
+        tracing::info!(
+            delay_ms = delay.as_millis() as u64,
+            "shutdown asked: /readyz answers 503"
+        );
+        tokio::time::sleep(delay).await;
+    };
+    serve(listener, app(state), args.serve_limits(), shutdown).await?;
     Ok(())
+}
+
+/// This process's arguments after `serve`, to parse them with the file's.
+fn serve_argv() -> Vec<std::ffi::OsString> {
+    std::env::args_os()
+        .skip(1)
+        .skip_while(|a| a != "serve")
+        .skip(1)
+        .collect()
 }
 
 /// Connections the kernel may hold for us before `accept`. Tokio's

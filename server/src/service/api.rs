@@ -1,5 +1,6 @@
 //! JSON routes: the model list and a model's manifest.
 
+use super::cache_headers;
 use super::cap::Audience;
 use super::error::{AppError, ErrorBody};
 use super::manifest::{self, Manifest};
@@ -8,7 +9,6 @@ use super::visitor::{HintQuery, VisitorHints};
 use super::AppState;
 use crate::storage::ModelSummary;
 use axum::extract::State;
-use axum::http::{header, HeaderValue};
 use axum::response::{IntoResponse, Response};
 use axum::Json;
 use serde::Serialize;
@@ -60,7 +60,7 @@ pub async fn visible_models(
     path = "/api/models",
     params(HintQuery),
     responses(
-        (status = 200, description = "Model list (`Cache-Control: no-store`)", body = ModelList),
+        (status = 200, description = "Model list (`Cache-Control: public, max-age=2, …` without a token, `private, no-store` with one)", body = ModelList),
         (status = 400, description = "Malformed query or `Authorization`", body = ErrorBody),
         (status = 401, description = "The token is unknown, revoked or expired", body = ErrorBody),
         (status = 503, description = "Database unavailable or server overloaded", body = ErrorBody,
@@ -86,7 +86,9 @@ pub async fn list(
             levels: m.batch_count + 1,
         })
         .collect();
-    Ok(no_store(Json(ModelList { models })))
+    let mut response = Json(ModelList { models }).into_response();
+    cache_headers::visitor_json(&mut response, &hints);
+    Ok(response)
 }
 
 /// A model's manifest: levels, textures, and this visitor's level cap now.
@@ -95,7 +97,7 @@ pub async fn list(
     path = "/api/models/{slug}",
     params(SlugParam, HintQuery),
     responses(
-        (status = 200, description = "Manifest (`Cache-Control: no-store`)", body = Manifest),
+        (status = 200, description = "Manifest (`Cache-Control: public, max-age=2, …` without a token, `private, no-store` with one; `Vary: Authorization` and the device hints)", body = Manifest),
         (status = 400, description = "Malformed slug, query or `Authorization`", body = ErrorBody),
         (status = 401, description = "The token is unknown, revoked or expired", body = ErrorBody),
         (status = 404, description = "No such model, or a restricted one without a token for it",
@@ -113,16 +115,10 @@ pub async fn list(
 pub async fn manifest(
     State(state): State<AppState>,
     ServableModel { record, visitor }: ServableModel,
+    hints: VisitorHints,
 ) -> Response {
     let cap = state.level_cap(&record, &visitor);
-    no_store(Json(manifest::build(&state, &record, &visitor, cap)))
-}
-
-/// Manifests and lists depend on load and on the visitor: never cache them.
-fn no_store(body: impl IntoResponse) -> Response {
-    let mut response = body.into_response();
-    response
-        .headers_mut()
-        .insert(header::CACHE_CONTROL, HeaderValue::from_static("no-store"));
+    let mut response = Json(manifest::build(&state, &record, &visitor, cap)).into_response();
+    cache_headers::visitor_json(&mut response, &hints);
     response
 }

@@ -81,7 +81,12 @@ pub async fn download(
         &sha[..sha.len().min(24)]
     ))
     .map_err(|e| AppError::Internal(e.to_string()))?;
-    let cache_control = cache_control(&record, level);
+    // Named by slug, not by compression: never immutable (cache_headers).
+    let cache_control = super::cache_headers::download(
+        visitor.grant.is_some() || visitor.study_model.is_some(),
+        query.level.is_some(),
+        cache_control(&record, level).starts_with("public"),
+    );
     if not_modified(&headers, &etag) {
         return Ok(not_modified_response(etag, cache_control));
     }

@@ -194,6 +194,8 @@ pub enum ErrorCode {
     TooManyRequests,
     NotAllowed,
     Timeout,
+    /// The instance is shutting down (`/readyz` only): send requests elsewhere.
+    ShuttingDown,
     Internal,
 }
 

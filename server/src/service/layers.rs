@@ -3,6 +3,7 @@
 //! timeout, body limit, metrics), CORS and compression.
 
 use super::error::AppError;
+use super::visitor::{self, ClientAddr};
 use super::{guard, AppState};
 use axum::http::{header, HeaderName, HeaderValue, Method};
 use axum::middleware::from_fn_with_state;
@@ -45,10 +46,16 @@ impl Default for RequestLimits {
 pub fn apply(router: Router<AppState>, state: &AppState) -> Router<AppState> {
     router.layer(
         ServiceBuilder::new()
+            // One `Vary` line, whatever the layers below added.
+            .layer(axum::middleware::map_response(cache_merge_vary))
             .layer(CatchPanicLayer::custom(panic_response))
+            // Who the visitor is, behind a trusted proxy too.
+            .layer(from_fn_with_state(state.clone(), visitor::mark_client))
             // Error responses are logged once, with their cause, by the guard.
             .layer(
-                TraceLayer::new_for_http().on_failure(DefaultOnFailure::new().level(Level::DEBUG)),
+                TraceLayer::new_for_http()
+                    .make_span_with(request_span)
+                    .on_failure(DefaultOnFailure::new().level(Level::DEBUG)),
             )
             .layer(from_fn_with_state(state.clone(), guard::admit))
             // The guard limits bodies (64 KiB; an upload's own limit, counted
@@ -62,6 +69,20 @@ pub fn apply(router: Router<AppState>, state: &AppState) -> Router<AppState> {
                         .and(NotForContentType::const_new("application/octet-stream")),
                 ),
             ),
+    )
+}
+
+async fn cache_merge_vary<B>(response: axum::http::Response<B>) -> axum::http::Response<B> {
+    super::cache_headers::merge_vary(response)
+}
+
+fn request_span<B>(request: &axum::http::Request<B>) -> tracing::Span {
+    let client = request.extensions().get::<ClientAddr>().map(|c| c.0);
+    tracing::debug_span!(
+        "request",
+        method = %request.method(),
+        uri = %request.uri(),
+        client = ?client,
     )
 }
 

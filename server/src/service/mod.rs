@@ -8,7 +8,9 @@
 pub mod admission;
 mod api;
 mod cache;
+mod cache_headers;
 pub mod cap;
+pub mod coherence;
 pub mod curator;
 mod download;
 mod error;
@@ -29,7 +31,7 @@ pub use cache::CacheConfig;
 pub use error::AppError;
 pub use layers::RequestLimits;
 pub use routes::{openapi, openapi_json};
-pub use visitor::VisitorHints;
+pub use visitor::{client_address, ClientAddr, PeerAddr, VisitorHints};
 
 use crate::storage::{sha256_hex, ModelRecord, Storage, TokenGrant, TokenScope};
 use admission::{Admission, AdmissionConfig};
@@ -58,6 +60,9 @@ pub struct ServiceConfig {
     pub cors_origins: Vec<String>,
     /// Uploads, their ingest jobs, and the public base URL of `og:image`.
     pub uploads: curator::UploadConfig,
+    /// Proxies whose `X-Forwarded-For` / `Forwarded` names the visitor
+    /// ([`client_address`]); empty: none is believed.
+    pub trusted_proxies: Vec<ipnet::IpNet>,
 }
 
 impl Default for ServiceConfig {
@@ -71,6 +76,7 @@ impl Default for ServiceConfig {
             web_dir: PathBuf::from("web/dist"),
             cors_origins: Vec::new(),
             uploads: curator::UploadConfig::default(),
+            trusted_proxies: Vec::new(),
         }
     }
 }
@@ -103,6 +109,8 @@ struct Inner {
     downloads: Arc<Semaphore>,
     /// Upload ingests ([`curator::jobs`]).
     jobs: curator::jobs::JobRunner,
+    /// Set once shutdown is asked for: `/readyz` answers 503 from then on.
+    draining: std::sync::atomic::AtomicBool,
 }
 
 impl AppState {
@@ -120,6 +128,7 @@ impl AppState {
                 config.uploads.concurrent_jobs,
                 config.uploads.max_queued,
             ),
+            draining: std::sync::atomic::AtomicBool::new(false),
             config,
         }))
     }
@@ -163,6 +172,17 @@ impl AppState {
 
     pub(crate) fn jobs(&self) -> &curator::jobs::JobRunner {
         &self.0.jobs
+    }
+
+    /// Shutdown has begun: `/readyz` answers 503 (requests are still served).
+    pub fn start_draining(&self) {
+        self.0
+            .draining
+            .store(true, std::sync::atomic::Ordering::Relaxed);
+    }
+
+    pub fn is_draining(&self) -> bool {
+        self.0.draining.load(std::sync::atomic::Ordering::Relaxed)
     }
 
     /// Forgets cached records, tokens and the model list, so that a new

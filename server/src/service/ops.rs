@@ -52,20 +52,37 @@ pub async fn healthz() -> Json<Health> {
     })
 }
 
-/// Readiness: the database answers.
+/// Readiness: the database answers, and the instance is not shutting down.
 ///
 /// A load balancer stops sending data requests while it is away, and health
-/// checks keep the process alive.
+/// checks keep the process alive. After SIGTERM it answers 503
+/// `shutting_down` while open requests finish.
 #[utoipa::path(
     get,
     path = "/readyz",
     responses(
         (status = 200, description = "Ready", body = Ready),
-        (status = 503, description = "Database unavailable", body = ErrorBody,
+        (status = 503, description = "Database unavailable, or shutting down", body = ErrorBody,
             headers(("Retry-After" = u64, description = "Seconds to wait before asking again"))),
     )
 )]
 pub async fn readyz(State(state): State<AppState>) -> Response {
+    if state.is_draining() {
+        let body = ErrorBody {
+            error: ErrorCode::ShuttingDown,
+            message: Some("shutting down".into()),
+            retry_after_s: Some(READY_RETRY_AFTER_S),
+        };
+        return (
+            StatusCode::SERVICE_UNAVAILABLE,
+            [
+                (header::RETRY_AFTER, HeaderValue::from(READY_RETRY_AFTER_S)),
+                (header::CACHE_CONTROL, HeaderValue::from_static("no-store")),
+            ],
+            Json(body),
+        )
+            .into_response();
+    }
     match tokio::time::timeout(READY_TIMEOUT, state.storage().ping()).await {
         Ok(Ok(())) => Json(Ready {
             status: Readiness::Ready,

@@ -1,13 +1,110 @@
 //! Who is asking: device class from an explicit `?device=` or client hints,
-//! researcher token from `Authorization: Bearer` or `?token=`.
+//! researcher token from `Authorization: Bearer` or `?token=`, and the
+//! visitor's address: the TCP peer, or, when that peer is a trusted proxy
+//! (`--trusted-proxies`), the address it forwarded.
+//!
+//! Behind a proxy the device class and the audience need nothing new: the
+//! proxy passes the query, `User-Agent`, `Sec-CH-UA-Mobile` and
+//! `Authorization` through unchanged.
 
 use super::cap::DeviceClass;
 use super::error::AppError;
 use axum::extract::FromRequestParts;
 use axum::http::request::Parts;
 use axum::http::{header, HeaderMap};
+use ipnet::IpNet;
 use serde::Deserialize;
+use std::net::{IpAddr, SocketAddr};
 use utoipa::IntoParams;
+
+/// The visitor's address, as [`client_address`] decided it (a request
+/// extension; absent for requests that did not come over TCP).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ClientAddr(pub IpAddr);
+
+/// The TCP peer of a connection (a request extension set by the accept loop).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct PeerAddr(pub SocketAddr);
+
+/// Who the visitor is, given the TCP `peer`: the peer itself unless it is a
+/// trusted proxy. Then the forwarded chain (`X-Forwarded-For`, else
+/// `Forwarded: for=`) is read from the right, skipping trusted proxies; the
+/// first address that is not one is the visitor (an address further left
+/// was written by the client and proves nothing). Unreadable entries stop
+/// the walk at the last trusted hop.
+pub fn client_address(peer: IpAddr, headers: &HeaderMap, trusted: &[IpNet]) -> IpAddr {
+    let is_trusted = |ip: &IpAddr| trusted.iter().any(|net| net.contains(ip));
+    if !is_trusted(&peer) {
+        return peer;
+    }
+    let chain = forwarded_chain(headers);
+    let mut visitor = peer;
+    for hop in chain.iter().rev() {
+        let Some(ip) = hop else { break };
+        visitor = *ip;
+        if !is_trusted(ip) {
+            break;
+        }
+    }
+    visitor
+}
+
+/// The forwarded addresses, leftmost (the client's claim) first; `None` for
+/// an entry that is not an address (`unknown`, an obfuscated name).
+fn forwarded_chain(headers: &HeaderMap) -> Vec<Option<IpAddr>> {
+    let values = |name: &str| -> Vec<String> {
+        headers
+            .get_all(name)
+            .iter()
+            .filter_map(|v| v.to_str().ok())
+            .flat_map(|v| v.split(','))
+            .map(|v| v.trim().to_owned())
+            .filter(|v| !v.is_empty())
+            .collect()
+    };
+    let xff = values("x-forwarded-for");
+    if !xff.is_empty() {
+        return xff.iter().map(|v| parse_node(v)).collect();
+    }
+    values("forwarded")
+        .iter()
+        .filter_map(|element| {
+            element.split(';').find_map(|pair| {
+                let (k, v) = pair.split_once('=')?;
+                k.trim().eq_ignore_ascii_case("for").then(|| parse_node(v))
+            })
+        })
+        .collect()
+}
+
+/// Records the visitor's [`ClientAddr`] on the request, for the log and
+/// for whatever is decided per visitor.
+pub async fn mark_client(
+    axum::extract::State(state): axum::extract::State<super::AppState>,
+    mut request: axum::extract::Request,
+    next: axum::middleware::Next,
+) -> axum::response::Response {
+    if let Some(PeerAddr(peer)) = request.extensions().get::<PeerAddr>().copied() {
+        let trusted = &state.config().trusted_proxies;
+        let client = client_address(peer.ip(), request.headers(), trusted);
+        request.extensions_mut().insert(ClientAddr(client));
+    }
+    next.run(request).await
+}
+
+/// `192.0.2.1`, `192.0.2.1:8080`, `"[2001:db8::1]:443"`, `2001:db8::1`.
+fn parse_node(text: &str) -> Option<IpAddr> {
+    let t = text.trim().trim_matches('"');
+    if let Ok(ip) = t.parse::<IpAddr>() {
+        return Some(ip);
+    }
+    if let Ok(sa) = t.parse::<SocketAddr>() {
+        return Some(sa.ip());
+    }
+    t.strip_prefix('[')
+        .and_then(|r| r.split_once(']'))
+        .and_then(|(ip, _)| ip.parse().ok())
+}
 
 /// What the request says about the visitor, before the token is checked.
 #[derive(Clone, Debug, PartialEq, Eq)]

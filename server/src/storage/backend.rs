@@ -181,6 +181,13 @@ macro_rules! sql_storage {
                 Ok(())
             }
 
+            async fn change_generation(&self) -> $crate::storage::Result<i64> {
+                sqlx::query_scalar("SELECT generation FROM change_generation")
+                    .fetch_one(&self.pool)
+                    .await
+                    .map_err(Self::classify)
+            }
+
             async fn list_models(&self) -> $crate::storage::Result<Vec<ModelSummary>> {
                 use sqlx::Row;
                 use $crate::storage::sql::{narrow, LIST};

@@ -91,6 +91,13 @@ pub trait Storage: StudyStorage + CuratorStorage + Send + Sync + 'static {
     /// A trivial round trip, for `/readyz`.
     async fn ping(&self) -> Result<()>;
 
+    /// The change counter (`change_generation`): bumped by every committed
+    /// change to model versions, policies or tokens, whoever made it. A
+    /// storage without one (a test double) never changes behind our back.
+    async fn change_generation(&self) -> Result<i64> {
+        Ok(0)
+    }
+
     /// The visible version of every model, by slug.
     async fn list_models(&self) -> Result<Vec<ModelSummary>>;
 

@@ -26,12 +26,37 @@ pub async fn crowd(args: CrowdArgs) -> Result<()> {
         sum.bytes as f64 / 1e6, sum.errors, sum.pressure_max
     );
 
+    let mut versions: BTreeMap<i64, usize> = BTreeMap::new();
+    for v in &outcome.visitors {
+        if let Some(c) = v.compression_id {
+            *versions.entry(c).or_insert(0) += 1;
+        }
+    }
+    let mixed = outcome.visitors.iter().filter(|v| v.mixed_versions).count();
+    let newer = outcome
+        .visitors
+        .iter()
+        .filter(|v| v.newer_version_seen)
+        .count();
+    println!(
+        "versions (compression id: visitors who started on it) {versions:?}; {newer} saw a newer one on a re-read; {mixed} saw a mix of two"
+    );
     let allow: Vec<u16> = args
         .allow
         .split(',')
         .filter_map(|s| s.trim().parse().ok())
         .collect();
     let mut violations = status_violations(&args, &sum, &allow);
+    if mixed > 0 {
+        violations.push(format!("{mixed} visitors got batches of two versions"));
+    }
+    if args.require_versions > versions.len() {
+        violations.push(format!(
+            "visitors started on {} version(s), {} required",
+            versions.len(),
+            args.require_versions
+        ));
+    }
     for required in &args.require {
         if !outcome.requests.iter().any(|r| r.status == *required) {
             violations.push(format!("no {required} answer was seen"));

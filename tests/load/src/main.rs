@@ -206,6 +206,10 @@ struct CrowdArgs {
     /// Writes the summary and timeline as JSON.
     #[arg(long)]
     json: Option<PathBuf>,
+    /// Fail unless visitors started on at least this many model versions
+    /// (a version ingested mid-run reached them).
+    #[arg(long, default_value_t = 0)]
+    require_versions: usize,
 }
 
 #[derive(Serialize, Deserialize)]

@@ -253,6 +253,17 @@ pub struct VisitorResult {
     /// Still held by a load cap when the visitor left (`--stay-s`).
     #[serde(default)]
     pub held_at_end: bool,
+    /// The compression (model version) of the first manifest: every payload
+    /// this visitor fetches must be of it.
+    #[serde(default)]
+    pub compression_id: Option<i64>,
+    /// A re-read manifest named a newer version; the visitor stayed on its own.
+    #[serde(default)]
+    pub newer_version_seen: bool,
+    /// A batch whose size is not that of the first manifest's level: a mix
+    /// of two versions on one screen.
+    #[serde(default)]
+    pub mixed_versions: bool,
 }
 
 impl VisitorResult {
@@ -431,6 +442,8 @@ impl Visit {
         page.result.manifest_cap = Some(cap);
         page.result.manifest_reason = manifest["cap"]["reason"].as_str().map(str::to_owned);
         page.result.target = cap.min(last);
+        page.result.compression_id = manifest["compression_id"].as_i64();
+        page.sizes = level_sizes(&manifest);
         let urls = level_urls(&manifest);
         if urls.len() <= page.result.target as usize {
             page.result.failure = Some("manifest lists fewer levels than its cap".into());
@@ -467,6 +480,7 @@ impl Visit {
             reqs: Vec::with_capacity(16),
             arrived,
             device,
+            sizes: Vec::new(),
         }
     }
 
@@ -579,7 +593,15 @@ impl Visit {
             // Nothing more unless the cap has risen past what is on screen.
             from = reached as usize + 1;
             page.result.target = reached;
-            let levels = level_urls(&manifest);
+            // A newer version: this page goes on with the one it shows
+            // (still served while it is not withdrawn), never mixes the two.
+            let same = manifest["compression_id"].as_i64() == page.result.compression_id;
+            page.result.newer_version_seen |= !same;
+            let levels = if same {
+                level_urls(&manifest)
+            } else {
+                urls.clone()
+            };
             cap = ManifestCap::of(&manifest, last);
             if cap.level > reached && levels.len() > cap.level as usize {
                 page.result.resumed = true;
@@ -658,6 +680,15 @@ impl Visit {
             if let Some(stop) = page.refused_or_failed(&f, k) {
                 return stop;
             }
+            let got = f.body.as_ref().map_or(0, |b| b.len() as u64);
+            if page.sizes.get(k).is_some_and(|&want| want != got) {
+                page.result.mixed_versions = true;
+                page.result.failure = Some(format!(
+                    "batch {k}: {got} bytes, but the version the page started with has {}",
+                    page.sizes[k]
+                ));
+                return Stop::Failed;
+            }
             if k < page.result.target as usize {
                 prefetch = Some(self.prefetch(page, urls[k + 1].clone()));
             }
@@ -701,6 +732,8 @@ struct Page {
     reqs: Vec<Req>,
     arrived: Instant,
     device: Device,
+    /// Each level's payload size in the first manifest.
+    sizes: Vec<u64>,
 }
 
 impl Page {
@@ -764,6 +797,14 @@ impl ManifestCap {
             retry_after_s: cap["retry_after_s"].as_f64(),
         }
     }
+}
+
+/// Each level's payload size, base mesh first.
+fn level_sizes(manifest: &serde_json::Value) -> Vec<u64> {
+    manifest["levels"]
+        .as_array()
+        .map(|a| a.iter().map(|l| l["bytes"].as_u64().unwrap_or(0)).collect())
+        .unwrap_or_default()
 }
 
 /// Each level's payload URL, base mesh first.

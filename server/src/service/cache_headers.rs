@@ -1,0 +1,93 @@
+//! What browsers and shared caches (nginx, a CDN) may keep, route by route.
+//! The rules, which `tests/topology/cache_rules.rs` checks on every route:
+//!
+//! - Base meshes, batches, textures: immutable under their URL, which names
+//!   the compression (`/api/compressions/{id}/…`) or the texture; strong
+//!   ETag. `public` when the public may fetch them, else `private` (see
+//!   `payload.rs`). A new version has a new compression id, hence new URLs.
+//! - Manifests and the model list, asked without a token: `public,
+//!   max-age=2`, with `stale-while-revalidate` and
+//!   `stale-if-error` so a proxy keeps answering while it refreshes or while
+//!   the origin is away, and `Vary: Authorization` plus, when the device
+//!   class was guessed rather than given as `?device=`, the headers it was
+//!   guessed from. A manifest carries the load cap of the instance that
+//!   answered: a cached one is at most two seconds older than the load it
+//!   reports, and a batch above the current cap is still refused (429 with
+//!   `Retry-After`), after which the viewer reads the manifest again.
+//! - Anything asked with a token (`Authorization` or `?token=`, researcher or
+//!   study invitation): `private, no-store` with the same `Vary`, so no
+//!   shared cache can ever hand one visitor's caps to another.
+//! - A download (`download.glb`): named by slug, so it changes with each new
+//!   version: short-lived like a manifest, and `private, no-cache` when the
+//!   level is this visitor's cap (no `?level=`) or a token was sent.
+//! - Errors: `no-store` (`error.rs`); pages: `no-cache` (`web.rs`).
+//!
+//! Several layers (CORS, compression, these rules) name `Vary` headers; they
+//! are merged into one line ([`merge_vary`]), which every cache reads alike.
+
+use super::visitor::VisitorHints;
+use axum::http::{header, HeaderValue};
+use axum::response::Response;
+
+/// A public manifest or model list: two seconds in a shared cache.
+const PUBLIC_SHORT: &str = "public, max-age=2, stale-while-revalidate=10, stale-if-error=60";
+const PERSONAL: &str = "private, no-store";
+const PERSONAL_REVALIDATE: &str = "private, no-cache";
+
+/// Whether the answer depends on who the visitor is beyond the URL.
+pub fn personal(hints: &VisitorHints) -> bool {
+    hints.token.is_some()
+}
+
+/// The request headers a visitor answer depends on.
+fn vary(hints: &VisitorHints) -> HeaderValue {
+    if hints.device_explicit {
+        HeaderValue::from_static("Authorization")
+    } else {
+        HeaderValue::from_static("Authorization, Sec-CH-UA-Mobile, User-Agent")
+    }
+}
+
+/// A manifest or the model list: short-lived and shared when nothing
+/// personal went into it, never shared otherwise.
+pub fn visitor_json(response: &mut Response, hints: &VisitorHints) {
+    let control = if personal(hints) {
+        PERSONAL
+    } else {
+        PUBLIC_SHORT
+    };
+    let headers = response.headers_mut();
+    headers.insert(header::CACHE_CONTROL, HeaderValue::from_static(control));
+    headers.append(header::VARY, vary(hints));
+}
+
+/// A download: `level_given` is whether `?level=` chose it (else it is the
+/// visitor's cap now); `public` whether the public may fetch that level;
+/// `personal` whether a token was sent.
+pub fn download(personal: bool, level_given: bool, public: bool) -> &'static str {
+    if public && level_given && !personal {
+        PUBLIC_SHORT
+    } else {
+        PERSONAL_REVALIDATE
+    }
+}
+
+/// Every `Vary` line of `response` as one, each name once.
+pub fn merge_vary<B>(mut response: axum::http::Response<B>) -> axum::http::Response<B> {
+    let headers = response.headers_mut();
+    if headers.get_all(header::VARY).iter().count() < 2 {
+        return response;
+    }
+    let mut names: Vec<String> = Vec::new();
+    for value in headers.get_all(header::VARY) {
+        for name in value.to_str().unwrap_or("*").split(',') {
+            let name = name.trim();
+            if !name.is_empty() && !names.iter().any(|n| n.eq_ignore_ascii_case(name)) {
+                names.push(name.to_owned());
+            }
+        }
+    }
+    let merged = HeaderValue::from_str(&names.join(", ")).unwrap_or(HeaderValue::from_static("*"));
+    headers.insert(header::VARY, merged);
+    response
+}

@@ -1,0 +1,164 @@
+//! Every route's `Cache-Control` and `Vary`, asked without and with a token,
+//! over real HTTP: immutable payloads, short-lived shared manifests for the
+//! public, nothing personal ever `public` (see `service/cache_headers.rs`).
+
+use crate::harness::{ingest_sample, test_config, Backend, TestDb, TestServer};
+use reqwest::header::{CACHE_CONTROL, VARY};
+use reqwest::Client;
+use vitrine::new_token;
+use vitrine::storage::{sha256_hex, NewToken, TokenScope};
+
+struct Answer {
+    status: u16,
+    cache_control: String,
+    vary: Vec<String>,
+    body: String,
+}
+
+async fn get(client: &Client, url: &str, token: Option<&str>) -> Answer {
+    let mut request = client.get(url);
+    if let Some(t) = token {
+        request = request.bearer_auth(t);
+    }
+    let response = request.send().await.unwrap();
+    let h = response.headers().clone();
+    Answer {
+        status: response.status().as_u16(),
+        cache_control: h
+            .get(CACHE_CONTROL)
+            .map(|v| v.to_str().unwrap().to_owned())
+            .unwrap_or_default(),
+        vary: h
+            .get_all(VARY)
+            .iter()
+            .map(|v| v.to_str().unwrap().to_owned())
+            .collect(),
+        body: response.text().await.unwrap(),
+    }
+}
+
+fn varies_on(a: &Answer, name: &str) -> bool {
+    // One line, whatever the layers added (nginx 1.22 reads one).
+    assert!(a.vary.len() <= 1, "several Vary lines: {:?}", a.vary);
+    a.vary
+        .first()
+        .is_some_and(|v| v.split(',').any(|n| n.trim().eq_ignore_ascii_case(name)))
+}
+
+fn shared_short(a: &Answer) -> bool {
+    a.cache_control.starts_with("public, max-age=2,")
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn every_route_says_what_may_be_cached() {
+    let db = TestDb::new(Backend::Sqlite).await.unwrap();
+    let report = ingest_sample(&*db.storage, "vase", "exhibition-download").await;
+    let id = report.stored.compression_id;
+    let token = new_token();
+    db.storage
+        .insert_token(&NewToken {
+            token_sha256: sha256_hex(token.as_bytes()),
+            label: "cache rules".into(),
+            scope: TokenScope::Researcher,
+            model_slug: None,
+            expires_at_ms: None,
+        })
+        .await
+        .unwrap();
+    let server = TestServer::start(db.storage.clone(), test_config()).await;
+    let c = Client::new();
+    let url = |p: &str| server.url(p);
+
+    // Manifest: shared for the public, varying on the token and on the
+    // device hints it was guessed from …
+    let public = get(&c, &url("/api/models/vase"), None).await;
+    assert_eq!(public.status, 200);
+    assert!(shared_short(&public), "{}", public.cache_control);
+    assert!(varies_on(&public, "Authorization"));
+    assert!(varies_on(&public, "User-Agent") && varies_on(&public, "Sec-CH-UA-Mobile"));
+    assert!(public.body.contains("\"audience\":\"public\""));
+    // … only on the token when ?device= says the class.
+    let explicit = get(&c, &url("/api/models/vase?device=desktop"), None).await;
+    assert!(shared_short(&explicit));
+    assert!(varies_on(&explicit, "Authorization") && !varies_on(&explicit, "User-Agent"));
+    // A researcher's manifest is never shared, by header or by query.
+    let researcher = get(&c, &url("/api/models/vase?device=desktop"), Some(&token)).await;
+    assert_eq!(researcher.status, 200);
+    assert!(researcher.body.contains("\"audience\":\"researcher\""));
+    assert_eq!(researcher.cache_control, "private, no-store");
+    assert!(varies_on(&researcher, "Authorization"));
+    let by_query = get(&c, &url(&format!("/api/models/vase?token={token}")), None).await;
+    assert_eq!(by_query.cache_control, "private, no-store");
+
+    // The model list alike.
+    let list = get(&c, &url("/api/models"), None).await;
+    assert!(shared_short(&list) && varies_on(&list, "Authorization"));
+    let list = get(&c, &url("/api/models"), Some(&token)).await;
+    assert_eq!(list.cache_control, "private, no-store");
+
+    // Payloads: immutable; public where the public may have them.
+    let immutable = "public, max-age=31536000, immutable";
+    for token in [None, Some(token.as_str())] {
+        let base = get(&c, &url(&format!("/api/compressions/{id}/base")), token).await;
+        assert_eq!((base.status, base.cache_control.as_str()), (200, immutable));
+        let batch = get(
+            &c,
+            &url(&format!("/api/compressions/{id}/batches/1")),
+            token,
+        )
+        .await;
+        assert_eq!(
+            (batch.status, batch.cache_control.as_str()),
+            (200, immutable)
+        );
+    }
+    // The last level of an exhibition is the researchers' only.
+    let manifest: serde_json::Value = serde_json::from_str(&public.body).unwrap();
+    let last = manifest["last_level"].as_u64().unwrap();
+    let path = format!("/api/compressions/{id}/batches/{last}");
+    let theirs = get(&c, &url(&path), Some(&token)).await;
+    assert_eq!(theirs.status, 200);
+    assert_eq!(theirs.cache_control, "private, max-age=31536000, immutable");
+    let refused = get(&c, &url(&path), None).await;
+    assert_eq!(
+        (refused.status, refused.cache_control.as_str()),
+        (403, "no-store")
+    );
+
+    // Downloads are named by slug: never immutable; personal when the
+    // level is the visitor's cap or a token was sent.
+    let d = get(&c, &url("/api/models/vase/download.glb?level=1"), None).await;
+    assert_eq!(d.status, 200);
+    assert!(shared_short(&d), "{}", d.cache_control);
+    let d = get(&c, &url("/api/models/vase/download.glb"), None).await;
+    assert_eq!(
+        (d.status, d.cache_control.as_str()),
+        (200, "private, no-cache")
+    );
+    let d = get(
+        &c,
+        &url("/api/models/vase/download.glb?level=1"),
+        Some(&token),
+    )
+    .await;
+    assert_eq!(d.cache_control, "private, no-cache");
+
+    // Errors and health are never cached.
+    let missing = get(&c, &url("/api/models/nothing"), None).await;
+    assert_eq!(
+        (missing.status, missing.cache_control.as_str()),
+        (404, "no-store")
+    );
+    let bad = get(&c, &url("/api/models/vase"), Some("vtr_unknown")).await;
+    assert_eq!((bad.status, bad.cache_control.as_str()), (401, "no-store"));
+    for p in ["/healthz", "/readyz"] {
+        let a = get(&c, &url(p), None).await;
+        assert_eq!(a.status, 200);
+        assert!(
+            !a.cache_control.contains("public"),
+            "{p}: {}",
+            a.cache_control
+        );
+    }
+    server.shut_down().await;
+}
