@@ -680,8 +680,9 @@ impl Visit {
             if let Some(stop) = page.refused_or_failed(&f, k) {
                 return stop;
             }
-            let got = f.body.as_ref().map_or(0, |b| b.len() as u64);
-            if page.sizes.get(k).is_some_and(|&want| want != got) {
+            // The body is not kept (`keep` false): its length is in the record.
+            let got = f.req.bytes;
+            if f.req.status == 200 && page.sizes.get(k).is_some_and(|&want| want != got) {
                 page.result.mixed_versions = true;
                 page.result.failure = Some(format!(
                     "batch {k}: {got} bytes, but the version the page started with has {}",
