@@ -26,6 +26,6 @@ step bash -c 'cd web && npm run --silent typecheck && npm test && npm run test:e
 step bash -c 'bash scripts/load.sh --short && bash scripts/faults.sh --short' # crowd, faults, hostile HTTP (~3 min)
 step bash scripts/topology.sh --short # two instances on one PostgreSQL behind nginx
 if [ -f scripts/fuzz.sh ]; then
-    step bash scripts/fuzz.sh "${FUZZ_SECONDS:-20}"
+    step bash scripts/fuzz.sh "${FUZZ_SECONDS:-10}"
 fi
 echo "::: all tests passed in $((SECONDS - start)) s"
