@@ -62,7 +62,13 @@ pub async fn uploads_as_jobs(db: TestDb) {
     let curator = token(&db, TokenScope::Curator, None).await;
     let researcher = token(&db, TokenScope::Researcher, None).await;
     let server = TestServer::start(db.storage.clone(), upload_config(spool.path())).await;
-    let http = reqwest::Client::new();
+    // No pooled connections: the server closes a connection whose upload it
+    // refused (413) without reading it, and a reused one would fail the
+    // next request with a reset rather than an answer.
+    let http = reqwest::Client::builder()
+        .pool_max_idle_per_host(0)
+        .build()
+        .unwrap();
     let upload = server.url("/api/models");
 
     // Scopes.
