@@ -157,8 +157,18 @@ async fn oversized(t: &Target, cases: &mut Cases) -> Result<()> {
     chunked.extend_from_slice(b"4\r\nabcd\r\n0\r\n\r\n");
     cases.check("chunked body", &[413], raw(a, &chunked).await?, &[]);
     cases.check(
-        "POST to the API",
+        "POST to a read-only route",
         &[405],
+        raw(
+            a,
+            b"POST /api/compressions/1/base HTTP/1.1\r\nhost: v\r\ncontent-length: 0\r\nconnection: close\r\n\r\n",
+        )
+        .await?,
+        &[],
+    );
+    cases.check(
+        "publishing without a curator token",
+        &[401],
         raw(
             a,
             b"POST /api/models HTTP/1.1\r\nhost: v\r\ncontent-length: 0\r\nconnection: close\r\n\r\n",
