@@ -14,19 +14,28 @@ use vitrine::study::{new_invitation, report};
 
 /// T for the tests: short, but the server's clock still enforces 2·T.
 const STATE_MS: u64 = 120;
+/// T where a test needs a request to land *before* 2·T has passed: long
+/// enough that a loaded CI machine (PostgreSQL, parallel tests) cannot
+/// overshoot it between two requests.
+const SLOW_STATE_MS: u64 = 1_500;
 
 struct Study {
     id: i64,
     invitations: Vec<String>,
 }
 
-async fn open_study(storage: &Arc<dyn Storage>, slug: &str, invitations: usize) -> Study {
+async fn open_study(
+    storage: &Arc<dyn Storage>,
+    slug: &str,
+    invitations: usize,
+    state_ms: u64,
+) -> Study {
     let record = storage.model_by_slug(slug).await.unwrap().unwrap();
     let vertices: Vec<u32> = record.levels.iter().map(|l| l.vertices).collect();
     let transitions = default_transitions(&vertices);
     assert!(transitions.len() >= 3, "the sample needs a few transitions");
     let id = storage
-        .create_study(record.model_id, &transitions, STATE_MS)
+        .create_study(record.model_id, &transitions, state_ms)
         .await
         .unwrap();
     let invitations: Vec<String> = (0..invitations).map(|_| new_invitation()).collect();
@@ -94,7 +103,11 @@ impl Client {
 }
 
 fn answer(improvement: &str, sufficient: bool) -> Value {
-    json!({"improvement": improvement, "sufficient": sufficient, "shown_ms": [STATE_MS, STATE_MS]})
+    answer_shown(improvement, sufficient, STATE_MS)
+}
+
+fn answer_shown(improvement: &str, sufficient: bool, shown_ms: u64) -> Value {
+    json!({"improvement": improvement, "sufficient": sufficient, "shown_ms": [shown_ms, shown_ms]})
 }
 
 /// One participant's whole session: sufficient from `good` on; the control
@@ -166,7 +179,7 @@ async fn participate(
 
 pub async fn scripted_participants(db: TestDb) {
     ingest_sample(&*db.storage, "bust", "exhibition").await;
-    let study = open_study(&db.storage, "bust", 4).await;
+    let study = open_study(&db.storage, "bust", 4, STATE_MS).await;
     let server = Arc::new(TestServer::start(db.storage.clone(), test_config()).await);
     let record = db.storage.model_by_slug("bust").await.unwrap().unwrap();
     let last = record.batch_count();
@@ -261,7 +274,7 @@ async fn stored(storage: &Arc<dyn Storage>, study: i64) -> (usize, usize, usize)
 
 pub async fn bad_study_requests(db: TestDb) {
     ingest_sample(&*db.storage, "bust", "exhibition").await;
-    let study = open_study(&db.storage, "bust", 2).await;
+    let study = open_study(&db.storage, "bust", 2, SLOW_STATE_MS).await;
     let server = Arc::new(TestServer::start(db.storage.clone(), test_config()).await);
     let http = reqwest::Client::new();
     let storage = db.storage.clone();
@@ -299,7 +312,7 @@ pub async fn bad_study_requests(db: TestDb) {
 
     // Before a session: answers and views are refused.
     let (status, _) = p
-        .put("/api/study/bust/session/answers/1", answer("none", true))
+        .put("/api/study/bust/session/answers/1", answer_slow("none", true))
         .await;
     assert_eq!(status, StatusCode::CONFLICT);
     // No consent, bad shapes, malformed JSON: no session.
@@ -351,50 +364,50 @@ pub async fn bad_study_requests(db: TestDb) {
 
     // Too early: both periods have not passed since the session started.
     let (status, body) = p
-        .put("/api/study/bust/session/answers/1", answer("none", false))
+        .put("/api/study/bust/session/answers/1", answer_slow("none", false))
         .await;
     assert_eq!(status, StatusCode::UNPROCESSABLE_ENTITY, "{body}");
-    tokio::time::sleep(Duration::from_millis(2 * STATE_MS + 5)).await;
+    tokio::time::sleep(Duration::from_millis(2 * SLOW_STATE_MS + 5)).await;
     // Out of order, unknown step, a state shown too briefly, bad values.
     let (status, _) = p
-        .put("/api/study/bust/session/answers/2", answer("none", false))
+        .put("/api/study/bust/session/answers/2", answer_slow("none", false))
         .await;
     assert_eq!(status, StatusCode::CONFLICT);
     let (status, _) = p
-        .put("/api/study/bust/session/answers/99", answer("none", false))
+        .put("/api/study/bust/session/answers/99", answer_slow("none", false))
         .await;
     assert_eq!(status, StatusCode::NOT_FOUND);
     let brief =
-        json!({"improvement": "none", "sufficient": false, "shown_ms": [STATE_MS, STATE_MS - 1]});
+        json!({"improvement": "none", "sufficient": false, "shown_ms": [SLOW_STATE_MS, SLOW_STATE_MS - 1]});
     let (status, _) = p.put("/api/study/bust/session/answers/1", brief).await;
     assert_eq!(status, StatusCode::UNPROCESSABLE_ENTITY);
     let (status, _) = p
         .put(
             "/api/study/bust/session/answers/1",
-            json!({"improvement": "lots", "sufficient": false, "shown_ms": [STATE_MS, STATE_MS]}),
+            json!({"improvement": "lots", "sufficient": false, "shown_ms": [SLOW_STATE_MS, SLOW_STATE_MS]}),
         )
         .await;
     assert_eq!(status, StatusCode::UNPROCESSABLE_ENTITY);
     let (status, _) = p
-        .put("/api/study/bust/session/answers/x", answer("none", false))
+        .put("/api/study/bust/session/answers/x", answer_slow("none", false))
         .await;
     assert_eq!(status, StatusCode::BAD_REQUEST);
     assert_eq!(stored(&storage, study.id).await, after_start);
 
     // Stored once; the same answer again is fine, a different one is not.
     let (status, receipt) = p
-        .put("/api/study/bust/session/answers/1", answer("none", false))
+        .put("/api/study/bust/session/answers/1", answer_slow("none", false))
         .await;
     assert_eq!(status, StatusCode::CREATED);
     assert_eq!(receipt["next_step"], 2);
     let (status, _) = p
-        .put("/api/study/bust/session/answers/1", answer("none", false))
+        .put("/api/study/bust/session/answers/1", answer_slow("none", false))
         .await;
     assert_eq!(status, StatusCode::OK);
     let (status, _) = p
         .put(
             "/api/study/bust/session/answers/1",
-            answer("greatly", false),
+            answer_slow("greatly", false),
         )
         .await;
     assert_eq!(status, StatusCode::CONFLICT);
@@ -467,4 +480,8 @@ pub async fn bad_study_requests(db: TestDb) {
 
 async fn sessions_of(storage: &Arc<dyn Storage>, study: i64) -> vitrine::storage::SessionRecord {
     storage.study_sessions(study).await.unwrap().remove(0).0
+}
+
+fn answer_slow(improvement: &str, sufficient: bool) -> Value {
+    answer_shown(improvement, sufficient, SLOW_STATE_MS)
 }
