@@ -444,7 +444,22 @@ fn colour_u8(v: f64, ty: Ty) -> u8 {
     }
 }
 
-pub(super) fn read(bytes: &[u8], opts: &ImportOptions) -> Result<IndexedMesh> {
+/// What a PLY reader does with the payload once the header is parsed: the
+/// mesh reader and the point reader (`ply_points`) share the header parser and
+/// the dispatch to an ASCII or binary source through this.
+trait Payload {
+    type Output;
+    fn read<S: Source>(
+        self,
+        header: &Header,
+        src: &mut S,
+        payload_len: usize,
+    ) -> Result<Self::Output>;
+}
+
+/// Parses the header of `bytes` and hands its payload to `payload` through
+/// the source its encoding needs.
+fn read_with<P: Payload>(bytes: &[u8], payload: P) -> Result<P::Output> {
     let header = parse_header(bytes)?;
     let data = &bytes[header.data_start..];
     match header.encoding {
@@ -460,7 +475,7 @@ pub(super) fn read(bytes: &[u8], opts: &ImportOptions) -> Result<IndexedMesh> {
                 line: first_line,
                 cursor_line: first_line,
             };
-            read_payload(&header, &mut src, data.len(), opts)
+            payload.read(&header, &mut src, data.len())
         }
         Encoding::LittleEndian | Encoding::BigEndian => {
             let mut src = Binary {
@@ -468,9 +483,28 @@ pub(super) fn read(bytes: &[u8], opts: &ImportOptions) -> Result<IndexedMesh> {
                 pos: 0,
                 big_endian: header.encoding == Encoding::BigEndian,
             };
-            read_payload(&header, &mut src, data.len(), opts)
+            payload.read(&header, &mut src, data.len())
         }
     }
+}
+
+/// The mesh reader's payload: vertices and faces.
+struct MeshPayload<'a>(&'a ImportOptions);
+
+impl Payload for MeshPayload<'_> {
+    type Output = IndexedMesh;
+    fn read<S: Source>(
+        self,
+        header: &Header,
+        src: &mut S,
+        payload_len: usize,
+    ) -> Result<IndexedMesh> {
+        read_payload(header, src, payload_len, self.0)
+    }
+}
+
+pub(super) fn read(bytes: &[u8], opts: &ImportOptions) -> Result<IndexedMesh> {
+    read_with(bytes, MeshPayload(opts))
 }
 
 fn read_payload<S: Source>(

@@ -7,8 +7,7 @@
 //! still refuses a PLY without faces).
 
 use super::{
-    check_counts, parse_header, skip, skip_records, Ascii, Binary, Encoding, Header, Kind, Records,
-    Source, WHAT,
+    check_counts, read_with, skip, skip_records, Header, Kind, Payload, Records, Source, WHAT,
 };
 use crate::import::ImportOptions;
 use crate::{Error, Result};
@@ -36,31 +35,21 @@ enum Slot {
 /// a vertex element or without scalar `x y z`, no vertices, more vertices than
 /// `opts.max_vertices` or than the bytes can hold, non-finite values.
 pub fn import_ply_points(bytes: &[u8], opts: &ImportOptions) -> Result<PlyPoints> {
-    let header = parse_header(bytes)?;
-    let data = &bytes[header.data_start..];
-    match header.encoding {
-        Encoding::Ascii => {
-            let first_line = bytes[..header.data_start]
-                .iter()
-                .filter(|&&b| b == b'\n')
-                .count()
-                + 1;
-            let mut src = Ascii {
-                data,
-                pos: 0,
-                line: first_line,
-                cursor_line: first_line,
-            };
-            read_points(&header, &mut src, data.len(), opts)
-        }
-        Encoding::LittleEndian | Encoding::BigEndian => {
-            let mut src = Binary {
-                data,
-                pos: 0,
-                big_endian: header.encoding == Encoding::BigEndian,
-            };
-            read_points(&header, &mut src, data.len(), opts)
-        }
+    read_with(bytes, PointsPayload(opts))
+}
+
+/// The point reader's payload: the vertex element only.
+struct PointsPayload<'a>(&'a ImportOptions);
+
+impl Payload for PointsPayload<'_> {
+    type Output = PlyPoints;
+    fn read<S: Source>(
+        self,
+        header: &Header,
+        src: &mut S,
+        payload_len: usize,
+    ) -> Result<PlyPoints> {
+        read_points(header, src, payload_len, self.0)
     }
 }
 
