@@ -41,8 +41,10 @@ pub mod voronoi;
 
 pub use collapse::{
     simplify, simplify_with, Cleanup, Collapse, Features, PassReport, Placement, Simplified,
-    SimplifyOptions, StopReason, Target,
+    SimplifyOptions, StopReason, Target, WEIGHTED_PASS_SHARE,
 };
 pub use deviation::{border_vertices, normal_deviation, one_ring_max, VertexFaces};
-pub use feature_guard::{FeatureGuard, FeatureThreshold, DEFAULT_FEATURE_SHARE};
+pub use feature_guard::{
+    FeatureGuard, FeatureThreshold, DEFAULT_FEATURE_SHARE, DEFAULT_RELIEF_GATE,
+};
 pub use voronoi::{simplify_voronoi, Distance, Order, Radius, VoronoiOptions, VoronoiSimplified};

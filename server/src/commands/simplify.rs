@@ -64,6 +64,9 @@ pub enum FeaturesKind {
     Keep,
     /// Removed last, least sharp first, once nothing else can go.
     Last,
+    /// No classes: one order of quadric error times `1 + (θ/τ)²` over
+    /// every vertex off the borders.
+    Weighted,
 }
 
 /// How `normal-deviation` removes vertices.
@@ -100,7 +103,8 @@ pub struct SimplifyArgs {
     #[arg(long, value_enum, default_value_t = PlacementKind::Quadric)]
     pub placement: PlacementKind,
     /// normal-deviation: whether feature vertices may go once nothing else
-    /// can (the target is then always met, borders permitting).
+    /// can (the target is then always met, borders permitting), or weigh
+    /// on one cost order instead of forming a class.
     #[arg(long, value_enum, default_value_t = FeaturesKind::Last)]
     pub features: FeaturesKind,
     #[command(flatten)]
@@ -264,6 +268,7 @@ fn normal_deviation(mesh: &IndexedMesh, args: &SimplifyArgs) -> anyhow::Result<O
         features: match args.features {
             FeaturesKind::Keep => Features::Keep,
             FeaturesKind::Last => Features::Last,
+            FeaturesKind::Weighted => Features::Weighted,
         },
         ..SimplifyOptions::default()
     };
