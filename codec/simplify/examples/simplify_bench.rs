@@ -1,6 +1,5 @@
-//! The normal-deviation simplifier (each collapse variant, quadric
-//! placement, with features last — the class order — and with θ as a
-//! weight on one cost order) at 10 % and 2 % of the faces,
+//! The normal-deviation simplifier (each collapse variant, with the seed's
+//! placement and with quadric placement) at 10 % and 2 % of the faces,
 //! beside a quadric-error peer on the very same repaired mesh: symmetric
 //! Hausdorff over the bounding-box diagonal, and time.
 //!
@@ -16,9 +15,7 @@ use vitrine_mesh::export::write_ply;
 use vitrine_mesh::import::{import_path, ImportOptions};
 use vitrine_mesh::repair::{prepare, RepairOptions};
 use vitrine_quality::metrics::hausdorff;
-use vitrine_simplify::{
-    simplify, Collapse, Features, Placement, SimplifyOptions, StopReason, Target,
-};
+use vitrine_simplify::{simplify, Collapse, Placement, SimplifyOptions, StopReason, Target};
 
 const FRACTIONS: [f64; 2] = [0.10, 0.02];
 const SAMPLES: usize = 200_000;
@@ -28,13 +25,11 @@ fn ours(
     mesh: &IndexedMesh,
     collapse: Collapse,
     placement: Placement,
-    features: Features,
     fraction: f64,
 ) -> (usize, f64, f64, &'static str) {
     let options = SimplifyOptions {
         collapse,
         placement,
-        features,
         target: Target::Fraction(fraction),
         ..SimplifyOptions::default()
     };
@@ -91,7 +86,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         paths.drain(..2);
     }
     println!(
-        "| scan | faces | kept | order, placement | edge: faces, H/diag, s | half-edge | triangle | quadric peer |"
+        "| scan | faces | kept | placement | edge: faces, H/diag, s | half-edge | triangle | quadric peer |"
     );
     println!("|---|---:|---:|---|---|---|---|---|");
     for path in &paths {
@@ -109,18 +104,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 }
                 None => " – |".to_string(),
             };
-            for (features, placement, label) in [
-                (Features::Last, Placement::Quadric, "classes, quadric"),
-                (Features::Weighted, Placement::Quadric, "weighted, quadric"),
-            ] {
+            for (placement, label) in [(Placement::Seed, "seed"), (Placement::Quadric, "quadric")] {
                 let mut row = format!(
                     "| {name} | {} | {:.0} % | {label} |",
                     mesh.triangles.len(),
                     100.0 * fraction
                 );
                 for collapse in [Collapse::Edge, Collapse::HalfEdge, Collapse::Triangle] {
-                    let (faces, h, s, stopped) =
-                        ours(&mesh, collapse, placement, features, fraction);
+                    let (faces, h, s, stopped) = ours(&mesh, collapse, placement, fraction);
                     let note = if stopped == "target" {
                         String::new()
                     } else {

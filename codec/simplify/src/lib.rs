@@ -41,7 +41,7 @@ pub mod voronoi;
 
 pub use collapse::{
     simplify, simplify_with, Cleanup, Collapse, Features, PassReport, Placement, Simplified,
-    SimplifyOptions, StopReason, Target, WEIGHTED_PASS_SHARE,
+    SimplifyOptions, StopReason, Target,
 };
 pub use deviation::{border_vertices, normal_deviation, one_ring_max, VertexFaces};
 pub use feature_guard::{

@@ -20,16 +20,11 @@ use vitrine_simplify::{
 
 const VARIANTS: [Collapse; 3] = [Collapse::Edge, Collapse::HalfEdge, Collapse::Triangle];
 
-/// Every collapse variant with each placement under the class order
-/// (features last), and with quadric placement under the weighted order.
-fn settings() -> impl Iterator<Item = (Collapse, Placement, Features)> {
-    VARIANTS.into_iter().flat_map(|c| {
-        [
-            (c, Placement::Seed, Features::Last),
-            (c, Placement::Quadric, Features::Last),
-            (c, Placement::Quadric, Features::Weighted),
-        ]
-    })
+/// Every collapse variant with each placement.
+fn settings() -> impl Iterator<Item = (Collapse, Placement)> {
+    VARIANTS
+        .into_iter()
+        .flat_map(|c| [Placement::Seed, Placement::Quadric].map(|p| (c, p)))
 }
 
 fn holed_grid() -> IndexedMesh {
@@ -65,15 +60,9 @@ fn options(collapse: Collapse, target: Target) -> SimplifyOptions {
     }
 }
 
-fn options_at(
-    collapse: Collapse,
-    placement: Placement,
-    features: Features,
-    target: Target,
-) -> SimplifyOptions {
+fn options_at(collapse: Collapse, placement: Placement, target: Target) -> SimplifyOptions {
     SimplifyOptions {
         placement,
-        features,
         ..options(collapse, target)
     }
 }
@@ -155,12 +144,12 @@ fn topology(mesh: &IndexedMesh) -> (i64, usize, usize) {
 fn every_pass_leaves_a_sound_manifold_and_the_clean_up_finds_nothing() {
     for (name, mesh) in corpus() {
         let surface = Surface::new(&mesh);
-        for (collapse, placement, features) in settings() {
-            let name = format!("{name}, {collapse:?}, {placement:?}, {features:?}");
+        for (collapse, placement) in settings() {
+            let name = format!("{name}, {collapse:?}, {placement:?}");
             let (mut passes, mut checked) = (0, HashSet::new());
             let out = simplify_with(
                 &mesh,
-                &options_at(collapse, placement, features, Target::Fraction(0.1)),
+                &options_at(collapse, placement, Target::Fraction(0.1)),
                 |r, m, _| {
                     passes += 1;
                     let pass = format!("{name}, pass {passes}");
@@ -183,33 +172,26 @@ fn every_pass_leaves_a_sound_manifold_and_the_clean_up_finds_nothing() {
 #[test]
 fn each_variant_stops_exactly_at_its_target() {
     let mesh = torus(64, 32, 1.0, 0.35);
-    for (collapse, placement, features) in settings() {
+    for (collapse, placement) in settings() {
         for n in [1500, 777, 301] {
-            let out = simplify(
-                &mesh,
-                &options_at(collapse, placement, features, Target::Vertices(n)),
-            )
-            .unwrap();
+            let out =
+                simplify(&mesh, &options_at(collapse, placement, Target::Vertices(n))).unwrap();
             assert_eq!(
                 out.stopped,
                 StopReason::Target,
-                "{collapse:?} {placement:?} {features:?} {n}"
+                "{collapse:?} {placement:?} {n}"
             );
-            assert_eq!(
-                out.mesh.vertex_count(),
-                n,
-                "{collapse:?} {placement:?} {features:?}"
-            );
+            assert_eq!(out.mesh.vertex_count(), n, "{collapse:?} {placement:?}");
             assert_eq!(out.origin.len(), n);
             assert_eq!(
                 out.mesh.face_count(),
                 2 * n,
-                "{collapse:?} {placement:?} {features:?}: a torus has F = 2V"
+                "{collapse:?} {placement:?}: a torus has F = 2V"
             );
         }
         let out = simplify(
             &icosphere(4),
-            &options_at(collapse, placement, features, Target::Fraction(0.25)),
+            &options_at(collapse, placement, Target::Fraction(0.25)),
         )
         .unwrap();
         assert_eq!(out.mesh.vertex_count(), (2562.0f64 * 0.25).round() as usize);
@@ -220,17 +202,13 @@ fn each_variant_stops_exactly_at_its_target() {
 fn genus_components_and_border_loops_survive() {
     for (name, mesh) in corpus() {
         let before = topology(&mesh);
-        for (collapse, placement, features) in settings() {
+        for (collapse, placement) in settings() {
             let out = simplify(
                 &mesh,
-                &options_at(collapse, placement, features, Target::Fraction(0.15)),
+                &options_at(collapse, placement, Target::Fraction(0.15)),
             )
             .unwrap();
-            assert_eq!(
-                topology(&out.mesh),
-                before,
-                "{name}, {collapse:?} {placement:?} {features:?}"
-            );
+            assert_eq!(topology(&out.mesh), before, "{name}, {collapse:?}");
         }
     }
     assert_eq!(topology(&plate_with_tunnels(3, 6)).0, 2 - 2 * 3);
@@ -263,22 +241,22 @@ fn borders_of_a_holed_grid_are_found_exactly_and_left_bit_for_bit() {
         .collect();
     assert_eq!(found, expected);
     assert!(expected.len() > 4 * 40, "outline and two holes");
-    for (collapse, placement, features) in settings() {
+    for (collapse, placement) in settings() {
         let out = simplify(
             &mesh,
-            &options_at(collapse, placement, features, Target::Fraction(0.3)),
+            &options_at(collapse, placement, Target::Fraction(0.3)),
         )
         .unwrap();
         assert_eq!(
             out.stopped,
             StopReason::Target,
-            "{collapse:?} {placement:?} {features:?}"
+            "{collapse:?} {placement:?}"
         );
         let target = (0.3 * mesh.vertex_count() as f64).round() as usize;
         assert_eq!(
             out.mesh.vertex_count(),
             target,
-            "{collapse:?} {placement:?} {features:?}"
+            "{collapse:?} {placement:?}"
         );
         let kept: HashSet<u32> = out.origin.iter().copied().collect();
         for (o, &v) in out.origin.iter().enumerate() {
@@ -287,22 +265,19 @@ fn borders_of_a_holed_grid_are_found_exactly_and_left_bit_for_bit() {
                 assert_eq!(
                     a.map(f32::to_bits),
                     b.map(f32::to_bits),
-                    "{collapse:?} {placement:?} {features:?}"
+                    "{collapse:?} {placement:?}"
                 );
             }
         }
         assert!(
             expected.is_subset(&kept),
-            "{collapse:?} {placement:?} {features:?}: a border vertex went"
+            "{collapse:?} {placement:?}: a border vertex went"
         );
         let output_border: HashSet<u32> = open_edge_vertices(&out.mesh)
             .into_iter()
             .map(|o| out.origin[o as usize])
             .collect();
-        assert_eq!(
-            output_border, expected,
-            "{collapse:?} {placement:?} {features:?}"
-        );
+        assert_eq!(output_border, expected, "{collapse:?} {placement:?}");
     }
 }
 
@@ -356,8 +331,8 @@ fn a_flat_region_simplifies_far_more_than_a_ridge() {
 #[test]
 fn the_same_input_gives_the_same_output() {
     let mesh = noisy_torus();
-    for (collapse, placement, features) in settings() {
-        let o = options_at(collapse, placement, features, Target::Fraction(0.2));
+    for collapse in VARIANTS {
+        let o = options(collapse, Target::Fraction(0.2));
         let (a, b) = (simplify(&mesh, &o).unwrap(), simplify(&mesh, &o).unwrap());
         assert_eq!(a.mesh, b.mesh);
         assert_eq!(a.origin, b.origin);
@@ -369,12 +344,8 @@ fn the_same_input_gives_the_same_output() {
 fn colours_travel_with_their_vertices() {
     let mut mesh = holed_grid();
     mesh.colors = Some(vec![[200, 40, 90]; mesh.positions.len()]);
-    for (collapse, placement, features) in settings() {
-        let out = simplify(
-            &mesh,
-            &options_at(collapse, placement, features, Target::Fraction(0.3)),
-        )
-        .unwrap();
+    for collapse in VARIANTS {
+        let out = simplify(&mesh, &options(collapse, Target::Fraction(0.3))).unwrap();
         let colours = out.mesh.colors.as_ref().unwrap();
         assert_eq!(colours.len(), out.mesh.vertex_count());
         assert!(
@@ -413,13 +384,6 @@ fn features_or_topology_can_stop_it_short_and_it_says_so() {
     )
     .unwrap();
     assert_eq!((out.stopped, out.passes.len()), (StopReason::Target, 0));
-    // Under the weighted order no threshold frees anything: only the
-    // grid's outline (its borders) is left when it stops.
-    let mut o = options(Collapse::Edge, Target::Vertices(10));
-    o.features = Features::Weighted;
-    let out = simplify(&grid(40), &o).unwrap();
-    assert_eq!(out.stopped, StopReason::NoCandidate);
-    assert!(out.mesh.vertex_count() >= 160);
 }
 
 #[test]
@@ -436,8 +400,6 @@ fn bad_parameters_and_non_manifold_input_are_refused() {
     let o = SimplifyOptions::default();
     assert!(matches!(simplify(&fin, &o), Err(Error::Unsupported(_))));
     assert_eq!("half-edge".parse::<Collapse>().unwrap(), Collapse::HalfEdge);
-    assert_eq!("weighted".parse::<Features>().unwrap(), Features::Weighted);
-    assert!("classes".parse::<Features>().is_err());
     assert_eq!("25%".parse::<Target>().unwrap(), Target::Fraction(0.25));
     assert_eq!("5000".parse::<Target>().unwrap(), Target::Vertices(5000));
     for bad in ["", "-3", "120%", "half"] {
@@ -517,12 +479,7 @@ fn quadric_placement_stays_closer_to_a_smooth_surface() {
         let seed = simplify(&mesh, &options(collapse, Target::Fraction(0.05))).unwrap();
         let quadric = simplify(
             &mesh,
-            &options_at(
-                collapse,
-                Placement::Quadric,
-                Features::Last,
-                Target::Fraction(0.05),
-            ),
+            &options_at(collapse, Placement::Quadric, Target::Fraction(0.05)),
         )
         .unwrap();
         assert_eq!(seed.mesh.vertex_count(), quadric.mesh.vertex_count());

@@ -64,9 +64,6 @@ pub enum FeaturesKind {
     Keep,
     /// Removed last, least sharp first, once nothing else can go.
     Last,
-    /// No classes: one order of quadric error times `1 + (θ/τ)²` over
-    /// every vertex off the borders.
-    Weighted,
 }
 
 /// How `normal-deviation` removes vertices.
@@ -103,8 +100,7 @@ pub struct SimplifyArgs {
     #[arg(long, value_enum, default_value_t = PlacementKind::Quadric)]
     pub placement: PlacementKind,
     /// normal-deviation: whether feature vertices may go once nothing else
-    /// can (the target is then always met, borders permitting), or weigh
-    /// on one cost order instead of forming a class.
+    /// can (the target is then always met, borders permitting).
     #[arg(long, value_enum, default_value_t = FeaturesKind::Last)]
     pub features: FeaturesKind,
     #[command(flatten)]
@@ -268,7 +264,6 @@ fn normal_deviation(mesh: &IndexedMesh, args: &SimplifyArgs) -> anyhow::Result<O
         features: match args.features {
             FeaturesKind::Keep => Features::Keep,
             FeaturesKind::Last => Features::Last,
-            FeaturesKind::Weighted => Features::Weighted,
         },
         ..SimplifyOptions::default()
     };

@@ -105,35 +105,6 @@ pub enum Features {
     /// remove, if fewer) with the lowest θ.
     #[default]
     Last,
-    /// No classes: every vertex off the borders is a candidate, in one
-    /// order of quadric error times `1 + (θ/τ)²`, so a feature costs more
-    /// to remove but a curved "flat" region is not emptied before a mild
-    /// feature loses a vertex. Each pass makes at most
-    /// [`WEIGHTED_PASS_SHARE`] of the live vertices' worth of merges, the
-    /// cheapest, so the order is nearly global. Error quadrics are
-    /// carried whatever the placement.
-    Weighted,
-}
-
-/// With [`Features::Weighted`], the most merges a pass makes, as a share
-/// of the live vertices: small enough that each pass takes only the
-/// cheapest merges, large enough that 2 % of a scan takes ~40 passes.
-pub const WEIGHTED_PASS_SHARE: f64 = 0.1;
-
-impl FromStr for Features {
-    type Err = Error;
-
-    /// `keep`, `last` or `weighted`.
-    fn from_str(s: &str) -> Result<Self> {
-        match s.trim() {
-            "keep" => Ok(Features::Keep),
-            "last" => Ok(Features::Last),
-            "weighted" => Ok(Features::Weighted),
-            _ => Err(Error::Parameter(format!(
-                "features must be keep, last or weighted, got {s:?}"
-            ))),
-        }
-    }
 }
 
 /// Where to stop.
@@ -301,16 +272,10 @@ fn run(
     options.target.validate()?;
     let (working, mut threshold) = WorkingMesh::new(mesh, options.threshold)?;
     let first_threshold = threshold;
-    let weighted = options.features == Features::Weighted;
-    let mut working = match (options.placement, weighted) {
-        (Placement::Seed, false) => working,
-        _ => working.with_quadrics(),
+    let mut working = match options.placement {
+        Placement::Seed => working,
+        Placement::Quadric => working.with_quadrics(),
     };
-    if weighted {
-        // No class of protected vertices: θ weighs on the cost instead.
-        threshold = f64::INFINITY;
-    }
-    let weight_scale = weighted.then_some(first_threshold);
     let target = options.target.vertices(working.live_vertices);
     let mut passes = Vec::new();
     let stopped = loop {
@@ -320,9 +285,7 @@ fn run(
         if passes.len() >= options.max_passes {
             break StopReason::MaxPasses;
         }
-        let merges = Pass::new(&mut working, options, threshold, target)
-            .weighted(weight_scale)
-            .run();
+        let merges = Pass::new(&mut working, options, threshold, target).run();
         let cleanup = cleanup::clean(&mut working, threshold, target);
         if merges == 0 && cleanup == Cleanup::default() {
             match options.features {
@@ -333,7 +296,7 @@ fn run(
                     }
                     None => break StopReason::NoCandidate,
                 },
-                Features::Keep | Features::Weighted => break StopReason::NoCandidate,
+                Features::Keep => break StopReason::NoCandidate,
             }
         }
         let report = PassReport {
@@ -355,7 +318,7 @@ fn run(
         passes,
         stopped,
         threshold_radians: first_threshold,
-        final_threshold_radians: if weighted { first_threshold } else { threshold },
+        final_threshold_radians: threshold,
     })
 }
 

@@ -19,10 +19,6 @@ pub(super) struct Pass<'a> {
     frozen: Vec<bool>,
     scratch: Scratch,
     ring: Vec<u32>,
-    /// τ with [`super::Features::Weighted`]: candidates go in order of
-    /// quadric cost times `1 + (θ/τ)²`, at most a share of the live
-    /// vertices a pass.
-    weight_scale: Option<f64>,
 }
 
 impl<'a> Pass<'a> {
@@ -42,15 +38,7 @@ impl<'a> Pass<'a> {
             frozen,
             scratch: Scratch::default(),
             ring: Vec::new(),
-            weight_scale: None,
         }
-    }
-
-    /// One weighted cost order (see [`super::Features::Weighted`]) when
-    /// `scale` (τ) is given.
-    pub fn weighted(mut self, scale: Option<f64>) -> Self {
-        self.weight_scale = scale;
-        self
     }
 
     /// Runs the pass; returns how many merges it made.
@@ -58,29 +46,15 @@ impl<'a> Pass<'a> {
         let mut candidates: Vec<u32> = (0..self.mesh.positions.len() as u32)
             .filter(|&v| self.mesh.removable(v, self.threshold))
             .collect();
-        let order: Vec<f64> = match (self.weight_scale, self.placement) {
-            (None, Placement::Seed) => self.mesh.theta.clone(),
-            (scale, _) => {
+        let order: Vec<f64> = match self.placement {
+            Placement::Seed => self.mesh.theta.clone(),
+            Placement::Quadric => {
                 let mut cost = vec![f64::INFINITY; self.mesh.positions.len()];
                 for &v in &candidates {
                     cost[v as usize] = self.cheapest(v);
                 }
-                if let Some(tau) = scale {
-                    // τ is 0 on a plane (every θ 0): the weights stay 1.
-                    let tau = tau.max(1e-12);
-                    for &v in &candidates {
-                        let t = self.mesh.theta[v as usize] / tau;
-                        cost[v as usize] *= 1.0 + t * t;
-                    }
-                }
                 cost
             }
-        };
-        let limit = match self.weight_scale {
-            Some(_) => ((self.mesh.live_vertices as f64 * super::WEIGHTED_PASS_SHARE).ceil()
-                as usize)
-                .max(1),
-            None => usize::MAX,
         };
         candidates.sort_by(|&a, &b| {
             order[a as usize]
@@ -90,7 +64,7 @@ impl<'a> Pass<'a> {
         let mut merges = 0;
         for v in candidates {
             let left = self.mesh.live_vertices.saturating_sub(self.target);
-            if left == 0 || merges >= limit {
+            if left == 0 {
                 break;
             }
             if !self.usable(v) {
