@@ -312,10 +312,7 @@ pub async fn bad_study_requests(db: TestDb) {
 
     // Before a session: answers and views are refused.
     let (status, _) = p
-        .put(
-            "/api/study/bust/session/answers/1",
-            answer_slow("none", true),
-        )
+        .put("/api/study/bust/session/answers/1", answer_slow("none", true))
         .await;
     assert_eq!(status, StatusCode::CONFLICT);
     // No consent, bad shapes, malformed JSON: no session.
@@ -367,29 +364,21 @@ pub async fn bad_study_requests(db: TestDb) {
 
     // Too early: both periods have not passed since the session started.
     let (status, body) = p
-        .put(
-            "/api/study/bust/session/answers/1",
-            answer_slow("none", false),
-        )
+        .put("/api/study/bust/session/answers/1", answer_slow("none", false))
         .await;
     assert_eq!(status, StatusCode::UNPROCESSABLE_ENTITY, "{body}");
     tokio::time::sleep(Duration::from_millis(2 * SLOW_STATE_MS + 5)).await;
     // Out of order, unknown step, a state shown too briefly, bad values.
     let (status, _) = p
-        .put(
-            "/api/study/bust/session/answers/2",
-            answer_slow("none", false),
-        )
+        .put("/api/study/bust/session/answers/2", answer_slow("none", false))
         .await;
     assert_eq!(status, StatusCode::CONFLICT);
     let (status, _) = p
-        .put(
-            "/api/study/bust/session/answers/99",
-            answer_slow("none", false),
-        )
+        .put("/api/study/bust/session/answers/99", answer_slow("none", false))
         .await;
     assert_eq!(status, StatusCode::NOT_FOUND);
-    let brief = json!({"improvement": "none", "sufficient": false, "shown_ms": [SLOW_STATE_MS, SLOW_STATE_MS - 1]});
+    let brief =
+        json!({"improvement": "none", "sufficient": false, "shown_ms": [SLOW_STATE_MS, SLOW_STATE_MS - 1]});
     let (status, _) = p.put("/api/study/bust/session/answers/1", brief).await;
     assert_eq!(status, StatusCode::UNPROCESSABLE_ENTITY);
     let (status, _) = p
@@ -400,28 +389,19 @@ pub async fn bad_study_requests(db: TestDb) {
         .await;
     assert_eq!(status, StatusCode::UNPROCESSABLE_ENTITY);
     let (status, _) = p
-        .put(
-            "/api/study/bust/session/answers/x",
-            answer_slow("none", false),
-        )
+        .put("/api/study/bust/session/answers/x", answer_slow("none", false))
         .await;
     assert_eq!(status, StatusCode::BAD_REQUEST);
     assert_eq!(stored(&storage, study.id).await, after_start);
 
     // Stored once; the same answer again is fine, a different one is not.
     let (status, receipt) = p
-        .put(
-            "/api/study/bust/session/answers/1",
-            answer_slow("none", false),
-        )
+        .put("/api/study/bust/session/answers/1", answer_slow("none", false))
         .await;
     assert_eq!(status, StatusCode::CREATED);
     assert_eq!(receipt["next_step"], 2);
     let (status, _) = p
-        .put(
-            "/api/study/bust/session/answers/1",
-            answer_slow("none", false),
-        )
+        .put("/api/study/bust/session/answers/1", answer_slow("none", false))
         .await;
     assert_eq!(status, StatusCode::OK);
     let (status, _) = p
