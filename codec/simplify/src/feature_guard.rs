@@ -106,12 +106,23 @@ pub struct FeatureGuard {
     /// count is about this over its mean face area.
     vertices_times_face_area: f64,
     share: f64,
+    /// With `Some(g)`, a ranked feature vertex may still go when its
+    /// [`relief`] over the retriangulation is at most `g`: removing it
+    /// would barely move the surface there, so the null patch is saved.
+    relief_gate: Option<f64>,
 }
 
-/// The share of a level's vertices that features may hold by default: on
-/// the shared scans 0.05 halves the features' distance to the coarse levels
-/// for under 5 % more connectivity (0.1 costs 8–10 %, 0.25 costs 12–21 %).
-pub const DEFAULT_FEATURE_SHARE: f64 = 0.05;
+/// The share of a level's vertices that features may hold by default.
+/// With the relief gate below, on the 13 shared scans (session 13,
+/// docs/bench-log/2026-12-02-session-13-guard.md) 0.3 cuts the features'
+/// RMS distance at the first level with ≥ 5 % of the vertices by 30.6 % on
+/// average for +2.0 % connectivity (0.05 without a gate: −26.2 %, +4.6 %).
+pub const DEFAULT_FEATURE_SHARE: f64 = 0.3;
+
+/// The relief gate by default: a ranked feature vertex whose removal
+/// bends the surface through less than about 17° (sine 0.3) may go, so
+/// null patches go where removal would cut the feature.
+pub const DEFAULT_RELIEF_GATE: Option<f64> = Some(0.3);
 
 impl FeatureGuard {
     /// `quantization` must be the stream's: `Quantization::for_positions`
@@ -142,7 +153,16 @@ impl FeatureGuard {
             threshold,
             vertices_times_face_area: 0.5 * quantized_area(mesh, quantization),
             share: DEFAULT_FEATURE_SHARE,
+            relief_gate: DEFAULT_RELIEF_GATE,
         }
+    }
+
+    /// Lets a ranked feature vertex go when its relief (height over its
+    /// retriangulated patch, relative to the patch's radius) is at most
+    /// `gate`: vetoes go only where removal would cut the feature.
+    pub fn with_relief_gate(mut self, gate: Option<f64>) -> Self {
+        self.relief_gate = gate.map(|g| g.max(0.0));
+        self
     }
 
     /// The share (0–1) of a level's vertices that features may hold; 1
@@ -175,16 +195,47 @@ fn quantized_area(mesh: &IndexedMesh, quantization: &Quantization) -> f64 {
         .sum()
 }
 
+/// How far removing the patch's centre moves the surface there, as a
+/// share of the patch's size: the centre's distance to the plane of its
+/// retriangulation (area-weighted normal, through the polygon's centroid)
+/// over its mean distance to the polygon. About the sine of the angle the
+/// surface bends through at the centre, at the current level's scale: 0
+/// on a plane, large where the patch straddles a crease. Infinite for a
+/// degenerate patch (the guard then refuses, as without a gate).
+fn relief(patch: &CandidatePatch<'_>) -> f64 {
+    let point = |p: [i32; 3]| DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64);
+    let polygon: Vec<DVec3> = patch.polygon[..patch.valence]
+        .iter()
+        .map(|&p| point(p))
+        .collect();
+    let centre = point(patch.centre);
+    let normal = patch
+        .triangles
+        .iter()
+        .map(|t| {
+            let [a, b, c] = t.map(|i| polygon[usize::from(i)]);
+            (b - a).cross(c - a)
+        })
+        .sum::<DVec3>()
+        .normalize_or_zero();
+    let k = polygon.len().max(1) as f64;
+    let centroid = polygon.iter().sum::<DVec3>() / k;
+    let radius = polygon.iter().map(|p| p.distance(centre)).sum::<f64>() / k;
+    if normal == DVec3::ZERO || radius <= 0.0 {
+        return f64::INFINITY;
+    }
+    (centre - centroid).dot(normal).abs() / radius
+}
+
 impl PatchGuard for FeatureGuard {
     fn allows(&self, patch: &CandidatePatch<'_>) -> bool {
         let Some(&rank) = self.rank.get(&patch.centre) else {
             return true;
         };
-        if self.share >= 1.0 || patch.mean_face_area <= 0.0 {
-            return false;
-        }
-        let level_vertices = self.vertices_times_face_area / patch.mean_face_area;
-        f64::from(rank) >= self.share * level_vertices
+        let protected = self.share >= 1.0
+            || patch.mean_face_area <= 0.0
+            || f64::from(rank) < self.share * self.vertices_times_face_area / patch.mean_face_area;
+        !protected || self.relief_gate.is_some_and(|g| relief(patch) <= g)
     }
 
     fn uses_mean_face_area(&self) -> bool {

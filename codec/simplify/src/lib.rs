@@ -44,5 +44,7 @@ pub use collapse::{
     SimplifyOptions, StopReason, Target,
 };
 pub use deviation::{border_vertices, normal_deviation, one_ring_max, VertexFaces};
-pub use feature_guard::{FeatureGuard, FeatureThreshold, DEFAULT_FEATURE_SHARE};
+pub use feature_guard::{
+    FeatureGuard, FeatureThreshold, DEFAULT_FEATURE_SHARE, DEFAULT_RELIEF_GATE,
+};
 pub use voronoi::{simplify_voronoi, Distance, Order, Radius, VoronoiOptions, VoronoiSimplified};
