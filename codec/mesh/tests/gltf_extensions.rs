@@ -287,9 +287,22 @@ fn textured_quad(texture_info: &str, required: &str) -> Vec<[f32; 2]> {
         ),
     )
     .replace("MATERIAL", r#","material":0"#);
-    let dir = folder("transform");
-    let path = dir.join("quad.glb");
-    std::fs::write(&path, g.bytes(&doc)).unwrap();
+    // One file per call: the tests run in parallel and call this with
+    // different documents (a shared name raced: one test read another's
+    // half-written file).
+    let bytes = g.bytes(&doc);
+    let name = {
+        use std::hash::{Hash, Hasher};
+        let mut h = std::collections::hash_map::DefaultHasher::new();
+        bytes.hash(&mut h);
+        format!(
+            "quad-{:016x}-{:?}.glb",
+            h.finish(),
+            std::thread::current().id()
+        )
+    };
+    let path = folder("transform").join(name.replace(['(', ')'], ""));
+    std::fs::write(&path, bytes).unwrap();
     let got = import_path_textured(&path, &ImportOptions::default()).unwrap();
     assert!(got.warnings.is_empty(), "{:?}", got.warnings);
     got.texture.expect("a texture").uvs
