@@ -287,21 +287,12 @@ fn textured_quad(texture_info: &str, required: &str) -> Vec<[f32; 2]> {
         ),
     )
     .replace("MATERIAL", r#","material":0"#);
-    // One file per call: the tests run in parallel and call this with
-    // different documents (a shared name raced: one test read another's
-    // half-written file).
+    // One file per call: the tests run in parallel, and a shared name let
+    // one test read another's half-written file.
+    static CALLS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+    let n = CALLS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    let path = folder("transform").join(format!("quad-{n}.glb"));
     let bytes = g.bytes(&doc);
-    let name = {
-        use std::hash::{Hash, Hasher};
-        let mut h = std::collections::hash_map::DefaultHasher::new();
-        bytes.hash(&mut h);
-        format!(
-            "quad-{:016x}-{:?}.glb",
-            h.finish(),
-            std::thread::current().id()
-        )
-    };
-    let path = folder("transform").join(name.replace(['(', ')'], ""));
     std::fs::write(&path, bytes).unwrap();
     let got = import_path_textured(&path, &ImportOptions::default()).unwrap();
     assert!(got.warnings.is_empty(), "{:?}", got.warnings);

@@ -204,23 +204,21 @@ fn quantized_area(mesh: &IndexedMesh, quantization: &Quantization) -> f64 {
 /// degenerate patch (the guard then refuses, as without a gate).
 fn relief(patch: &CandidatePatch<'_>) -> f64 {
     let point = |p: [i32; 3]| DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64);
-    let polygon: Vec<DVec3> = patch.polygon[..patch.valence]
-        .iter()
-        .map(|&p| point(p))
-        .collect();
+    // No allocation: this runs for every protected candidate patch.
+    let polygon = || patch.polygon[..patch.valence].iter().map(|&p| point(p));
     let centre = point(patch.centre);
     let normal = patch
         .triangles
         .iter()
         .map(|t| {
-            let [a, b, c] = t.map(|i| polygon[usize::from(i)]);
+            let [a, b, c] = t.map(|i| point(patch.polygon[usize::from(i)]));
             (b - a).cross(c - a)
         })
         .sum::<DVec3>()
         .normalize_or_zero();
-    let k = polygon.len().max(1) as f64;
-    let centroid = polygon.iter().sum::<DVec3>() / k;
-    let radius = polygon.iter().map(|p| p.distance(centre)).sum::<f64>() / k;
+    let k = patch.valence.max(1) as f64;
+    let centroid = polygon().sum::<DVec3>() / k;
+    let radius = polygon().map(|p| p.distance(centre)).sum::<f64>() / k;
     if normal == DVec3::ZERO || radius <= 0.0 {
         return f64::INFINITY;
     }
