@@ -185,15 +185,33 @@ pub async fn uploads_as_jobs(db: TestDb) {
     socket.read_exact(&mut first).await.unwrap();
     assert_eq!(&first, b"HTTP/1.1 202");
     drop(socket);
-    eventually(Duration::from_secs(60), "the uploaded model", || async {
+    // The model is committed (and served) a moment before its job is marked
+    // done, so wait on the job itself, then check the model is there.
+    eventually(
+        Duration::from_secs(60),
+        "the upload job to finish",
+        || async {
+            let jobs: Value = http
+                .get(server.url("/api/jobs"))
+                .bearer_auth(&curator)
+                .send()
+                .await
+                .unwrap()
+                .json()
+                .await
+                .unwrap();
+            matches!(jobs["jobs"][0]["state"].as_str(), Some("done" | "failed"))
+        },
+    )
+    .await;
+    assert_eq!(
         http.get(server.url("/api/models/vase"))
             .send()
             .await
             .unwrap()
-            .status()
-            == StatusCode::OK
-    })
-    .await;
+            .status(),
+        StatusCode::OK
+    );
     let jobs: Value = http
         .get(server.url("/api/jobs"))
         .bearer_auth(&curator)
