@@ -339,8 +339,46 @@ check_leak() {
     if [ $ok = 1 ]; then report PASS leak "$detail"; else report FAIL leak "$detail"; fi
 }
 
+# 7. nginx keys the cache on the device class by Vitrine's own rule
+# (deploy/nginx.conf's $vitrine_device, visitor.rs's guess_device): for each
+# User-Agent (and Sec-CH-UA-Mobile) the class nginx keyed on is the class
+# the answering instance guessed, and a cached tablet manifest never
+# answers a desktop.
+check_device() {
+    local ok=1 detail="" n=0 line hint ua origin keyed
+    while IFS='|' read -r hint ua; do
+        n=$((n + 1))
+        local url="$proxy/api/models/topo?probe=device-$n"
+        local args=(-s -D "$work/device.h" -A "$ua")
+        [ -n "$hint" ] && args+=(-H "Sec-CH-UA-Mobile: $hint")
+        origin=$(curl "${args[@]}" "$url" | grep -o '"device":"[a-z]*"' | head -1 | cut -d'"' -f4)
+        keyed=$(grep -i '^x-vitrine-device:' "$work/device.h" | awk '{print $2}' | tr -d '\r')
+        [ "$origin" = "$keyed" ] || { ok=0; detail="$detail [$ua: nginx $keyed, Vitrine $origin]"; }
+    done <<'AGENTS'
+|Mozilla/5.0 (X11; Linux x86_64) AppleWebKit/537.36 Chrome/120.0 Safari/537.36
+|Mozilla/5.0 (iPad; CPU OS 17_0 like Mac OS X) AppleWebKit/605.1.15 Mobile/15E148
+|Mozilla/5.0 (iPhone; CPU iPhone OS 17_0 like Mac OS X) Mobile/15E148
+|Mozilla/5.0 (Linux; Android 14; Pixel 8) Chrome/120.0 Mobile Safari/537.36
+|Mozilla/5.0 (Linux; Android 14; SM-X710) Chrome/120.0 Safari/537.36
+|Mozilla/5.0 (Windows NT 10.0; Win64; x64; Tablet PC 2.0) Chrome/120.0
+?1|Mozilla/5.0 (Linux; Android 10; K) Chrome/120.0 Safari/537.36
+?0|Mozilla/5.0 (Linux; Android 10; K) Chrome/120.0 Safari/537.36
+?1|Mozilla/5.0 (iPad; CPU OS 17_0 like Mac OS X) Mobile/15E148
+|curl/8.0
+AGENTS
+    # One URL, a tablet first, then a desktop: the desktop is not served
+    # the tablet's cached copy.
+    local url="$proxy/api/models/topo?probe=device-shared" tablet desktop
+    tablet=$(curl -s -A "Mozilla/5.0 (iPad; CPU OS 17_0) Mobile/15E148" "$url" | grep -o '"device":"[a-z]*"' | head -1)
+    desktop=$(curl -s -A "Mozilla/5.0 (X11; Linux x86_64) Chrome/120.0" "$url" | grep -o '"device":"[a-z]*"' | head -1)
+    [ "$tablet" = '"device":"tablet"' ] && [ "$desktop" = '"device":"desktop"' ] || { ok=0; detail="$detail [shared URL: tablet $tablet, then desktop $desktop]"; }
+    detail="$n User-Agents: nginx's class = Vitrine's${detail:+; mismatches:$detail}; one URL asked by a tablet then a desktop: $tablet, $desktop"
+    if [ $ok = 1 ]; then report PASS device "$detail"; else report FAIL device "$detail"; fi
+}
+
 started=$(now)
 check_leak
+check_device
 check_crowd
 check_kill
 check_ingest
