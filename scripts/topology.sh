@@ -335,7 +335,18 @@ check_leak() {
         echo "$p" | grep -q '"audience":"public"' || ok=0
         echo "$p" | grep -q '"audience":"researcher"' && ok=0
     done
-    local detail="token, then the same URL without: researcher / $(echo "$public" | grep -o '"audience":"[a-z]*"' | head -1); the token request after a public one: ${reused:-no X-Cache-Status}"
+    # A payload only researchers may fetch: never stored, so the public
+    # asking the same URL next is refused by an instance, not served a copy.
+    local private_url private_r private_p
+    private_url=$(echo "$public" | grep -o '"url":"[^"]*","allowed":false' | tail -n 1 | cut -d'"' -f4)
+    if [ -n "$private_url" ]; then
+        private_r=$(code -H "Authorization: Bearer $token" "$proxy$private_url")
+        private_p=$(code "$proxy$private_url")
+        [ "$private_r" = 200 ] && [ "$private_p" != 200 ] || ok=0
+    else
+        ok=0 private_r="no level above the public cap" private_p="-"
+    fi
+    local detail="token, then the same URL without: researcher / $(echo "$public" | grep -o '"audience":"[a-z]*"' | head -1); the token request after a public one: ${reused:-no X-Cache-Status}; a researcher-only batch ($private_url): researcher $private_r, then the public $private_p"
     if [ $ok = 1 ]; then report PASS leak "$detail"; else report FAIL leak "$detail"; fi
 }
 
