@@ -12,6 +12,8 @@ command -v node >/dev/null 2>&1 || need_apt+=(nodejs npm)
 [ -x /usr/bin/chromium ] || need_apt+=(chromium)
 # The caching proxy of scripts/topology.sh (CI runs its --short version).
 command -v nginx >/dev/null 2>&1 || need_apt+=(nginx-light)
+# The meshopt crate (glTF's EXT_meshopt_compression) builds meshoptimizer's C++.
+command -v c++ >/dev/null 2>&1 || need_apt+=(g++)
 if [ ${#need_apt[@]} -gt 0 ]; then
     export DEBIAN_FRONTEND=noninteractive
     apt-get update -qq

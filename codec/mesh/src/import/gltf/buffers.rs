@@ -19,23 +19,46 @@ pub(super) struct Buffers<'a> {
 
 impl<'a> Buffers<'a> {
     pub(super) fn load(&mut self, buffer: &gltf::Buffer<'_>) -> Result<()> {
-        let i = buffer.index();
+        let uri = match buffer.source() {
+            Source::Bin => None,
+            Source::Uri(uri) => Some(uri),
+        };
+        self.load_uri(buffer.index(), uri, buffer.length())
+    }
+
+    /// [`Self::load`] for a buffer of the JSON document, before it is
+    /// validated (the decompression of `EXT_meshopt_compression` and
+    /// `KHR_draco_mesh_compression` reads buffers then).
+    pub(super) fn load_json(&mut self, i: usize, buffer: &gltf::json::Buffer) -> Result<()> {
+        let length = usize::try_from(buffer.byte_length.0).unwrap_or(usize::MAX);
+        self.load_uri(i, buffer.uri.as_deref(), length)
+    }
+
+    /// Buffer `i` is `data`, decoded from a compressed view or primitive.
+    pub(super) fn preload(&mut self, i: usize, data: Vec<u8>) {
+        if self.loaded.len() <= i {
+            self.loaded.resize(i + 1, None);
+        }
+        self.loaded[i] = Some(Cow::Owned(data));
+    }
+
+    fn load_uri(&mut self, i: usize, uri: Option<&str>, length: usize) -> Result<()> {
         if self.loaded.get(i).is_some_and(|b| b.is_some()) {
             return Ok(());
         }
         let what = self.what;
-        let data: Cow<'a, [u8]> = match buffer.source() {
-            Source::Bin => Cow::Borrowed(self.bin.ok_or_else(|| {
+        let data: Cow<'a, [u8]> = match uri {
+            None => Cow::Borrowed(self.bin.ok_or_else(|| {
                 Error::input(
                     what,
                     format!("buffer {i} refers to a GLB binary chunk that is absent"),
                 )
             })?),
-            Source::Uri(uri) if uri.starts_with("data:") => Cow::Owned(
+            Some(uri) if uri.starts_with("data:") => Cow::Owned(
                 decode_data_uri(uri)
                     .map_err(|e| Error::input(what, format!("buffer {i}: bad data URI: {e}")))?,
             ),
-            Source::Uri(uri) => {
+            Some(uri) => {
                 let Some(base) = self.base else {
                     return Err(Error::input(
                         what,
@@ -53,13 +76,13 @@ impl<'a> Buffers<'a> {
                 })?)
             }
         };
-        if data.len() < buffer.length() {
+        if data.len() < length {
             return Err(Error::input(
                 what,
                 format!(
                     "truncated: buffer {i} holds {} bytes but declares byteLength {}",
                     data.len(),
-                    buffer.length()
+                    length
                 ),
             ));
         }

@@ -104,12 +104,14 @@ fn check_attribute_accessors(root: &gltf::json::Root, what: &'static str) -> Res
     Ok(())
 }
 
-/// The JSON document of a `.gltf` or GLB file, and the GLB's binary chunk.
-pub(super) fn parse_document<'a>(
+/// The JSON document of a `.gltf` or GLB file, not yet validated (the
+/// compressed views and primitives are decoded into it first), and the
+/// GLB's binary chunk.
+pub(super) fn parse_root<'a>(
     bytes: &'a [u8],
     format: MeshFormat,
     what: &'static str,
-) -> Result<(gltf::Document, Option<&'a [u8]>)> {
+) -> Result<(gltf::json::Root, Option<&'a [u8]>)> {
     let (json, bin) = if bytes.starts_with(b"glTF") {
         split_glb(bytes, what)?
     } else if format == MeshFormat::Glb {
@@ -124,8 +126,13 @@ pub(super) fn parse_document<'a>(
         .map_err(|e| gltf_error(gltf::Error::Deserialize(e), what))?;
     super::extensions::accept_required(&mut root, what)?;
     check_attribute_accessors(&root, what)?;
-    let doc = gltf::Document::from_json(root).map_err(|e| gltf_error(e, what))?;
-    Ok((doc, bin))
+    Ok((root, bin))
+}
+
+/// The document, validated by the `gltf` crate.
+pub(super) fn validate(root: gltf::json::Root, what: &'static str) -> Result<gltf::Document> {
+    check_attribute_accessors(&root, what)?;
+    gltf::Document::from_json(root).map_err(|e| gltf_error(e, what))
 }
 
 #[cfg(test)]

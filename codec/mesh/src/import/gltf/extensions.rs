@@ -10,6 +10,9 @@ use crate::{Error, Result};
 
 /// Extensions the importer reads.
 pub(super) const READ: &[&str] = &[
+    // Decoded by `draco.rs` (draco-core) and `meshopt.rs` (meshopt).
+    "KHR_draco_mesh_compression",
+    "EXT_meshopt_compression",
     // Integer (normalized or not) positions and texture coordinates:
     // `Accessor::value` reads every component type.
     "KHR_mesh_quantization",
@@ -39,12 +42,6 @@ pub(super) const MATERIAL_ONLY: &[&str] = &[
 /// Why a known extension the importer cannot honour is refused.
 fn refusal(name: &str) -> &'static str {
     match name {
-        "KHR_draco_mesh_compression" => {
-            "Draco-compressed primitives are not decoded (no Draco decoder is built in)"
-        }
-        "EXT_meshopt_compression" => {
-            "meshoptimizer-compressed buffer views are not decoded (no meshopt decoder is built in)"
-        }
         "KHR_materials_pbrSpecularGlossiness" => {
             "its diffuse texture replaces the base colour texture the importer reads"
         }

@@ -18,6 +18,10 @@
 //! are images decoded, through [`super::texture`], and the reference's
 //! `KHR_texture_transform` applied to the coordinates.
 //!
+//! Compressed geometry is decoded into the document before it is
+//! validated: [`meshopt`] (`EXT_meshopt_compression` buffer views) and
+//! [`draco`] (`KHR_draco_mesh_compression` primitives).
+//!
 //! [`extensions`] says which required extensions are read, which are
 //! accepted because they only change how a material looks, and which are
 //! refused by name. Sparse accessors and `KHR_mesh_quantization`'s integer
@@ -39,8 +43,10 @@ mod accessor;
 mod buffers;
 mod colour;
 mod document;
+mod draco;
 mod extensions;
 mod material;
+mod meshopt;
 mod primitive;
 mod scene;
 mod surface;
@@ -94,13 +100,16 @@ fn read_inner(
     } else {
         format.name()
     };
-    let (doc, bin) = document::parse_document(bytes, format, what)?;
+    let (mut root, bin) = document::parse_root(bytes, format, what)?;
     let mut buffers = Buffers {
         what,
         base,
         bin,
         loaded: Vec::new(),
     };
+    meshopt::decode_views(&mut root, &mut buffers, opts)?;
+    draco::decode_primitives(&mut root, &mut buffers, opts)?;
+    let doc = document::validate(root, what)?;
     let instances = scene::mesh_instances(&doc, what)?;
     let mut reading = Reading {
         what,
