@@ -69,8 +69,11 @@ async fn json(http: &reqwest::Client, url: &str, token: Option<&str>) -> Value {
     serde_json::from_slice(&body).unwrap()
 }
 
+/// Positions and normals as bit patterns, and colours.
+type CloudBits = (Vec<[u32; 3]>, Vec<[u32; 3]>, Option<Vec<[u8; 3]>>);
+
 /// Bit patterns, so that equal means bit-exact (and NaN would not hide).
-fn bits(cloud: &PointCloud) -> (Vec<[u32; 3]>, Vec<[u32; 3]>, Option<Vec<[u8; 3]>>) {
+fn bits(cloud: &PointCloud) -> CloudBits {
     let f = |v: &[[f32; 3]]| v.iter().map(|p| p.map(f32::to_bits)).collect::<Vec<_>>();
     (
         f(&cloud.positions),
