@@ -1,6 +1,7 @@
 //! `vitrine sample cloud` and `vitrine ingest` of a point cloud, as a user
 //! runs them (issue 21): a PLY without faces is stored as a point stream,
-//! and `--kind mesh` on it fails with a message that says what it is.
+//! and `--kind mesh` on it fails with a message that says what it is; a
+//! LAZ file (georeferenced, without normals) is one too.
 
 use std::path::Path;
 use std::process::{Command, Output};
@@ -79,4 +80,63 @@ fn faceless_ply_is_ingested_as_points() {
     let line = listed.lines().find(|l| l.starts_with("cube")).unwrap_or("");
     assert!(line.contains(" points "), "{listed}");
     assert!(!listed.contains("forced"), "{listed}");
+}
+
+/// A LAZ file of `n` points on a gently sloping 40-wide grid, far from the
+/// origin as georeferenced scans are, with colour and without normals.
+fn laz_bytes(n: usize) -> Vec<u8> {
+    let mut b = las::Builder::from((1, 2));
+    b.point_format = las::point::Format::new(2).unwrap();
+    b.point_format.is_compressed = true;
+    let t = |offset| las::Transform {
+        scale: 0.001,
+        offset,
+    };
+    b.transforms = las::Vector {
+        x: t(500_000.0),
+        y: t(4_000_000.0),
+        z: t(0.0),
+    };
+    let header = b.into_header().unwrap();
+    let mut w = las::Writer::new(std::io::Cursor::new(Vec::new()), header).unwrap();
+    for i in 0..n {
+        let (col, row) = ((i % 40) as f64, (i / 40) as f64);
+        w.write_point(las::Point {
+            x: 500_000.0 + col * 0.05,
+            y: 4_000_000.0 + row * 0.05,
+            z: 12.5 + 0.01 * col,
+            color: Some(las::Color::new((i * 257) as u16, 65535, 0)),
+            ..Default::default()
+        })
+        .unwrap();
+    }
+    w.close().unwrap();
+    w.into_inner().unwrap().into_inner()
+}
+
+#[test]
+fn laz_is_ingested_as_points_with_estimated_normals() {
+    let dir = tempfile::tempdir().unwrap();
+    let laz = dir.path().join("site.laz");
+    std::fs::write(&laz, laz_bytes(2000)).unwrap();
+    let db = format!("sqlite:{}", dir.path().join("v.db").display());
+    let out = vitrine(&[
+        "ingest",
+        text(&laz),
+        "--db",
+        &db,
+        "--slug",
+        "site",
+        "--title",
+        "Site",
+    ]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(stdout.contains("point cloud"), "{stdout}");
+    assert!(stdout.contains("→ 2000 points"), "{stdout}");
+    assert!(stdout.contains("normals estimated"), "{stdout}");
 }
