@@ -16,6 +16,7 @@ use vitrine::commands::sample::{cloud, write_cloud_ply};
 use vitrine::ingest::points::ingest_points;
 use vitrine::ingest::{IngestOptions, ModelMeta};
 use vitrine::storage::TokenScope;
+use vitrine::AppState;
 use vitrine_points::stream::{self, EncodeOptions, Limits};
 use vitrine_points::PointCloud;
 
@@ -93,7 +94,8 @@ pub async fn points_streamed_under_caps(db: TestDb) {
     let mut config = test_config();
     config.caps.phone_max_vertices = counts[1];
     config.caps.tablet_max_vertices = counts[last - 1];
-    let server = TestServer::start(db.storage.clone(), config).await;
+    let state = AppState::new(db.storage.clone(), config);
+    let server = TestServer::serve(state.clone()).await;
     let http = reqwest::Client::new();
     let researcher = token_for(&db, None).await;
 
@@ -194,6 +196,30 @@ pub async fn points_streamed_under_caps(db: TestDb) {
     assert_eq!(body["reason"], "device");
     let tablet = json(&http, &server.url("/api/models/cube?device=tablet"), None).await;
     assert_eq!(tablet["cap"]["level"], last - 1);
+    // Load at its highest: the cap falls to the good-enough level (the
+    // first with 20 % of the points), even for a researcher.
+    state.load().force_pressure(Some(u8::MAX));
+    let loaded = json(&http, &server.url("/api/models/cube"), Some(&researcher)).await;
+    let good = counts
+        .iter()
+        .position(|&c| f64::from(c) >= 0.2 * f64::from(counts[last]))
+        .unwrap();
+    assert_eq!(loaded["good_enough_level"], good);
+    assert_eq!(
+        (
+            loaded["cap"]["level"].as_u64(),
+            loaded["cap"]["reason"].as_str()
+        ),
+        (Some(good as u64), Some("load"))
+    );
+    assert!(
+        good < last,
+        "the sample's good-enough level is below its last: {counts:?}"
+    );
+    let (status, headers, _) = get(&http, &batch(good + 1), Some(&researcher)).await;
+    assert_eq!(status, StatusCode::TOO_MANY_REQUESTS);
+    assert!(headers.contains_key(reqwest::header::RETRY_AFTER));
+    state.load().force_pressure(None);
 
     // No GLB of a cloud, with a message that says why.
     let (status, _, body) = get(
