@@ -1,23 +1,32 @@
-//! `vitrine ingest <mesh> --db … --slug … --title …`
+//! `vitrine ingest <mesh|cloud> --db … --slug … --title …`: a mesh, or a
+//! point cloud (a PLY without faces, LAS, LAZ) stored as a point stream.
 
 use super::guard::GuardArgs;
 use crate::database::open_storage;
+use crate::ingest::points::{detect_kind, ingest_points, load_cloud};
 use crate::ingest::{
     ingest_coloured, IngestOptions, IngestReport, MeasuredQuality, ModelMeta, SourceInfo,
 };
 use crate::source::load_coloured_frame;
-use crate::storage::{ConnectOptions, OnExisting, UpAxis};
+use crate::storage::{ConnectOptions, ModelKind, OnExisting, UpAxis};
 use std::path::PathBuf;
 use std::time::Duration;
 use vitrine_codec::EncodeOptions;
 use vitrine_colour::ccc::CccOptions;
 use vitrine_colour::ColourMode;
+use vitrine_points::stream::EncodeOptions as PointEncodeOptions;
 use vitrine_quality::QualityOptions;
 
 #[derive(clap::Args, Clone, Debug)]
 pub struct IngestArgs {
-    /// Mesh file: PLY, OBJ, OFF, glTF, GLB or MD2.
+    /// Mesh file (PLY, OBJ, OFF, glTF, GLB or MD2) or point cloud (PLY
+    /// without faces, LAS, LAZ).
     pub mesh: PathBuf,
+    /// What the file is stored as: `mesh`, or `points` (a progressive point
+    /// stream; a mesh PLY's vertices are taken as the points). Default:
+    /// `points` for LAS, LAZ and a PLY that declares no faces, else `mesh`.
+    #[arg(long, value_enum)]
+    pub kind: Option<ModelKind>,
     /// MD2: the animation frame the stream carries (its skin becomes the
     /// texture the cell complex samples).
     #[arg(long, default_value_t = 0)]
@@ -43,9 +52,10 @@ pub struct IngestArgs {
     /// If the slug exists, add a new version instead of refusing.
     #[arg(long)]
     pub new_version: bool,
-    /// Position quantization, 8–16 bits.
-    #[arg(long, default_value_t = 12)]
-    pub quantization_bits: u8,
+    /// Position quantization: 8–16 bits for a mesh (default 12), 1–20 for
+    /// a point cloud (default 14).
+    #[arg(long)]
+    pub quantization_bits: Option<u8>,
     /// How colour travels: `ccc` (a cubic cell complex: a cell texture and
     /// a colour texture shared by every level, sampled from the file's
     /// colour texture (OBJ, glTF) or else its per-vertex colour; the stream
@@ -119,14 +129,24 @@ impl CccArgs {
 pub async fn run(args: IngestArgs) -> anyhow::Result<()> {
     super::init_tracing();
     let options = args.options()?;
+    let detected = detect_kind(&args.mesh)?;
+    match args.kind.unwrap_or(detected) {
+        ModelKind::Points => return run_points(args, options).await,
+        ModelKind::Mesh if detected == ModelKind::Points => {
+            // The mesh importer would only say "contains no faces".
+            anyhow::bail!(
+                "{} is a point cloud (no faces): it cannot be stored as a mesh; \
+                 ingest it with --kind points (the default for this file)",
+                args.mesh.display()
+            );
+        }
+        ModelKind::Mesh => {}
+    }
     let (path, frame) = (args.mesh.clone(), args.frame);
     let (source, info) = tokio::task::spawn_blocking(move || -> anyhow::Result<_> {
         let source = load_coloured_frame(&path, frame)?;
         let info = SourceInfo {
-            name: path
-                .file_name()
-                .map(|n| n.to_string_lossy().into_owned())
-                .unwrap_or_default(),
+            name: file_name(&path),
             vertices: source.imported_vertices as u64,
             faces: source.imported_faces as u64,
             repair: Some(source.repair.to_string()),
@@ -140,6 +160,41 @@ pub async fn run(args: IngestArgs) -> anyhow::Result<()> {
     let report = ingest_coloured(&*storage, source.mesh, source.texture, meta, &options).await?;
     print_report(&slug, &report);
     Ok(())
+}
+
+/// Reads the file as a point cloud and stores it as a point stream.
+async fn run_points(args: IngestArgs, options: IngestOptions) -> anyhow::Result<()> {
+    let path = args.mesh.clone();
+    let cloud = tokio::task::spawn_blocking(move || load_cloud(&path)).await??;
+    let info = SourceInfo {
+        name: file_name(&args.mesh),
+        vertices: cloud.len() as u64,
+        faces: 0,
+        repair: None,
+    };
+    let had_normals = cloud.normals.is_some();
+    let storage = open_storage(&args.db, &ConnectOptions::default(), false).await?;
+    let meta = args.meta(info);
+    let slug = meta.slug.clone();
+    let report = ingest_points(&*storage, cloud, meta, &options).await?;
+    println!(
+        "ingested {slug} version {} (compression {}): point cloud, {} levels, {} → {} points, {} bytes, normals {}, encoded in {:.1} s",
+        report.stored.version,
+        report.stored.compression_id,
+        report.levels,
+        report.base_vertices,
+        report.full_vertices,
+        report.stream_bytes,
+        if had_normals { "from the file" } else { "estimated" },
+        report.encode_time.as_secs_f64(),
+    );
+    Ok(())
+}
+
+fn file_name(path: &std::path::Path) -> String {
+    path.file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default()
 }
 
 impl IngestArgs {
@@ -164,8 +219,12 @@ impl IngestArgs {
     fn options(&self) -> anyhow::Result<IngestOptions> {
         Ok(IngestOptions {
             encode: EncodeOptions {
-                quantization_bits: self.quantization_bits,
+                quantization_bits: self.quantization_bits.unwrap_or(12),
                 ..EncodeOptions::default()
+            },
+            points: PointEncodeOptions {
+                bits: self.quantization_bits.unwrap_or(14),
+                ..PointEncodeOptions::default()
             },
             colour: self.colour,
             ccc: self.ccc.options(),

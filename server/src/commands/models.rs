@@ -25,7 +25,7 @@ pub fn models_table(models: &[ModelSummary]) -> (String, usize) {
         .unwrap_or(4)
         .max(4);
     let mut out = format!(
-        "{:width$}  version  levels  public  stream format\n",
+        "{:width$}  version    kind  levels  public  stream format\n",
         "slug"
     );
     let mut stale = 0;
@@ -37,15 +37,16 @@ pub fn models_table(models: &[ModelSummary]) -> (String, usize) {
             format!(
                 "{} (this build reads {}: ingest it again)",
                 m.stream_format,
-                vitrine_codec::VERSION
+                m.kind.reads()
             )
         };
         let public = if m.public_access { "yes" } else { "no" };
         let _ = writeln!(
             out,
-            "{:width$}  {:>7}  {:>6}  {public:>6}  {format}",
+            "{:width$}  {:>7}  {:>6}  {:>6}  {public:>6}  {format}",
             m.slug,
             m.version,
+            m.kind.name(),
             m.batch_count + 1
         );
     }

@@ -39,15 +39,21 @@ pub const UNITS: [&str; 4] = ["mm", "cm", "m", "in"];
 ///
 /// The sign is never guessed: `--up -z` says a model is upside down.
 pub fn detect_up(path: Option<&Path>, mesh: &IndexedMesh) -> UpAxis {
+    detect_up_of(path, &mesh.positions)
+}
+
+/// [`detect_up`] of positions alone (a point cloud's); LAS/LAZ, whose
+/// coordinates are geographic, have z up.
+pub fn detect_up_of(path: Option<&Path>, positions: &[[f32; 3]]) -> UpAxis {
     let extension = path
         .and_then(|p| p.extension())
         .map(|e| e.to_string_lossy().to_ascii_lowercase());
     match extension.as_deref() {
         Some("gltf" | "glb") => UpAxis::Y,
-        Some("md2") => UpAxis::Z,
+        Some("md2" | "las" | "laz") => UpAxis::Z,
         _ => {
             let (mut min, mut max) = (Vec3::INFINITY, Vec3::NEG_INFINITY);
-            for p in &mesh.positions {
+            for p in positions {
                 min = min.min(Vec3::from(*p));
                 max = max.max(Vec3::from(*p));
             }
@@ -85,14 +91,19 @@ pub fn measure_levels(
 }
 
 pub fn bounds_of(mesh: &IndexedMesh) -> Bounds {
+    bounds_of_positions(&mesh.positions)
+}
+
+/// The bounds of `positions` (all zero when there are none).
+pub fn bounds_of_positions(positions: &[[f32; 3]]) -> Bounds {
     let (mut min, mut max) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
-    for p in &mesh.positions {
+    for p in positions {
         for i in 0..3 {
             min[i] = min[i].min(f64::from(p[i]));
             max[i] = max[i].max(f64::from(p[i]));
         }
     }
-    if mesh.positions.is_empty() {
+    if positions.is_empty() {
         return Bounds {
             min: [0.0; 3],
             max: [0.0; 3],

@@ -3,10 +3,12 @@
 //! commit; a crash or kill before it leaves no trace. With
 //! [`IngestOptions::quality`], every level is measured against the original
 //! first (outside the transaction) and the curve is stored in the level rows.
+//! Point clouds take the same road through [`points::ingest_points`].
 
 pub mod curation;
 mod guards;
 mod mapping;
+pub mod points;
 mod store;
 
 pub use guards::{threshold_name, FeatureSummary, GuardOptions, Guards};
@@ -17,7 +19,7 @@ use anyhow::{bail, Context};
 use std::path::Path;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
-use store::{store, Product};
+use store::{stage_and_commit, store, Product};
 use vitrine_codec::{EncodeOptions, Encoded, IndexedMesh, Limits};
 use vitrine_colour::ccc::{CccOptions, CccReport, TextureMapping};
 use vitrine_colour::{encode_coloured, ColourMode};
@@ -72,6 +74,8 @@ pub struct SourceInfo {
 #[derive(Clone, Debug, Default)]
 pub struct IngestOptions {
     pub encode: EncodeOptions,
+    /// The point stream's options, for a point cloud ([`points`]).
+    pub points: vitrine_points::stream::EncodeOptions,
     /// How colour travels (`ccc`, `vertex`, `vertex-metric`, `none`; see
     /// `vitrine_colour::ColourMode`). `None`: `vertex` when the mesh has
     /// colour or a texture, else `none`.

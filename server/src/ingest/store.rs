@@ -6,7 +6,9 @@ use super::{
     threshold_name, Curated, FeatureSummary, IngestOptions, IngestReport, MeasuredQuality,
     ModelMeta, SourceInfo,
 };
-use crate::storage::{LevelMetrics, NewCompression, NewLevel, NewModel, Storage, StoredModel};
+use crate::storage::{
+    LevelMetrics, ModelKind, NewCompression, NewLevel, NewModel, Storage, StoredModel,
+};
 use anyhow::{bail, Context};
 use serde_json::json;
 use std::ops::Range;
@@ -50,6 +52,7 @@ pub(super) async fn store(
         title: meta.title.clone(),
         description: meta.description.clone(),
         policy: meta.policy.clone(),
+        kind: ModelKind::Mesh,
         good_enough_level: meta.good_enough_level,
         on_existing: meta.on_existing,
         source_name: (!source.name.is_empty()).then(|| source.name.clone()),
@@ -181,7 +184,7 @@ fn stats_json(
     })
 }
 
-async fn stage_and_commit(
+pub(super) async fn stage_and_commit(
     storage: &dyn Storage,
     new: &NewModel,
     pause_before_commit: Option<Duration>,

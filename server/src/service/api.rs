@@ -7,7 +7,7 @@ use super::manifest::{self, Manifest};
 use super::servable::{ServableModel, SlugParam};
 use super::visitor::{HintQuery, VisitorHints};
 use super::AppState;
-use crate::storage::ModelSummary;
+use crate::storage::{ModelKind, ModelSummary};
 use axum::extract::State;
 use axum::response::{IntoResponse, Response};
 use axum::Json;
@@ -25,6 +25,8 @@ struct ListedModel {
     slug: String,
     title: String,
     version: u32,
+    /// `mesh` or `points` (a point cloud).
+    kind: ModelKind,
     /// Base mesh plus batches.
     levels: u32,
     manifest_url: String,
@@ -83,6 +85,7 @@ pub async fn list(
             slug: m.slug,
             title: m.title,
             version: m.version,
+            kind: m.kind,
             levels: m.batch_count + 1,
         })
         .collect();

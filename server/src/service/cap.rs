@@ -205,6 +205,7 @@ mod tests {
             model_id: 1,
             slug: "m".into(),
             version: 1,
+            kind: Default::default(),
             title: "M".into(),
             description: String::new(),
             policy,

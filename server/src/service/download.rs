@@ -9,6 +9,7 @@ use super::payload::{cache_control, level_bytes, not_modified, not_modified_resp
 use super::servable::{ServableModel, SlugParam};
 use super::visitor::HintQuery;
 use super::AppState;
+use crate::storage::ModelKind;
 use axum::extract::{RawQuery, State};
 use axum::http::{header, HeaderMap, HeaderValue};
 use axum::response::{IntoResponse, Response};
@@ -43,7 +44,8 @@ pub struct DownloadQuery {
         (status = 403, description = "The policy allows no downloads (`not_allowed`), or the level \
             is above the audience or device cap (`level_capped`)", body = ErrorBody),
         (status = 404, description = "No such model or level", body = ErrorBody),
-        (status = 409, description = "Stored in a stream format this build cannot decode", body = ErrorBody),
+        (status = 409, description = "Stored in a stream format this build cannot decode, or a \
+            point cloud (`conflict`: only meshes are downloaded as GLB)", body = ErrorBody),
         (status = 429, description = "Above the cap set by server load", body = LevelCappedBody,
             headers(("Retry-After" = u64, description = "Seconds to wait before asking again"))),
         (status = 503, description = "Database unavailable, or downloads busy", body = ErrorBody,
@@ -58,6 +60,12 @@ pub async fn download(
 ) -> Result<Response, AppError> {
     let query: DownloadQuery = serde_urlencoded::from_str(query.as_deref().unwrap_or(""))
         .map_err(|e| AppError::BadRequest(format!("query: {e}")))?;
+    if record.kind == ModelKind::Points {
+        return Err(AppError::Conflict(format!(
+            "model {:?} is a point cloud: GLB downloads are of meshes only (fetch its levels from the manifest)",
+            record.slug
+        )));
+    }
     if !record.policy.downloads {
         return Err(AppError::NotAllowed(format!(
             "model {:?} cannot be downloaded: its policy ({}) allows no downloads",

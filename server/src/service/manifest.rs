@@ -4,7 +4,7 @@
 
 use super::cap::{good_enough_level, Audience, CapReason, DeviceClass, LevelCap};
 use super::{AppState, Visitor};
-use crate::storage::{ModelRecord, TextureRef};
+use crate::storage::{ModelKind, ModelRecord, TextureRef};
 use serde::Serialize;
 use utoipa::ToSchema;
 
@@ -14,7 +14,13 @@ pub struct Manifest<'a> {
     version: u32,
     title: &'a str,
     description: &'a str,
+    /// `mesh`: the payloads are the mesh stream's base and batches
+    /// (`codec/core/FORMAT.md`); `points`: a point cloud, the payloads are
+    /// the point stream's header with its first level, then one level each
+    /// (`codec/points/FORMAT.md`, VPTS), concatenated in order to decode.
+    kind: ModelKind,
     compression_id: i64,
+    /// Position bits per axis (for a point cloud, the octree's depth).
     quantization_bits: u8,
     has_colour: bool,
     /// Index of the full-resolution level (= number of batches).
@@ -56,8 +62,15 @@ struct ManifestBounds {
 #[derive(Serialize, ToSchema)]
 struct ManifestLevel {
     level: u32,
+    /// Vertices of the mesh at this level; for a point cloud, its points.
     vertices: u32,
+    /// 0 for a point cloud.
     faces: u32,
+    /// Points after this level (cumulative: every level is a prefix of the
+    /// next), for a point cloud; absent for a mesh.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    #[schema(nullable = false)]
+    points: Option<u32>,
     bytes: u64,
     /// Symmetric Hausdorff distance to the original over its bounding-box
     /// diagonal, measured at ingest (sampled by default, with `--quality`
@@ -66,7 +79,8 @@ struct ManifestLevel {
     /// Lindstrom–Turk image RMSE (luma, 0–255, 24 views) against the
     /// original, when measured at ingest; also in `quality`.
     rmse: Option<f64>,
-    /// The payload that produces this level: the base for level 0.
+    /// The payload that produces this level: the base for level 0 (for a
+    /// point cloud, the stream header with level 0).
     url: String,
     /// Within this visitor's cap now.
     allowed: bool,
@@ -203,6 +217,7 @@ pub fn build<'a>(
         version: record.version,
         title: &record.title,
         description: &record.description,
+        kind: record.kind,
         compression_id: record.compression_id,
         quantization_bits: record.quantization_bits,
         has_colour: record.has_colour,
@@ -254,6 +269,7 @@ fn levels(record: &ModelRecord, cap: LevelCap) -> Vec<ManifestLevel> {
             level: k as u32,
             vertices: l.vertices,
             faces: l.faces,
+            points: (record.kind == ModelKind::Points).then_some(l.vertices),
             bytes: l.bytes,
             hausdorff: l.hausdorff,
             rmse: l.rmse,

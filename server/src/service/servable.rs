@@ -89,7 +89,7 @@ impl ServableModel {
             return Err(AppError::StaleFormat {
                 slug: record.slug.clone(),
                 stored: record.stream_format,
-                reads: vitrine_codec::VERSION,
+                reads: record.kind.reads(),
             });
         }
         Ok(ServableModel { record, visitor })

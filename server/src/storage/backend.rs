@@ -18,6 +18,7 @@ macro_rules! sql_storage {
                     model_id: row.try_get("model_id").map_err(get)?,
                     slug: row.try_get("slug").map_err(get)?,
                     version: narrow(row.try_get("version").map_err(get)?, "model.version")?,
+                    kind: Self::kind_from_row(row)?,
                     title: row.try_get("title").map_err(get)?,
                     description: row.try_get("description").map_err(get)?,
                     policy: AudiencePolicy {
@@ -70,6 +71,18 @@ macro_rules! sql_storage {
                         thumbnail_sha256: row.try_get("thumbnail_sha256").map_err(get)?,
                     },
                 })
+            }
+
+            /// Column `model.kind` of a row.
+            fn kind_from_row(
+                row: &<$db as sqlx::Database>::Row,
+            ) -> $crate::storage::Result<ModelKind> {
+                use sqlx::Row;
+                let name: String = row
+                    .try_get("kind")
+                    .map_err(|e| StorageError::Corrupt(e.to_string()))?;
+                ModelKind::parse(&name)
+                    .ok_or_else(|| StorageError::Corrupt(format!("model.kind = {name:?}")))
             }
 
             /// Fills in levels and textures of a record read by `sql`.
@@ -199,6 +212,7 @@ macro_rules! sql_storage {
                             slug: row.try_get("slug").map_err(c)?,
                             title: row.try_get("title").map_err(c)?,
                             version: narrow(row.try_get("version").map_err(c)?, "model.version")?,
+                            kind: Self::kind_from_row(row)?,
                             created_at_ms: row.try_get("created_at").map_err(c)?,
                             public_access: row.try_get("public_access").map_err(c)?,
                             batch_count: narrow(

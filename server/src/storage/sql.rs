@@ -8,7 +8,7 @@ use async_trait::async_trait;
 
 macro_rules! record_select {
     () => {
-        "SELECT m.id AS model_id, m.slug, m.version, m.title, m.description, \
+        "SELECT m.id AS model_id, m.slug, m.version, m.kind, m.title, m.description, \
          m.good_enough_level, m.created_at, p.name AS policy_name, p.public_access, \
          p.public_max_vertex_fraction, p.public_full_resolution, p.token_full_resolution, p.downloads, \
          c.id AS compression_id, c.codec_version, c.quantization_bits, c.has_colour, c.mapping_id, \
@@ -39,7 +39,7 @@ pub(super) const TEXTURES: &str = "SELECT t.id, t.kind, t.media_type, t.byte_len
      FROM texture_mapping tm \
      JOIN texture t ON t.id IN (tm.cell_texture_id, tm.colour_texture_id, tm.colour_low_texture_id) \
      WHERE tm.id = $1 ORDER BY t.id";
-pub(super) const LIST: &str = "SELECT m.slug, m.title, m.version, m.created_at, p.public_access, c.batch_count, c.codec_version, \
+pub(super) const LIST: &str = "SELECT m.slug, m.title, m.version, m.kind, m.created_at, p.public_access, c.batch_count, c.codec_version, \
      (th.model_id IS NOT NULL) AS has_thumbnail \
      FROM model m JOIN audience_policy p ON p.id = m.policy_id JOIN compression c ON c.model_id = m.id \
      LEFT JOIN thumbnail th ON th.model_id = m.id \
@@ -65,8 +65,8 @@ pub(super) const MAX_VERSION: &str = "SELECT MAX(version) AS v FROM model WHERE 
 pub(super) const INSERT_MODEL: &str =
     "INSERT INTO model (slug, version, title, description, policy_id, \
      good_enough_level, source_name, source_vertices, source_faces, status, created_at, \
-     up_axis, unit, bounds) \
-     VALUES ($1, $2, $3, $4, $5, $6, $7, $8, $9, 'ready', $10, $11, $12, $13) RETURNING id";
+     up_axis, unit, bounds, kind) \
+     VALUES ($1, $2, $3, $4, $5, $6, $7, $8, $9, 'ready', $10, $11, $12, $13, $14) RETURNING id";
 pub(super) const INSERT_THUMBNAIL: &str = "INSERT INTO thumbnail \
      (model_id, media_type, width, height, byte_len, sha256, bytes, created_at) \
      VALUES ($1, $2, $3, $4, $5, $6, $7, $8)";

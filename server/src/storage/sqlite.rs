@@ -5,7 +5,7 @@ use super::curator::curator_storage;
 use super::study::study_storage;
 use super::{
     is_connection_error, AudiencePolicy, Bounds, ConnectOptions, Curation, LevelRecord,
-    MappingRecord, ModelRecord, ModelSummary, NewModel, NewToken, StagedModel, Storage,
+    MappingRecord, ModelKind, ModelRecord, ModelSummary, NewModel, NewToken, StagedModel, Storage,
     StorageError, TexturePayload, TextureRef, TokenGrant, TokenScope, UpAxis,
 };
 use sqlx::sqlite::{SqliteConnectOptions, SqliteJournalMode, SqlitePoolOptions, SqliteSynchronous};

@@ -41,6 +41,7 @@ macro_rules! stage_body {
             .bind($model.up_axis.map(|a| a.name()))
             .bind($model.unit.clone())
             .bind($model.bounds.map(|b| b.to_json()))
+            .bind($model.kind.name())
             .fetch_one(&mut *$tx)
             .await
             .map_err(conflict)?;

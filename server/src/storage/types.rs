@@ -83,12 +83,52 @@ pub struct MappingRecord {
     pub parameters: serde_json::Value,
 }
 
+/// What a model version is (column `model.kind`): a mesh stream
+/// (`codec/core/FORMAT.md`) or a point stream (`codec/points/FORMAT.md`),
+/// stored in the same tables (see the migration `model_kind`).
+#[derive(
+    Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, utoipa::ToSchema, clap::ValueEnum,
+)]
+#[serde(rename_all = "lowercase")]
+pub enum ModelKind {
+    #[default]
+    Mesh,
+    Points,
+}
+
+impl ModelKind {
+    pub fn name(self) -> &'static str {
+        match self {
+            ModelKind::Mesh => "mesh",
+            ModelKind::Points => "points",
+        }
+    }
+
+    pub fn parse(name: &str) -> Option<ModelKind> {
+        match name {
+            "mesh" => Some(ModelKind::Mesh),
+            "points" => Some(ModelKind::Points),
+            _ => None,
+        }
+    }
+
+    /// The stream format version this build decodes for this kind.
+    pub fn reads(self) -> u8 {
+        match self {
+            ModelKind::Mesh => vitrine_codec::VERSION,
+            ModelKind::Points => vitrine_points::stream::VERSION,
+        }
+    }
+}
+
 /// A visible model version and the compression the service serves for it.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ModelRecord {
     pub model_id: i64,
     pub slug: String,
     pub version: u32,
+    /// Mesh or point cloud.
+    pub kind: ModelKind,
     pub title: String,
     pub description: String,
     pub policy: AudiencePolicy,
@@ -101,7 +141,8 @@ pub struct ModelRecord {
     /// Stream format version the payloads were encoded in (column
     /// `compression.codec_version`, `codec/core/FORMAT.md`).
     pub stream_format: u8,
-    /// `levels[0]` is the base mesh, `levels[k]` the mesh after batch `k`.
+    /// `levels[0]` is the base mesh, `levels[k]` the mesh after batch `k`
+    /// (for a point cloud: `vertices` counts the points so far, `faces` is 0).
     pub levels: Vec<LevelRecord>,
     /// The CCC colour mapping, if the model has one.
     pub mapping: Option<MappingRecord>,
@@ -134,7 +175,7 @@ impl ModelRecord {
     /// Whether this build's decoder (and so its viewer) reads the stored
     /// payloads: streams of another format version must be re-ingested.
     pub fn servable(&self) -> bool {
-        self.stream_format == vitrine_codec::VERSION
+        self.stream_format == self.kind.reads()
     }
 }
 
@@ -144,6 +185,8 @@ pub struct ModelSummary {
     pub slug: String,
     pub title: String,
     pub version: u32,
+    /// Mesh or point cloud.
+    pub kind: ModelKind,
     #[serde(skip)]
     pub public_access: bool,
     pub batch_count: u32,
@@ -157,7 +200,7 @@ pub struct ModelSummary {
 impl ModelSummary {
     /// See [`ModelRecord::servable`].
     pub fn servable(&self) -> bool {
-        self.stream_format == vitrine_codec::VERSION
+        self.stream_format == self.kind.reads()
     }
 }
 
@@ -252,6 +295,8 @@ pub struct NewModel {
     pub description: String,
     /// Name of an `audience_policy` row.
     pub policy: String,
+    /// Mesh or point cloud: says what the compression's payloads are.
+    pub kind: ModelKind,
     pub good_enough_level: Option<u32>,
     pub on_existing: OnExisting,
     pub source_name: Option<String>,

@@ -11,6 +11,7 @@ mod download;
 mod harness;
 mod http;
 mod kill;
+mod points;
 mod proxy;
 mod quality;
 mod slow;
@@ -80,6 +81,8 @@ on_both_backends!(
     curators::annotations_and_scopes,
     uploads::uploads_as_jobs,
     curation::curation_in_manifest_and_thumbnail,
+    points::points_streamed_under_caps,
+    points::cloud_uploads,
 );
 
 /// `server/openapi.json` is the served description, committed for reviewers

@@ -256,6 +256,17 @@ impl Models {
         let measured = id(ingest_sample(s, "measured", "open").await);
         let painted = ingest_coloured(db, "painted", "open").await;
         let hidden = ingest_coloured(db, "hidden", "researchers").await;
+        // A point cloud: its manifest has `kind` and per-level `points`.
+        let mut meta = ModelMeta::new("cloud", "Cloud");
+        meta.policy = "open-download".into();
+        vitrine::ingest::points::ingest_points(
+            s,
+            vitrine::commands::sample::cloud(2000, true, 0.0),
+            meta,
+            &IngestOptions::default(),
+        )
+        .await
+        .expect("ingest a point cloud");
         let stale_format = vitrine_codec::VERSION - 1;
         for sql in [
             format!("UPDATE compression SET codec_version = {stale_format} WHERE id = {stale}"),
@@ -351,6 +362,8 @@ pub async fn responses_match_openapi(db: TestDb) {
         call("/api/models/open", 200),
         call("/api/models/measured", 200),
         call("/api/models/painted", 200),
+        call("/api/models/cloud", 200),
+        call("/m/cloud", 200),
         call("/api/models/open?device=phone", 200),
         call_with("/api/models/vault", with_token, 200),
         call("/api/models/Not_A_Slug", 400),
@@ -685,5 +698,8 @@ async fn download_calls(spec: &mut Spec, server: &TestServer, db: &TestDb) {
     )
     .await;
     spec.check(server, call("/api/models/open/download.glb", 403))
+        .await;
+    // A point cloud is no mesh: 409, whatever its policy allows.
+    spec.check(server, call("/api/models/cloud/download.glb", 409))
         .await;
 }

@@ -18,7 +18,7 @@ fn sample_ply() -> Vec<u8> {
     bytes
 }
 
-fn form(file_name: &str, bytes: Vec<u8>, slug: &str) -> reqwest::multipart::Form {
+pub fn form(file_name: &str, bytes: Vec<u8>, slug: &str) -> reqwest::multipart::Form {
     reqwest::multipart::Form::new()
         .text("slug", slug.to_owned())
         .text("title", format!("Uploaded {slug}"))
@@ -30,14 +30,14 @@ fn form(file_name: &str, bytes: Vec<u8>, slug: &str) -> reqwest::multipart::Form
         )
 }
 
-fn upload_config(dir: &std::path::Path) -> ServiceConfig {
+pub fn upload_config(dir: &std::path::Path) -> ServiceConfig {
     let mut config = test_config();
     config.uploads.dir = dir.to_owned();
     config.uploads.limit_bytes = 512 * 1024;
     config
 }
 
-async fn job_until_finished(http: &reqwest::Client, url: &str, token: &str) -> Value {
+pub async fn job_until_finished(http: &reqwest::Client, url: &str, token: &str) -> Value {
     let mut last = Value::Null;
     for _ in 0..1500 {
         last = http

@@ -6,12 +6,13 @@
 //! `max_queued` more wait, and beyond that an upload is refused with 429.
 
 use super::Curator;
+use crate::ingest::points::{detect_kind, ingest_points, load_cloud};
 use crate::ingest::{ingest_coloured, IngestOptions, ModelMeta, ProgressHook, SourceInfo};
 use crate::service::error::{AppError, ErrorBody};
 use crate::service::servable::PathParams;
 use crate::service::AppState;
 use crate::source::load_coloured_frame;
-use crate::storage::{JobRecord, JobState};
+use crate::storage::{JobRecord, JobState, ModelKind};
 use axum::extract::State;
 use axum::Json;
 use serde::{Deserialize, Serialize};
@@ -62,6 +63,8 @@ pub struct JobInput {
     pub file: TempPath,
     pub meta: ModelMeta,
     pub options: IngestOptions,
+    /// As the form asked; `None`: from the file.
+    pub kind: Option<ModelKind>,
 }
 
 /// Runs the job in the background; the request that made it may go.
@@ -143,10 +146,38 @@ async fn ingest_upload(
         file,
         mut meta,
         mut options,
+        kind,
     } = input;
     let source_name = job.source_name.clone();
     let spooled = file.to_string_lossy().into_owned();
     let shown = source_name.clone();
+    let detected = detect_kind(&file)?;
+    match kind.unwrap_or(detected) {
+        ModelKind::Points => {
+            let cloud = tokio::task::spawn_blocking(move || {
+                let cloud = load_cloud(&file);
+                drop(file);
+                cloud.map_err(|e| anyhow::anyhow!(format!("{e:#}").replace(&spooled, &shown)))
+            })
+            .await??;
+            meta.source = Some(SourceInfo {
+                name: source_name,
+                vertices: cloud.len() as u64,
+                faces: 0,
+                repair: None,
+            });
+            options.progress = Some(hook);
+            let report = ingest_points(storage, cloud, meta, &options).await?;
+            return Ok(report.stored.version);
+        }
+        ModelKind::Mesh if detected == ModelKind::Points => {
+            anyhow::bail!(
+                "{source_name} is a point cloud (no faces): it cannot be stored as a mesh \
+                 (leave `kind` out, or send `points`)"
+            );
+        }
+        ModelKind::Mesh => {}
+    }
     let source = tokio::task::spawn_blocking(move || {
         let source = load_coloured_frame(&file, 0);
         drop(file); // the spooled upload is removed once read
@@ -177,7 +208,8 @@ pub struct Job {
     state: JobState,
     /// 0–1.
     progress: f64,
-    /// What it is doing: `queued`, `importing`, `encoding`, `measuring`,
+    /// What it is doing: `queued`, `importing`, `estimating normals` (a
+    /// point cloud), `encoding`, `measuring`,
     /// `rendering the thumbnail`, `storing`, `done` or `failed`.
     stage: String,
     /// The importer's or encoder's message, when failed.

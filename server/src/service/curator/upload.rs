@@ -1,5 +1,7 @@
 //! `POST /api/models`: a curator uploads a scan as `multipart/form-data`
-//! (`file`, `slug`, `title`, optional `description`, `policy`, `colour`).
+//! (`file`, `slug`, `title`, optional `description`, `policy`, `colour`,
+//! `kind`). A point cloud (a PLY without faces, LAS, LAZ) is stored as a
+//! point stream.
 //! The file is streamed to a spool file on disk, never held in memory; its
 //! name as sent never becomes a path (the spool file's name is generated
 //! and keeps only the validated extension, which picks the importer). The
@@ -11,7 +13,7 @@ use super::Curator;
 use crate::ingest::{IngestOptions, ModelMeta};
 use crate::service::error::{AppError, ErrorBody};
 use crate::service::AppState;
-use crate::storage::{valid_slug, NewJob, OnExisting};
+use crate::storage::{valid_slug, ModelKind, NewJob, OnExisting};
 use axum::extract::multipart::{Field, Multipart, MultipartError};
 use axum::extract::State;
 use axum::http::StatusCode;
@@ -24,8 +26,9 @@ use utoipa::ToSchema;
 use vitrine_colour::ColourMode;
 
 /// Formats an upload may be in: the single-file ones (OBJ's materials and
-/// a glTF's external buffers would need files beside them).
-pub const EXTENSIONS: [&str; 6] = ["ply", "obj", "off", "glb", "gltf", "md2"];
+/// a glTF's external buffers would need files beside them), and the point
+/// clouds' LAS and LAZ.
+pub const EXTENSIONS: [&str; 8] = ["ply", "obj", "off", "glb", "gltf", "md2", "las", "laz"];
 
 /// Longest text field (title, description…), in bytes.
 const MAX_FIELD_BYTES: usize = 16 * 1024;
@@ -34,7 +37,8 @@ const MAX_FIELD_BYTES: usize = 16 * 1024;
 #[derive(ToSchema)]
 #[allow(dead_code)]
 pub struct UploadForm {
-    /// The scan: PLY, OBJ, OFF, GLB, glTF (embedded buffers) or MD2.
+    /// The scan: PLY, OBJ, OFF, GLB, glTF (embedded buffers) or MD2; or a
+    /// point cloud: PLY without faces, LAS or LAZ.
     #[schema(value_type = String, format = Binary)]
     file: Vec<u8>,
     /// URL name: 1–64 of a-z, 0-9 and '-'. An existing slug gets a new version.
@@ -46,6 +50,9 @@ pub struct UploadForm {
     /// `ccc`, `vertex`, `vertex-metric` or `none` (default: `ccc` for a
     /// textured scan, `vertex` with per-vertex colour, else `none`).
     colour: Option<String>,
+    /// `mesh` or `points` (default: `points` for LAS, LAZ and a PLY that
+    /// declares no faces, else `mesh`).
+    kind: Option<String>,
 }
 
 #[derive(Serialize, ToSchema)]
@@ -95,7 +102,7 @@ pub async fn upload(
     }
     let (file, source_name) =
         spooled.ok_or_else(|| AppError::Unprocessable("the form has no `file`".into()))?;
-    let (meta, options) = fields.validate()?;
+    let (meta, options, kind) = fields.validate()?;
     curator.check_model(&meta.slug)?;
     let place = state.jobs().reserve().ok_or_else(|| {
         AppError::TooManyRequests("too many uploads are waiting; try again later".into())
@@ -121,6 +128,7 @@ pub async fn upload(
             file,
             meta,
             options,
+            kind,
         },
     );
     Ok((StatusCode::ACCEPTED, Json(accepted)).into_response())
@@ -201,6 +209,7 @@ struct Fields {
     description: Option<String>,
     policy: Option<String>,
     colour: Option<String>,
+    kind: Option<String>,
 }
 
 impl Fields {
@@ -211,9 +220,10 @@ impl Fields {
             "description" => &mut self.description,
             "policy" => &mut self.policy,
             "colour" => &mut self.colour,
+            "kind" => &mut self.kind,
             other => {
                 return Err(AppError::Unprocessable(format!(
-                    "unknown form field {other:?} (file, slug, title, description, policy, colour)"
+                    "unknown form field {other:?} (file, slug, title, description, policy, colour, kind)"
                 )))
             }
         };
@@ -221,7 +231,7 @@ impl Fields {
         Ok(())
     }
 
-    fn validate(self) -> Result<(ModelMeta, IngestOptions), AppError> {
+    fn validate(self) -> Result<(ModelMeta, IngestOptions, Option<ModelKind>), AppError> {
         let bad = |m: String| AppError::Unprocessable(m);
         let slug = self
             .slug
@@ -249,10 +259,17 @@ impl Fields {
                 ))
             })?),
         };
+        let kind = match self.kind.as_deref() {
+            None | Some("") => None,
+            Some(name) => Some(
+                ModelKind::parse(name)
+                    .ok_or_else(|| bad(format!("kind {name:?} must be mesh or points")))?,
+            ),
+        };
         let options = IngestOptions {
             colour,
             ..IngestOptions::default()
         };
-        Ok((meta, options))
+        Ok((meta, options, kind))
     }
 }

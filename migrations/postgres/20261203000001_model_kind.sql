@@ -1,0 +1,21 @@
+-- Point clouds (issue 21): a model version is a mesh or a point cloud. The
+-- kind belongs to the version (`model`), not to one of its compressions:
+-- every compression of a version encodes the same data. Keep in step with
+-- ../sqlite/ (same column, only types differ).
+--
+-- A point cloud is stored in the tables a mesh is stored in, with no change
+-- to them, because its stream (VPTS, codec/points/FORMAT.md) has the same
+-- shape: a header, then one self-delimiting chunk per level, every level a
+-- prefix of the next. So for `kind = 'points'`:
+--   compression.codec_version       the VPTS format version (not the mesh
+--                                   stream's), compression.quantization_bits
+--                                   the position bits per axis;
+--   base_mesh                       the stream header plus the first level's
+--                                   chunk (what a viewer fetches first, as for
+--                                   a mesh), `vertices` = its points, `faces` = 0;
+--   refinement_batch (iteration k)  level k's chunk, `vertices` = the points
+--                                   after it (cumulative), `faces` = 0.
+-- Concatenating the base and batches 1..=k in order gives a valid VPTS
+-- stream of levels 0..=k, which the decoder reads bit for bit.
+ALTER TABLE model ADD COLUMN kind TEXT NOT NULL DEFAULT 'mesh'
+    CHECK (kind IN ('mesh', 'points'));
