@@ -12,7 +12,7 @@ import { SplatView } from '../src/splats/splat-view.js';
 const root = /** @type {HTMLElement} */ (document.getElementById('root'));
 /** @type {OrbitCamera | null} */
 let camera = null;
-const view = new SplatView(root, { camera: () => camera, background: BACKGROUND });
+const view = new SplatView((canvas) => root.append(canvas), { camera: () => camera, background: BACKGROUND });
 const worker = new Worker('/dist/splat-worker.js');
 const module = WebAssembly.compileStreaming(fetch('/dist/vitrine_wasm.wasm'));
 

@@ -15,6 +15,8 @@ import { Annotations } from './annotations.js';
 import { Inspection } from './inspection.js';
 import { canTransfer, openRenderer } from './render-host.js';
 import { retryAfterSeconds, waitToRetry } from './retry.js';
+import { BACKGROUND } from './shading.js';
+import { PointModel } from './splats/point-model.js';
 
 /**
  * @typedef {object} ViewerOptions
@@ -47,6 +49,7 @@ import { retryAfterSeconds, waitToRetry } from './retry.js';
  * @property {string} [up] which model axis points up (`x`, `y`, `z`, `-x`, `-y`, `-z`; default `y`)
  * @property {'mm' | 'cm' | 'm' | 'in' | null} [unit] the model's unit
  * @property {import('./geometry.js').Bounds} [bounds] every level's extent, model coordinates
+ * @property {'mesh' | 'points'} [kind] a point cloud's levels are prefixes of a point stream (splats/point-model.js)
  */
 
 /**
@@ -150,6 +153,8 @@ export class Viewer {
    * @type {import('./render-host.js').RenderHost | null}
    */
   renderer = null;
+  /** A point-cloud model's splats (null: a mesh). @type {PointModel | null} */
+  points = null;
   /** @type {Promise<import('./render-host.js').RenderHost> | null} */
   #rendering = null;
   /** The port the newest decode worker posts its levels into. @type {MessagePort | null} */
@@ -318,6 +323,10 @@ export class Viewer {
         worker.terminate();
         return;
       }
+      if (manifest.kind === 'points') {
+        worker.terminate();
+        return await this.#beginPoints(manifest, module);
+      }
       const levels = this.#begin(manifest, module, worker);
       this.#levels = levels;
       const renderer = await rendering;
@@ -343,6 +352,7 @@ export class Viewer {
     this.#attempt++;
     this.#worker?.terminate();
     this.#worker = null;
+    this.points?.stop();
     if (this.#retry) clearTimeout(this.#retry);
     this.#retry = null;
   }
@@ -530,6 +540,36 @@ export class Viewer {
     const channel = new MessageChannel();
     worker.postMessage({ type: 'load', module, request, port: channel.port2 }, [channel.port2]);
     return channel.port1;
+  }
+
+  /**
+   * A point cloud: its levels go to the splat worker, its splats over the canvas.
+   * @param {Manifest} manifest
+   * @param {WebAssembly.Module} module
+   */
+  #beginPoints(manifest, module) {
+    this.manifest = manifest;
+    this.ui.setDetails(manifest.title, manifest.description);
+    this.#look = { ...this.#look, model: upRotation(manifest.up), bounds: validBounds(manifest.bounds, null) };
+    this.#cap = { level: manifest.cap.level, reason: manifest.cap.reason, retryAfterS: manifest.cap.retry_after_s };
+    const target = this.#target(manifest.cap.level);
+    this.#set({ status: 'refining', lastLevel: manifest.last_level, targetLevel: target });
+    this.points?.destroy();
+    this.points = new PointModel({
+      place: (canvas) => this.ui.canvas.after(canvas),
+      background: this.options.background ?? BACKGROUND,
+      camera: (bounds) => this.#makeCamera(bounds),
+      current: () => this.camera,
+      model: () => this.#look.model,
+      createWorker: () => this.#createWorker(new URL('./splat-worker.js', this.options.workerUrl).href),
+      shown: (level) => this.#shown(level),
+      framed: (frame) => this.#framed(frame),
+      set: (patch) => this.#set(patch),
+      fail: (message) => this.#fail(message),
+    });
+    const url = (/** @type {string} */ path) => this.#apiUrl(path);
+    const levels = manifest.levels.slice(0, target + 1).map((l) => url(l.url));
+    return this.points.start(module, { baseUrl: levels[0], batchUrls: levels.slice(1), upTo: target });
   }
 
   /** The renderer, opened once per viewer (a retry keeps it); a failure is tried again on retry. */

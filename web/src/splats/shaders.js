@@ -29,6 +29,7 @@ layout(location = 5) in uint a_surface;
 layout(location = 6) in uint a_clip;
 uniform mat4 u_view;
 uniform mat4 u_projection;
+uniform mat3 u_model;
 uniform float u_scale;
 out vec2 v_local;
 out vec3 v_world;
@@ -46,14 +47,16 @@ void main() {
   float r = a_radius * u_scale;
   vec3 world = a_centre + r * (a_corner.x * t + a_corner.y * b);
   v_local = a_corner;
+  // Clipping happens in model coordinates (the planes'), the rest upright.
   v_world = world;
-  v_eye = (u_view * vec4(world, 1.0)).xyz;
-  v_normal = mat3(u_view) * n;
+  vec3 upright = u_model * world;
+  v_eye = (u_view * vec4(upright, 1.0)).xyz;
+  v_normal = mat3(u_view) * (u_model * n);
   v_colour = a_colour;
   v_radius = r;
   v_surface = a_surface;
   v_clip = a_clip;
-  gl_Position = u_projection * u_view * vec4(world, 1.0);
+  gl_Position = u_projection * vec4(v_eye, 1.0);
 }`;
 
 /** Shared by the two disc passes: on the disc, and not clipped away. */

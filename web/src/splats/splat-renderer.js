@@ -38,6 +38,7 @@ export class SplatUnsupported extends Error {}
 
 const PLANE_TEXTURE_WIDTH = 1024;
 const CLAY = 190;
+const IDENTITY = [1, 0, 0, 0, 1, 0, 0, 0, 1];
 
 /**
  * @param {WebGL2RenderingContext} gl
@@ -230,7 +231,8 @@ export class SplatRenderer {
 
   /**
    * Draws one frame onto the canvas (the default framebuffer).
-   * @param {{ view: Float32Array, projection: Float32Array, width: number, height: number }} camera
+   * @param {{ view: Float32Array, projection: Float32Array, width: number, height: number, model?: ArrayLike<number> }} camera
+   *   model: the upright rotation (frame.js upRotation, column-major 3×3; identity without)
    * @param {SplatOptions} options
    */
   draw(camera, options) {
@@ -248,6 +250,7 @@ export class SplatRenderer {
       gl.useProgram(prog.p);
       gl.uniformMatrix4fv(prog.u.u_view, false, camera.view);
       gl.uniformMatrix4fv(prog.u.u_projection, false, camera.projection);
+      gl.uniformMatrix3fv(prog.u.u_model, false, new Float32Array(camera.model ?? IDENTITY));
       gl.uniform1f(prog.u.u_scale, options.scale);
       gl.uniform1i(prog.u.u_clipping, options.clipping ? 1 : 0);
       gl.activeTexture(gl.TEXTURE0);

@@ -10,6 +10,8 @@ import { DEFAULT_SPLAT_OPTIONS, SplatRenderer } from './splat-renderer.js';
 
 /** @typedef {import('./splat-renderer.js').SplatSet} SplatSet */
 
+const IDENTITY = [1, 0, 0, 0, 1, 0, 0, 0, 1];
+
 export class SplatView {
   /** @type {SplatRenderer} */
   renderer;
@@ -20,23 +22,26 @@ export class SplatView {
   /** Frames drawn. */
   frames = 0;
   #camera;
+  #model;
   #dirty = true;
   #lastView = '';
   /** @type {number | null} */
   #raf = null;
 
   /**
-   * @param {HTMLElement} parent where the canvas goes (over the viewer's)
-   * @param {{ camera: () => import('../camera.js').OrbitCamera | null, background: [number, number, number] }} options
+   * @param {(canvas: HTMLCanvasElement) => void} place puts the canvas on the page (over the viewer's)
+   * @param {{ camera: () => import('../camera.js').OrbitCamera | null, background: [number, number, number],
+   *   model?: () => ArrayLike<number> }} options model: the upright rotation (frame.js upRotation)
    */
-  constructor(parent, options) {
+  constructor(place, options) {
     this.#camera = options.camera;
+    this.#model = options.model ?? (() => IDENTITY);
     this.canvas = document.createElement('canvas');
     this.canvas.className = 'splats';
     Object.assign(this.canvas.style, { position: 'absolute', inset: '0', width: '100%', height: '100%', pointerEvents: 'none' });
     const gl = this.canvas.getContext('webgl2', { antialias: false, preserveDrawingBuffer: false });
     if (!gl) throw new Error('The splat view needs WebGL2.');
-    parent.append(this.canvas);
+    place(this.canvas);
     try {
       this.renderer = new SplatRenderer(gl, options.background);
     } catch (error) {
@@ -78,7 +83,7 @@ export class SplatView {
     const camera = this.#camera();
     if (!camera) return;
     const { width, height } = this.#size();
-    const key = `${camera.view().join()}|${width}x${height}`;
+    const key = `${camera.view().join()}|${Array.from(this.#model()).join()}|${width}x${height}`;
     if (!this.#dirty && key === this.#lastView) return;
     this.#lastView = key;
     this.#dirty = false;
@@ -90,7 +95,7 @@ export class SplatView {
     const camera = this.#camera();
     if (!camera) return false;
     const { width, height } = this.#size();
-    this.renderer.draw({ view: camera.view(), projection: camera.projection(width / height), width, height }, this.options);
+    this.renderer.draw({ view: camera.view(), projection: camera.projection(width / height), width, height, model: this.#model() }, this.options);
     this.frames++;
     return true;
   }

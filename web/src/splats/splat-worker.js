@@ -11,17 +11,8 @@ import { VitrineCodec } from '../codec.js';
 import { meshSplats } from './mesh-splats.js';
 import { PointStream, splitHeader } from './point-stream.js';
 
-/**
- * @typedef {{ type: 'points', module: WebAssembly.Module, baseUrl: string, batchUrls: string[], upTo: number,
- *     sharpThreshold?: number, headers?: Record<string, string> }
- *   | { type: 'mesh', id: number, positions: Float32Array, indices: Uint32Array, colours: Uint8Array | null }} SplatCommand
- */
-
-/**
- * @typedef {{ type: 'splats', id: number | null, level: number, set: import('./splat-renderer.js').SplatSet, received: number, ms: number }
- *   | { type: 'error', kind: 'network' | 'decode', level: number, message: string }
- *   | { type: 'done', level: number }} SplatMessage
- */
+/** @typedef {import('./messages.js').SplatCommand} SplatCommand */
+/** @typedef {import('./messages.js').SplatMessage} SplatMessage */
 
 const scope = /** @type {DedicatedWorkerGlobalScope} */ (/** @type {unknown} */ (self));
 
