@@ -12,7 +12,8 @@ import { createServer } from 'node:http';
 import { join } from 'node:path';
 import { build } from 'esbuild';
 import { launch } from '../test/support/browser.mjs';
-import { fixturesDir, root } from '../test/support/fixtures.mjs';
+import { fixture, fixturesDir, root } from '../test/support/fixtures.mjs';
+import { splitStream } from '../src/codec.js';
 import { foreground, rasterize } from '../test/support/raster.mjs';
 import { vertexNormals } from '../src/geometry.js';
 import { splitLevels } from '../src/splats/point-stream.js';
@@ -31,6 +32,8 @@ let browser;
 
 /** Level payloads by stream name: level 0 = header + first chunk, then one chunk each. */
 const streams = new Map();
+/** @type {Map<string, { payloads: Uint8Array[], levels: import('../test/support/fixtures.mjs').FixtureLevel[] }>} */
+const meshes = new Map();
 
 /** Two intersecting spheres, centres ±0.35 on x, radius 0.6. */
 const SPHERES_BOX = { min: [-0.95, -0.6, -0.6], max: [0.95, 0.6, 0.6] };
@@ -49,6 +52,10 @@ before(async () => {
   streams.set('spheres', levels);
   // Level 1 cut short: the decoder refuses it.
   streams.set('truncated', [levels[0], levels[1].subarray(0, levels[1].length >> 1), levels[2], levels[3]]);
+  // A mesh model from a committed stream (the Rust encoder's), base then batches.
+  const torus = fixture('torus');
+  const { base: torusBase, batches } = splitStream(torus.stream);
+  meshes.set('torus', { payloads: [torusBase, ...batches], levels: torus.levels });
   server = createServer((req, res) => {
     const path = new URL(req.url ?? '/', 'http://x').pathname;
     const level = /^\/levels\/(\w+)\/(\d+)$/.exec(path);
@@ -68,9 +75,15 @@ before(async () => {
     } else if (path === '/harness.js') {
       res.writeHead(200, { 'content-type': 'text/javascript' });
       res.end(script);
+    } else if (path.startsWith('/api/models/') && meshes.has(path.slice(12))) {
+      res.writeHead(200, { 'content-type': 'application/json' });
+      res.end(JSON.stringify(meshManifest(path.slice(12))));
     } else if (level && streams.get(level[1])?.[Number(level[2])]) {
       res.writeHead(200, { 'content-type': 'application/octet-stream' });
       res.end(streams.get(level[1])[Number(level[2])]);
+    } else if (level && meshes.get(level[1])?.payloads[Number(level[2])]) {
+      res.writeHead(200, { 'content-type': 'application/octet-stream' });
+      res.end(meshes.get(level[1])?.payloads[Number(level[2])]);
     } else if (path.startsWith('/dist/') && existsSync(join(dist, path.slice(6)))) {
       const type = path.endsWith('.wasm') ? 'application/wasm' : path.endsWith('.js') ? 'text/javascript' : 'application/octet-stream';
       res.writeHead(200, { 'content-type': type });
@@ -145,6 +158,25 @@ function pointManifest(name) {
     cap: { level: levels.length - 1, reason: null, retry_after_s: null },
     up: 'y',
     bounds: SPHERES_BOX,
+  };
+}
+
+/**
+ * A mesh model's manifest, as the server writes one.
+ * @param {string} name
+ */
+function meshManifest(name) {
+  const { payloads, levels } = /** @type {{ payloads: Uint8Array[], levels: any[] }} */ (meshes.get(name));
+  return {
+    slug: name,
+    title: 'Torus',
+    description: 'A generated torus.',
+    has_colour: false,
+    last_level: levels.length - 1,
+    levels: levels.map((l, k) => ({ level: k, vertices: l.vertices, faces: l.faces, bytes: payloads[k].length, url: `/levels/${name}/${k}`, allowed: true })),
+    colour: { mode: 'none' },
+    visitor: { device: 'desktop', audience: 'public' },
+    cap: { level: levels.length - 1, reason: null, retry_after_s: null },
   };
 }
 
@@ -319,5 +351,52 @@ test('a truncated point stream in the viewer shows its error state', async () =>
   });
   assert.equal(error.hidden, false);
   assert.match(error.text, /Could not show this model/);
+  await page.close();
+});
+
+/** @param {Page} page @param {'renderer' | 'splats'} which */
+async function viewerCapture(page, which) {
+  const c = await page.evaluate(async (w) => {
+    const viewer = /** @type {any} */ (document.querySelector('vitrine-viewer')).viewer;
+    const { width, height, rgba } = w === 'renderer' ? await viewer.renderer.capture() : viewer.meshSplats.view.capture();
+    let binary = '';
+    for (let i = 0; i < rgba.length; i += 0x8000) binary += String.fromCharCode(...rgba.subarray(i, i + 0x8000));
+    return { width, height, data: btoa(binary) };
+  }, which);
+  return { ...c, rgba: new Uint8Array(Buffer.from(c.data, 'base64')) };
+}
+
+test("the viewer's Splats view of a mesh model: drawn over the mesh, silhouette close to it; off, the mesh as before", async () => {
+  const page = await browser.context.newPage();
+  /** @type {string[]} */
+  const problems = [];
+  page.on('pageerror', (e) => problems.push(e.message));
+  await page.goto(`${base}/viewer/torus`);
+  const state = await until(page, "s.status === 'complete'");
+  const mesh = await viewerCapture(page, 'renderer');
+  await page.evaluate(() => /** @type {HTMLElement} */ (document.querySelector('vitrine-viewer')?.shadowRoot?.querySelector('[data-action="splats"]')).click());
+  await page.waitForFunction((last) => /** @type {any} */ (document.querySelector('vitrine-viewer')).viewer.meshSplats.level === last, state.shownLevel, { timeout: 30_000 });
+  const pressed = await page.evaluate(() => document.querySelector('vitrine-viewer')?.shadowRoot?.querySelector('[data-action="splats"]')?.getAttribute('aria-pressed'));
+  assert.equal(pressed, 'true');
+  const splats = await viewerCapture(page, 'splats');
+  const a = foreground(splats.rgba);
+  const b = foreground(mesh.rgba);
+  let both = 0;
+  let either = 0;
+  for (let p = 0; p < a.length; p++) {
+    both += a[p] & b[p];
+    either += a[p] | b[p];
+  }
+  const iou = both / Math.max(1, either);
+  console.log(`# viewer, mesh splat view (${state.vertices} vertices): splats ${count(a)} px, mesh ${count(b)} px, IoU ${iou.toFixed(3)}`);
+  assert.ok(count(a) > 0.02 * a.length, 'the splats differ from the background');
+  assert.ok(iou > 0.85, `silhouette IoU ${iou}`);
+  // Off: the splat canvas is gone and the mesh renders as it did.
+  await page.evaluate(() => /** @type {any} */ (document.querySelector('vitrine-viewer')).viewer.setSplatView(false));
+  const canvases = await page.evaluate(() => document.querySelector('vitrine-viewer')?.shadowRoot?.querySelectorAll('canvas').length);
+  assert.equal(canvases, 1);
+  const again = await viewerCapture(page, 'renderer');
+  assert.deepEqual(again.rgba, mesh.rgba);
+  assert.deepEqual(problems, []);
   await page.close();
 });

@@ -16,6 +16,7 @@ import { Inspection } from './inspection.js';
 import { canTransfer, openRenderer } from './render-host.js';
 import { retryAfterSeconds, waitToRetry } from './retry.js';
 import { BACKGROUND } from './shading.js';
+import { MeshSplats } from './splats/mesh-splat-view.js';
 import { PointModel } from './splats/point-model.js';
 
 /**
@@ -155,6 +156,8 @@ export class Viewer {
   renderer = null;
   /** A point-cloud model's splats (null: a mesh). @type {PointModel | null} */
   points = null;
+  /** The splat view of a mesh model's level (splats/mesh-splat-view.js). @type {MeshSplats} */
+  meshSplats;
   /** @type {Promise<import('./render-host.js').RenderHost> | null} */
   #rendering = null;
   /** The port the newest decode worker posts its levels into. @type {MessagePort | null} */
@@ -202,6 +205,11 @@ export class Viewer {
     this.options = options;
     this.#decodeTo = options.hold ?? null;
     this.#hold = options.hold ?? null;
+    this.meshSplats = new MeshSplats({
+      ...this.#splatHost(),
+      requestLevel: (id) => (this.#worker?.postMessage({ type: 'level-data', id }), this.#worker !== null),
+      warn: (message) => this.ui.showNotice(message),
+    });
     this.controls = new OrbitControls(ui.canvas, {
       camera: () => this.camera,
       changed: () => {
@@ -216,6 +224,7 @@ export class Viewer {
     ui.onReset = () => this.resetView();
     ui.onWireframe = () => this.setWireframe(!this.#wireframe);
     ui.onRelief = () => this.setRelief(!this.#relief);
+    ui.onSplats = () => this.setSplatView(!this.meshSplats.on);
     ui.onRetry = () => this.start();
     ui.onResize = () => {
       this.renderer?.requestFrame();
@@ -471,6 +480,13 @@ export class Viewer {
     this.#endTurn?.();
   }
 
+  /** The splat view of the mesh level on screen (a point cloud is always splats). @param {boolean} on */
+  setSplatView(on) {
+    if (on) this.meshSplats.show();
+    else this.meshSplats.hide();
+    this.ui.setSplats(this.meshSplats.on);
+  }
+
   /** @param {boolean} on */
   setWireframe(on) {
     this.#wireframe = on;
@@ -554,14 +570,11 @@ export class Viewer {
     this.#cap = { level: manifest.cap.level, reason: manifest.cap.reason, retryAfterS: manifest.cap.retry_after_s };
     const target = this.#target(manifest.cap.level);
     this.#set({ status: 'refining', lastLevel: manifest.last_level, targetLevel: target });
+    this.ui.splatsButton.hidden = true;
     this.points?.destroy();
     this.points = new PointModel({
-      place: (canvas) => this.ui.canvas.after(canvas),
-      background: this.options.background ?? BACKGROUND,
+      ...this.#splatHost(),
       camera: (bounds) => this.#makeCamera(bounds),
-      current: () => this.camera,
-      model: () => this.#look.model,
-      createWorker: () => this.#createWorker(new URL('./splat-worker.js', this.options.workerUrl).href),
       shown: (level) => this.#shown(level),
       framed: (frame) => this.#framed(frame),
       set: (patch) => this.#set(patch),
@@ -570,6 +583,17 @@ export class Viewer {
     const url = (/** @type {string} */ path) => this.#apiUrl(path);
     const levels = manifest.levels.slice(0, target + 1).map((l) => url(l.url));
     return this.points.start(module, { baseUrl: levels[0], batchUrls: levels.slice(1), upTo: target });
+  }
+
+  /** What both splat views (splats/) borrow from the viewer. */
+  #splatHost() {
+    return {
+      place: (/** @type {HTMLCanvasElement} */ canvas) => this.ui.canvas.after(canvas),
+      background: this.options.background ?? BACKGROUND,
+      current: () => this.camera,
+      model: () => this.#look.model,
+      createWorker: () => this.#createWorker(new URL('./splat-worker.js', this.options.workerUrl).href),
+    };
   }
 
   /** The renderer, opened once per viewer (a retry keeps it); a failure is tried again on retry. */
@@ -620,8 +644,9 @@ export class Viewer {
     this.ui.root.dispatchEvent(new CustomEvent(type, { detail, bubbles: true, composed: true }));
   }
 
-  /** @param {import('./reconstruction.js').PageMessage | { type: 'geodesic', id: number, distance?: number, level?: number, error?: string }} message */
+  /** @param {import('./reconstruction.js').PageMessage | import('./splats/mesh-splat-view.js').LevelData | { type: 'geodesic', id: number, distance?: number, level?: number, error?: string }} message */
   #message(message) {
+    if (message.type === 'level-data') return void this.meshSplats.receive(message);
     if (message.type === 'geodesic') {
       this.#geodesics.get(message.id)?.(message);
       this.#geodesics.delete(message.id);
@@ -669,6 +694,7 @@ export class Viewer {
     this.#set({ shownLevel: level.level, vertices: level.vertices, normalsMs: level.normalsMs });
     this.annotations.levelShown();
     this.inspection.levelShown();
+    this.meshSplats.levelShown();
     this.#ready(level.level);
     if (level.level < this.state.targetLevel || this.state.status !== 'refining') return;
     const last = /** @type {Manifest} */ (this.manifest).last_level;
