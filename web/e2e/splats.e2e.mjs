@@ -400,3 +400,18 @@ test("the viewer's Splats view of a mesh model: drawn over the mesh, silhouette 
   assert.deepEqual(problems, []);
   await page.close();
 });
+
+test('without float render targets the point model says why', async () => {
+  const page = await browser.context.newPage();
+  await page.addInitScript(() => {
+    const proto = /** @type {any} */ (WebGL2RenderingContext.prototype);
+    const get = proto.getExtension;
+    proto.getExtension = function (/** @type {string} */ name) {
+      return name === 'EXT_color_buffer_float' ? null : get.call(this, name);
+    };
+  });
+  await page.goto(`${base}/viewer/spheres`);
+  const state = await until(page, "s.status === 'error'");
+  assert.match(state.message, /float render targets \(EXT_color_buffer_float\)/);
+  await page.close();
+});
