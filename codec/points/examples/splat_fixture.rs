@@ -10,7 +10,9 @@ use vitrine_points::testing::sphere;
 use vitrine_points::PointCloud;
 
 fn main() {
-    let out = std::env::args().nth(1).expect("usage: splat_fixture OUT.vpts");
+    let out = std::env::args()
+        .nth(1)
+        .expect("usage: splat_fixture OUT.vpts");
     let n = 12_000;
     let (mut positions, mut normals) = sphere(n, [-0.35, 0.0, 0.0], 0.6, 21);
     let (p2, n2) = sphere(n, [0.35, 0.0, 0.0], 0.6, 22);
