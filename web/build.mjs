@@ -1,9 +1,10 @@
 // Builds web/dist from web/src and the WebAssembly decoder:
 //   node build.mjs            (expects the wasm to be built, see README)
 //   VITRINE_WASM=path node build.mjs
-// esbuild bundles four entries: app.js (the pages), vitrine.js (the
+// esbuild bundles five entries: app.js (the pages), vitrine.js (the
 // <vitrine-viewer> element for other sites), worker.js (the decoder) and
-// render-worker.js (WebGL on an OffscreenCanvas) — classic workers, so
+// render-worker.js (WebGL on an OffscreenCanvas), splat-worker.js (point
+// streams and splat preprocessing) — classic workers, so
 // another origin can start them from blob URLs.
 import { build } from 'esbuild';
 import { copyFileSync, existsSync, mkdirSync, rmSync, statSync } from 'node:fs';
@@ -28,13 +29,13 @@ const common = { bundle: true, minify: true, sourcemap: true, target: ['chrome11
 await build({ ...common, entryPoints: { app: join(src, 'app.js'), vitrine: join(src, 'element.js') }, format: 'esm', outdir: dist });
 await build({
   ...common,
-  entryPoints: { worker: join(src, 'worker.js'), 'render-worker': join(src, 'render-worker.js') },
+  entryPoints: { worker: join(src, 'worker.js'), 'render-worker': join(src, 'render-worker.js'), 'splat-worker': join(src, 'splats', 'splat-worker.js') },
   format: 'iife',
   outdir: dist,
 });
 for (const file of ['index.html', 'style.css']) copyFileSync(join(src, file), join(dist, file));
 copyFileSync(wasm, join(dist, 'vitrine_wasm.wasm'));
 
-for (const file of ['app.js', 'vitrine.js', 'worker.js', 'render-worker.js', 'vitrine_wasm.wasm']) {
+for (const file of ['app.js', 'vitrine.js', 'worker.js', 'render-worker.js', 'splat-worker.js', 'vitrine_wasm.wasm']) {
   console.log(`dist/${file.padEnd(18)} ${(statSync(join(dist, file)).size / 1024).toFixed(1)} KB`);
 }

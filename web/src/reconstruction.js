@@ -202,6 +202,15 @@ export class Reconstruction {
     }
   }
 
+  /**
+   * A copy of the level decoded last (the splat view of a mesh).
+   * @returns {import('./codec.js').Level}
+   */
+  current() {
+    if (!this.#decoder || this.level < 0) throw new Error('no level decoded yet');
+    return this.#decoder.level();
+  }
+
   cancel() {
     this.#cancelled = true;
     this.#abort.abort();

@@ -90,6 +90,7 @@ export class ViewerUi {
   onReset = () => {};
   onWireframe = () => {};
   onRelief = () => {};
+  onSplats = () => {};
   onRetry = () => {};
   onResize = () => {};
   /** The quality curve the chart shows. @type {ReadonlyArray<import('./quality-chart.js').QualityPoint> | null} */
@@ -118,6 +119,7 @@ export class ViewerUi {
     <button data-action="wireframe" title="Wireframe (W)" aria-pressed="false" class="optional">Wireframe</button>
     <button data-action="relief" title="Relief: colour by average normal deviation θ (erosion, tool marks)"
       aria-pressed="false" class="optional">Relief</button>
+    <button data-action="splats" title="Splats: draw the level's vertices as surface splats" aria-pressed="false" class="optional">Splats</button>
     <button data-action="notes" title="The curators' notes on this object" aria-pressed="false" hidden>Notes</button>
     <button data-action="measure" title="Measure: click two points on the surface" aria-pressed="false" class="optional">Measure</button>
     <button data-action="light" title="Light: move the light, raking light for inscriptions" aria-pressed="false" class="optional">Light</button>
@@ -155,6 +157,7 @@ export class ViewerUi {
     this.error = $('.error');
     this.wireButton = $('[data-action="wireframe"]');
     this.reliefButton = $('[data-action="relief"]');
+    this.splatsButton = $('[data-action="splats"]');
     this.legend = $('.legend');
     /** Tool panes (annotations list, measurement, light, section), under the toolbar. */
     this.panes = $('.panes');
@@ -171,6 +174,7 @@ export class ViewerUi {
     $('[data-action="reset"]').onclick = () => this.onReset();
     this.wireButton.onclick = () => this.onWireframe();
     this.reliefButton.onclick = () => this.onRelief();
+    this.splatsButton.onclick = () => this.onSplats();
     $('[data-action="fullscreen"]').onclick = () => this.toggleFullscreen();
     $('[data-action="retry"]').onclick = () => this.onRetry();
     this.#watchSize();
@@ -383,6 +387,11 @@ export class ViewerUi {
   /** @param {boolean} on */
   setRelief(on) {
     this.reliefButton.setAttribute('aria-pressed', String(on));
+  }
+
+  /** @param {boolean} on */
+  setSplats(on) {
+    this.splatsButton.setAttribute('aria-pressed', String(on));
   }
 
   toggleFullscreen() {

@@ -15,6 +15,9 @@ import { Annotations } from './annotations.js';
 import { Inspection } from './inspection.js';
 import { canTransfer, openRenderer } from './render-host.js';
 import { retryAfterSeconds, waitToRetry } from './retry.js';
+import { BACKGROUND } from './shading.js';
+import { MeshSplats } from './splats/mesh-splat-view.js';
+import { PointModel } from './splats/point-model.js';
 
 /**
  * @typedef {object} ViewerOptions
@@ -47,6 +50,7 @@ import { retryAfterSeconds, waitToRetry } from './retry.js';
  * @property {string} [up] which model axis points up (`x`, `y`, `z`, `-x`, `-y`, `-z`; default `y`)
  * @property {'mm' | 'cm' | 'm' | 'in' | null} [unit] the model's unit
  * @property {import('./geometry.js').Bounds} [bounds] every level's extent, model coordinates
+ * @property {'mesh' | 'points'} [kind] a point cloud's levels are prefixes of a point stream (splats/point-model.js)
  */
 
 /**
@@ -150,6 +154,10 @@ export class Viewer {
    * @type {import('./render-host.js').RenderHost | null}
    */
   renderer = null;
+  /** A point-cloud model's splats (null: a mesh). @type {PointModel | null} */
+  points = null;
+  /** The splat view of a mesh model's level (splats/mesh-splat-view.js). @type {MeshSplats} */
+  meshSplats;
   /** @type {Promise<import('./render-host.js').RenderHost> | null} */
   #rendering = null;
   /** The port the newest decode worker posts its levels into. @type {MessagePort | null} */
@@ -197,6 +205,11 @@ export class Viewer {
     this.options = options;
     this.#decodeTo = options.hold ?? null;
     this.#hold = options.hold ?? null;
+    this.meshSplats = new MeshSplats({
+      ...this.#splatHost(),
+      requestLevel: (id) => (this.#worker?.postMessage({ type: 'level-data', id }), this.#worker !== null),
+      warn: (message) => this.ui.showNotice(message),
+    });
     this.controls = new OrbitControls(ui.canvas, {
       camera: () => this.camera,
       changed: () => {
@@ -211,6 +224,7 @@ export class Viewer {
     ui.onReset = () => this.resetView();
     ui.onWireframe = () => this.setWireframe(!this.#wireframe);
     ui.onRelief = () => this.setRelief(!this.#relief);
+    ui.onSplats = () => this.setSplatView(!this.meshSplats.on);
     ui.onRetry = () => this.start();
     ui.onResize = () => {
       this.renderer?.requestFrame();
@@ -318,6 +332,10 @@ export class Viewer {
         worker.terminate();
         return;
       }
+      if (manifest.kind === 'points') {
+        worker.terminate();
+        return await this.#beginPoints(manifest, module);
+      }
       const levels = this.#begin(manifest, module, worker);
       this.#levels = levels;
       const renderer = await rendering;
@@ -343,6 +361,7 @@ export class Viewer {
     this.#attempt++;
     this.#worker?.terminate();
     this.#worker = null;
+    this.points?.stop();
     if (this.#retry) clearTimeout(this.#retry);
     this.#retry = null;
   }
@@ -461,6 +480,13 @@ export class Viewer {
     this.#endTurn?.();
   }
 
+  /** The splat view of the mesh level on screen (a point cloud is always splats). @param {boolean} on */
+  setSplatView(on) {
+    if (on) this.meshSplats.show();
+    else this.meshSplats.hide();
+    this.ui.setSplats(this.meshSplats.on);
+  }
+
   /** @param {boolean} on */
   setWireframe(on) {
     this.#wireframe = on;
@@ -532,6 +558,44 @@ export class Viewer {
     return channel.port1;
   }
 
+  /**
+   * A point cloud: its levels go to the splat worker, its splats over the canvas.
+   * @param {Manifest} manifest
+   * @param {WebAssembly.Module} module
+   */
+  #beginPoints(manifest, module) {
+    this.manifest = manifest;
+    this.ui.setDetails(manifest.title, manifest.description);
+    this.#look = { ...this.#look, model: upRotation(manifest.up), bounds: validBounds(manifest.bounds, null) };
+    this.#cap = { level: manifest.cap.level, reason: manifest.cap.reason, retryAfterS: manifest.cap.retry_after_s };
+    const target = this.#target(manifest.cap.level);
+    this.#set({ status: 'refining', lastLevel: manifest.last_level, targetLevel: target });
+    this.ui.splatsButton.hidden = true;
+    this.points?.destroy();
+    this.points = new PointModel({
+      ...this.#splatHost(),
+      camera: (bounds) => this.#makeCamera(bounds),
+      shown: (level) => this.#shown(level),
+      framed: (frame) => this.#framed(frame),
+      set: (patch) => this.#set(patch),
+      fail: (message) => this.#fail(message),
+    });
+    const url = (/** @type {string} */ path) => this.#apiUrl(path);
+    const levels = manifest.levels.slice(0, target + 1).map((l) => url(l.url));
+    return this.points.start(module, { baseUrl: levels[0], batchUrls: levels.slice(1), upTo: target });
+  }
+
+  /** What both splat views (splats/) borrow from the viewer. */
+  #splatHost() {
+    return {
+      place: (/** @type {HTMLCanvasElement} */ canvas) => this.ui.canvas.after(canvas),
+      background: this.options.background ?? BACKGROUND,
+      current: () => this.camera,
+      model: () => this.#look.model,
+      createWorker: () => this.#createWorker(new URL('./splat-worker.js', this.options.workerUrl).href),
+    };
+  }
+
   /** The renderer, opened once per viewer (a retry keeps it); a failure is tried again on retry. */
   #openRenderer() {
     this.#rendering ??= openRenderer(
@@ -580,8 +644,9 @@ export class Viewer {
     this.ui.root.dispatchEvent(new CustomEvent(type, { detail, bubbles: true, composed: true }));
   }
 
-  /** @param {import('./reconstruction.js').PageMessage | { type: 'geodesic', id: number, distance?: number, level?: number, error?: string }} message */
+  /** @param {import('./reconstruction.js').PageMessage | import('./splats/mesh-splat-view.js').LevelData | { type: 'geodesic', id: number, distance?: number, level?: number, error?: string }} message */
   #message(message) {
+    if (message.type === 'level-data') return void this.meshSplats.receive(message);
     if (message.type === 'geodesic') {
       this.#geodesics.get(message.id)?.(message);
       this.#geodesics.delete(message.id);
@@ -629,6 +694,7 @@ export class Viewer {
     this.#set({ shownLevel: level.level, vertices: level.vertices, normalsMs: level.normalsMs });
     this.annotations.levelShown();
     this.inspection.levelShown();
+    this.meshSplats.levelShown();
     this.#ready(level.level);
     if (level.level < this.state.targetLevel || this.state.status !== 'refining') return;
     const last = /** @type {Manifest} */ (this.manifest).last_level;

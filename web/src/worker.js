@@ -17,8 +17,10 @@ import { Reconstruction } from './reconstruction.js';
  *   | { type: 'wireframe', on: boolean }
  *   | { type: 'relief', on: boolean }
  *   | { type: 'normals', which: 'always' | 'last' }
- *   | { type: 'geodesic', id: number, from: number[], to: number[] }} WorkerCommand
- * `geodesic` is answered with `{ type: 'geodesic', id, distance, level }` or `{ type: 'geodesic', id, error }`.
+ *   | { type: 'geodesic', id: number, from: number[], to: number[] }
+ *   | { type: 'level-data', id: number }} WorkerCommand
+ * `geodesic` is answered with `{ type: 'geodesic', id, distance, level }` or `{ type: 'geodesic', id, error }`;
+ * `level-data` with a copy of the last decoded level (splats/mesh-splat-view.js `LevelData`), or nothing before one.
  */
 
 const scope = /** @type {DedicatedWorkerGlobalScope} */ (/** @type {unknown} */ (self));
@@ -81,6 +83,11 @@ scope.onmessage = async (/** @type {MessageEvent<WorkerCommand>} */ event) => {
     } catch (error) {
       scope.postMessage({ type: 'geodesic', id: command.id, error: error instanceof Error ? error.message : String(error) });
     }
+  } else if (command.type === 'level-data') {
+    if (!job || job.level < 0) return;
+    const { level, positions, indices, colours } = job.current();
+    const transfer = [positions.buffer, indices.buffer, ...(colours ? [colours.buffer] : [])];
+    scope.postMessage({ type: 'level-data', id: command.id, level, positions, indices, colours }, transfer);
   } else if (command.type === 'normals') {
     normals = command.which;
     job?.setNormals(command.which);

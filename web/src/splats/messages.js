@@ -1,0 +1,18 @@
+// @ts-check
+/**
+ * What the page and the splat worker (splat-worker.js) say to each other.
+ */
+
+/**
+ * @typedef {{ type: 'points', module: WebAssembly.Module, baseUrl: string, batchUrls: string[], upTo: number,
+ *     sharpThreshold?: number, headers?: Record<string, string> }
+ *   | { type: 'mesh', id: number, positions: Float32Array, indices: Uint32Array, colours: Uint8Array | null }} SplatCommand
+ */
+
+/**
+ * @typedef {{ type: 'splats', id: number | null, level: number, set: import('./splat-renderer.js').SplatSet, received: number, ms: number }
+ *   | { type: 'error', kind: 'network' | 'decode', level: number, message: string }
+ *   | { type: 'done', level: number }} SplatMessage
+ */
+
+export {};
