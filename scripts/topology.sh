@@ -132,7 +132,7 @@ sed -e "s|^pid .*|pid $work/nginx/nginx.pid;|" \
     -e "s|/var/cache/nginx/vitrine|$work/nginx/cache|" \
     -e "s|127.0.0.1:8081|127.0.0.1:${ports[0]}|" \
     -e "s|127.0.0.1:8082|127.0.0.1:${ports[1]}|" \
-    -e "s|listen 80;|listen 127.0.0.1:$port;|" \
+    -e "s|listen 80 |listen 127.0.0.1:$port |" \
     -e "s|^worker_processes .*|worker_processes 2;|" \
     -e "s|^http {|http {\n    client_body_temp_path $work/nginx/tmp/body;\n    proxy_temp_path $work/nginx/tmp/proxy;\n    fastcgi_temp_path $work/nginx/tmp/fastcgi;\n    uwsgi_temp_path $work/nginx/tmp/uwsgi;\n    scgi_temp_path $work/nginx/tmp/scgi;|" \
     "$root/deploy/nginx.conf" >"$work/nginx/nginx.conf"
