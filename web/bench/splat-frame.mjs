@@ -34,7 +34,10 @@ const harness = await build({
 const script = harness.outputFiles[0].text;
 const server = createServer((req, res) => {
   const path = new URL(req.url ?? '/', 'http://x').pathname;
-  if (path === '/') {
+  if (path === '/favicon.ico') {
+    res.writeHead(204);
+    res.end();
+  } else if (path === '/') {
     res.writeHead(200, { 'content-type': 'text/html' });
     res.end(`<!doctype html><body style="margin:0"><div id="root" style="position:relative;width:${WIDTH}px;height:${HEIGHT}px"></div><script type="module" src="/harness.js"></script></body>`);
   } else if (path === '/harness.js') {
