@@ -10,6 +10,7 @@ db=data/vitrine.db
 vitrine=target/release/vitrine
 [ -f data/torus.ply ] || $vitrine sample torus --colour --noise 0.002 --kilo-vertices 300 -o data/torus.ply
 [ -f data/plate.ply ] || $vitrine sample plate --kilo-vertices 120 -o data/plate.ply
+[ -f data/cloud.ply ] || $vitrine sample cloud --colour -o data/cloud.ply
 rm -f "$db" "$db-wal" "$db-shm"
 $vitrine ingest data/torus.ply --db "sqlite:$db" --slug painted-torus --policy open \
     --title "Painted torus" --description "A generated, painted torus with scan-like noise (300k vertices)."
@@ -25,6 +26,10 @@ if [ -f "$mask" ]; then
 fi
 $vitrine ingest data/plate.ply --db "sqlite:$db" --slug tunnel-plate --policy open --guard features \
     --title "Tunnel plate" --description "A genus-3 plate with sharp edges and tunnels, kept sharp in the coarse levels by the feature guard; try Relief."
+# A point cloud (a PLY without faces): streamed as points, drawn as splats.
+$vitrine ingest data/cloud.ply --db "sqlite:$db" --slug jittered-cube --policy open \
+    --title "Jittered cube (point cloud)" \
+    --description "A generated point cloud with normals and colour, drawn as splats that keep the cube's edges sharp."
 # A quality study of the torus (T = 5 s here; the thesis used 20): one invitation link.
 base=http://127.0.0.1:${PORT:-8080}
 $vitrine study create --db "sqlite:$db" --slug painted-torus --seconds 5 >/dev/null

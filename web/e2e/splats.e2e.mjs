@@ -3,8 +3,8 @@
 // (WebGL2 on SwiftShader), on a static server: a point stream of two
 // intersecting spheres (web/test/fixtures/two-spheres.vpts, written by
 // codec/points/examples/splat_fixture.rs) level by level, a truncated one,
-// a generated torus mesh as splats against its rasterized silhouette, and
-// the frame time of 1 M splats.
+// a generated torus mesh as splats against its rasterized silhouette. The
+// frame time of 1 M splats is a benchmark: bench/splat-frame.mjs.
 import { after, before, test } from 'node:test';
 import assert from 'node:assert/strict';
 import { existsSync, readFileSync } from 'node:fs';
@@ -274,23 +274,6 @@ test("a mesh level's splat view renders, its silhouette close to the mesh's", as
   console.log(`# torus: splat silhouette ${count(a)} px, mesh ${count(b)} px, IoU ${iou.toFixed(3)}`);
   assert.ok(count(a) > 0.05 * a.length, 'the splats differ from the background');
   assert.ok(iou > 0.9, `silhouette IoU ${iou}`);
-  assert.deepEqual(problems, []);
-  await page.close();
-});
-
-test('frame time of 1 M splats (printed, not asserted)', async () => {
-  const { page, problems } = await open();
-  const ms = await page.evaluate(() => {
-    const h = /** @type {any} */ (window).harness;
-    h.synthetic(1_000_000);
-    h.frameTime(1);
-    // SwiftShader takes tens of seconds a frame here: two frames after the warm-up.
-    const ms = h.frameTime(2);
-    h.view.destroy();
-    return ms;
-  });
-  console.log(`# 1 M splats, ${WIDTH}x${HEIGHT}, headless Chromium (SwiftShader): ${ms.toFixed(1)} ms per frame (2 frames after a warm-up)`);
-  assert.ok(ms > 0);
   assert.deepEqual(problems, []);
   await page.close();
 });

@@ -10,7 +10,7 @@
 import { DecodeError } from './codec.js';
 import { bounds, edgeIndices, vertexNormals } from './geometry.js';
 import { normalDeviation, reliefTop } from './relief.js';
-import { retryAfterSeconds, waitToRetry } from './retry.js';
+import { NetworkError, fetchPayload } from './payload.js';
 
 /**
  * @typedef {object} LoadRequest
@@ -86,13 +86,9 @@ import { retryAfterSeconds, waitToRetry } from './retry.js';
 
 /** @typedef {(message: WorkerMessage, transfer: Transferable[]) => void} Post */
 
-/** @typedef {{ bytes: Uint8Array } | { capped: { status: number, reason: string | null, retryAfterS: number | null } }} Fetched */
+/** @typedef {import('./payload.js').Fetched} Fetched */
 
-/** How many times one payload waits out a 503 with Retry-After. */
-const UNAVAILABLE_RETRIES = 5;
-
-/** Thrown for transport failures and unexpected HTTP answers. */
-export class NetworkError extends Error {}
+export { NetworkError };
 
 const PROGRESS_EVERY_MS = 100;
 
@@ -363,34 +359,8 @@ export class Reconstruction {
    */
   async #fetch(level, url) {
     const what = level === 0 ? 'base mesh' : `batch ${level}`;
-    /** @type {Response} */
-    let response;
-    for (let tries = 0; ; tries++) {
-      try {
-        response = await this.fetchImpl(url, { headers: this.request.headers, signal: this.#abort.signal });
-      } catch (error) {
-        throw new NetworkError(`could not fetch the ${what}: ${describe(error)}`);
-      }
-      // A 503 that says when to come back (shedding under load, a database
-      // restarting) is waited out, with 0–1 s of jitter, a few times.
-      if (response.status !== 503 || tries >= UNAVAILABLE_RETRIES) break;
-      const wait = retryAfterSeconds(response, await response.json().catch(() => null));
-      if (wait === null) break;
-      await waitToRetry(Math.min(wait, 60), this.#abort.signal);
-    }
-    if (response.status === 403 || response.status === 429) {
-      const body = await response.json().catch(() => ({}));
-      if (body && body.error === 'level_capped') {
-        const retryAfterS = retryAfterSeconds(response, body);
-        return { capped: { status: response.status, reason: body.reason ?? null, retryAfterS } };
-      }
-    }
-    if (!response.ok) throw new NetworkError(`the server answered ${response.status} for the ${what}`);
-    try {
-      return { bytes: await this.#readBody(response) };
-    } catch (error) {
-      throw new NetworkError(`the ${what} was cut off: ${describe(error)}`);
-    }
+    const { headers } = this.request;
+    return fetchPayload(url, { what, headers, signal: this.#abort.signal, fetchImpl: this.fetchImpl, read: (r) => this.#readBody(r) });
   }
 
   /** @param {Response} response */

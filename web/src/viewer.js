@@ -108,6 +108,9 @@ export function compileDecoder(url) {
   return module;
 }
 
+/** Toolbar buttons for a mesh only: hidden on a point cloud. */
+const MESH_TOOLS = ['wireframe', 'relief', 'splats', 'measure'];
+
 /** How many times a load waits out a 503 with Retry-After before it gives up. */
 const BUSY_RETRIES = 20;
 
@@ -217,7 +220,7 @@ export class Viewer {
         this.cameraMoved();
       },
       reset: () => this.resetView(),
-      toggleWireframe: () => this.setWireframe(!this.#wireframe),
+      toggleWireframe: () => this.points === null && this.setWireframe(!this.#wireframe),
       toggleFullscreen: () => ui.toggleFullscreen(),
       interacted: (kind) => this.#emit('vitrine-interaction', { kind }),
     });
@@ -306,7 +309,7 @@ export class Viewer {
     const target = this.#target(this.#cap.level);
     if (target <= this.state.targetLevel) return;
     this.#set({ targetLevel: target, status: 'refining' });
-    this.#worker?.postMessage({ type: 'extend', upTo: target });
+    this.#extend(target);
   }
 
   /** Loads from scratch (also the retry after an error). */
@@ -383,7 +386,7 @@ export class Viewer {
     const target = this.#target(this.#cap.level);
     if (target <= this.state.targetLevel) return;
     this.#set({ targetLevel: target, status: 'refining' });
-    this.#worker?.postMessage({ type: 'extend', upTo: target });
+    this.#extend(target);
   }
 
   /**
@@ -517,6 +520,9 @@ export class Viewer {
    */
   #begin(manifest, module, worker) {
     this.manifest = manifest;
+    this.#pointTools(false);
+    this.points?.destroy();
+    this.points = null;
     this.ui.setDetails(manifest.title, manifest.description);
     this.ui.setQuality(manifest.quality ?? null);
     this.#look = { ...this.#look, model: upRotation(manifest.up), bounds: validBounds(manifest.bounds, null) };
@@ -570,7 +576,7 @@ export class Viewer {
     this.#cap = { level: manifest.cap.level, reason: manifest.cap.reason, retryAfterS: manifest.cap.retry_after_s };
     const target = this.#target(manifest.cap.level);
     this.#set({ status: 'refining', lastLevel: manifest.last_level, targetLevel: target });
-    this.ui.splatsButton.hidden = true;
+    this.#pointTools(true);
     this.points?.destroy();
     this.points = new PointModel({
       ...this.#splatHost(),
@@ -578,11 +584,22 @@ export class Viewer {
       shown: (level) => this.#shown(level),
       framed: (frame) => this.#framed(frame),
       set: (patch) => this.#set(patch),
+      capped: (cap) => this.#capped(cap),
       fail: (message) => this.#fail(message),
     });
     const url = (/** @type {string} */ path) => this.#apiUrl(path);
     const levels = manifest.levels.slice(0, target + 1).map((l) => url(l.url));
     return this.points.start(module, { baseUrl: levels[0], batchUrls: levels.slice(1), upTo: target });
+  }
+
+  /**
+   * Hides the tools that read a mesh (wireframe, relief, measure along the
+   * surface, the splat view of a mesh level) on a point cloud; shows them
+   * again for a mesh.
+   * @param {boolean} points
+   */
+  #pointTools(points) {
+    for (const action of MESH_TOOLS) this.ui.button(action).hidden = points;
   }
 
   /** What both splat views (splats/) borrow from the viewer. */
@@ -673,10 +690,7 @@ export class Viewer {
         this.#set({ received: message.received });
         break;
       case 'capped':
-        // The cap fell after the manifest was read: the server refused a batch.
-        this.#cap = { level: message.level, reason: message.reason, retryAfterS: message.retryAfterS };
-        this.#set({ targetLevel: message.level });
-        if (this.state.shownLevel >= message.level) this.#announceCap();
+        this.#capped(message);
         break;
       case 'error': {
         const where = message.level < 0 ? 'the base mesh' : `level ${message.level + 1}`;
@@ -687,6 +701,26 @@ export class Viewer {
       case 'done':
         break;
     }
+  }
+
+  /**
+   * The cap fell after the manifest was read: the server refused a batch
+   * (a mesh's or a point cloud's).
+   * @param {{ level: number, reason: string | null, retryAfterS: number | null }} cap
+   */
+  #capped(cap) {
+    this.#cap = { level: cap.level, reason: cap.reason, retryAfterS: cap.retryAfterS };
+    this.#set({ targetLevel: cap.level });
+    if (this.state.shownLevel >= cap.level) this.#announceCap();
+  }
+
+  /**
+   * Loads up to `upTo`: the decode worker, or a point cloud's splat worker.
+   * @param {number} upTo
+   */
+  #extend(upTo) {
+    if (this.points) this.points.extend(upTo);
+    else this.#worker?.postMessage({ type: 'extend', upTo });
   }
 
   /** @param {{ level: number, vertices: number, normalsMs: number }} level */
@@ -756,7 +790,7 @@ export class Viewer {
     } catch {
       manifest = null;
     }
-    if (!this.#worker) return;
+    if (!this.#worker && !this.points?.running) return;
     const current = /** @type {Manifest} */ (this.manifest);
     if (!manifest) {
       this.#retry = setTimeout(() => this.#recheck(), ((current.cap.retry_after_s ?? 10) + Math.random()) * 1000);
@@ -768,7 +802,7 @@ export class Viewer {
     if (target > this.state.targetLevel) {
       this.ui.showNotice(null);
       this.#set({ status: 'refining', message: null, targetLevel: target });
-      this.#worker.postMessage({ type: 'extend', upTo: target });
+      this.#extend(target);
     } else {
       this.#cap.level = Math.min(this.#cap.level, this.state.targetLevel);
       this.#announceCap();

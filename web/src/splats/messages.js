@@ -6,13 +6,17 @@
 /**
  * @typedef {{ type: 'points', module: WebAssembly.Module, baseUrl: string, batchUrls: string[], upTo: number,
  *     sharpThreshold?: number, headers?: Record<string, string> }
+ *   | { type: 'extend', upTo: number }
  *   | { type: 'mesh', id: number, positions: Float32Array, indices: Uint32Array, colours: Uint8Array | null }} SplatCommand
  */
 
 /**
  * @typedef {{ type: 'splats', id: number | null, level: number, set: import('./splat-renderer.js').SplatSet, received: number, ms: number }
  *   | { type: 'error', kind: 'network' | 'decode', level: number, message: string }
+ *   | { type: 'capped', level: number, status: number, reason: string | null, retryAfterS: number | null }
  *   | { type: 'done', level: number }} SplatMessage
+ * `extend`: load up to a higher level (the cap rose); `capped`: the server
+ * refused the level after `level` (the cap fell since the manifest was read).
  */
 
 export {};

@@ -6,7 +6,8 @@
  * each level's splats replace the last in a SplatView over the viewer's
  * canvas, so the cloud refines as levels arrive. A chunk that does not
  * decode (a truncated stream) or a download that fails ends in the
- * viewer's error state.
+ * viewer's error state; a level the server refuses (a load cap) holds the
+ * cloud at the level before it until {@link PointModel#extend}.
  */
 
 import { bounds } from '../geometry.js';
@@ -25,6 +26,8 @@ import { SplatView } from './splat-view.js';
  * @property {(level: { level: number, vertices: number, normalsMs: number }) => void} shown a level is on screen
  * @property {(frame: { level: number, colourResolution: null, reliefTop: null, at: number }) => void} framed a level was drawn
  * @property {(patch: Partial<import('../viewer.js').ViewerState>) => void} set
+ * @property {(cap: { level: number, reason: string | null, retryAfterS: number | null }) => void} capped the
+ *   server refused the level after `level` (the viewer's cap handling, as for a mesh)
  * @property {(message: string) => void} fail
  */
 
@@ -61,12 +64,24 @@ export class PointModel {
         host.set({ decodedLevel: m.level, received: m.received, decodeMs: (this.#decodeMs += m.ms) });
         host.shown({ level: m.level, vertices: m.set.count, normalsMs: 0 });
         host.framed({ level: m.level, colourResolution: null, reliefTop: null, at: performance.now() });
+      } else if (m.type === 'capped') {
+        host.capped(m);
       } else if (m.type === 'error') {
         const what = m.kind === 'decode' ? `could not decode level ${m.level + 1} of the point stream` : 'a download failed';
         host.fail(`${what}: ${m.message}`);
       }
     };
     worker.postMessage({ type: 'points', module, ...request });
+  }
+
+  /** Loads up to `upTo` (the cap rose). @param {number} upTo */
+  extend(upTo) {
+    this.#worker?.postMessage({ type: 'extend', upTo });
+  }
+
+  /** Whether levels may still come (not stopped). */
+  get running() {
+    return this.#worker !== null;
   }
 
   /** Stops decoding; what is on screen stays until {@link destroy}. */

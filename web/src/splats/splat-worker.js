@@ -9,6 +9,7 @@
 
 import { VitrineCodec } from '../codec.js';
 import { meshSplats } from './mesh-splats.js';
+import { fetchPayload } from '../payload.js';
 import { PointStream, splitHeader } from './point-stream.js';
 
 /** @typedef {import('./messages.js').SplatCommand} SplatCommand */
@@ -27,38 +28,62 @@ function post(message) {
   scope.postMessage(message, transfer);
 }
 
-/**
- * @param {string} url
- * @param {Record<string, string> | undefined} headers
- */
-async function download(url, headers) {
-  const response = await fetch(url, { headers });
-  if (!response.ok) throw Object.assign(new Error(`the server answered ${response.status}`), { network: true });
-  return new Uint8Array(await response.arrayBuffer());
-}
+/** The point model loading now: `extend` raises its `upTo`. @type {{ upTo: number, wake: (() => void) | null } | null} */
+let loading = null;
 
 /** @param {Extract<SplatCommand, { type: 'points' }>} command */
 async function points(command) {
   const codec = await VitrineCodec.instantiate(command.module);
   const threshold = command.sharpThreshold ?? 0.9;
+  const load = { upTo: command.upTo, wake: /** @type {(() => void) | null} */ (null) };
+  loading = load;
   /** @type {PointStream | null} */
   let stream = null;
   let received = 0;
   // Level k + 1 downloads while level k decodes.
   /** @param {number} k */
-  const fetchLevel = (k) => download(k === 0 ? command.baseUrl : command.batchUrls[k - 1], command.headers);
-  let next = fetchLevel(0);
-  for (let level = 0; level <= command.upTo; level++) {
-    let bytes;
+  const fetchLevel = (k) =>
+    fetchPayload(k === 0 ? command.baseUrl : command.batchUrls[k - 1], {
+      what: k === 0 ? 'first level of the point stream' : `level ${k + 1} of the point stream`,
+      headers: command.headers,
+    });
+  /** @type {Promise<import('../payload.js').Fetched> | null} */
+  let next = null;
+  let level = 0;
+  for (;;) {
+    if (level > load.upTo) {
+      post({ type: 'done', level: load.upTo });
+      // Until the page raises the cap (a capped load resumes).
+      await new Promise((resolve) => (load.wake = () => resolve(undefined)));
+      load.wake = null;
+      continue;
+    }
+    next ??= fetchLevel(level);
+    let fetched;
     try {
-      bytes = await next;
+      fetched = await next;
     } catch (error) {
       post({ type: 'error', kind: 'network', level, message: error instanceof Error ? error.message : String(error) });
       return;
     }
+    next = null;
+    if ('capped' in fetched) {
+      // The server refused this level (its cap fell since the manifest was
+      // read): the levels before it stay on screen.
+      if (level === 0) {
+        post({ type: 'error', kind: 'network', level, message: 'the server refused the first level of the point stream' });
+        return;
+      }
+      load.upTo = level - 1;
+      post({ type: 'capped', level: level - 1, ...fetched.capped });
+      continue;
+    }
+    const bytes = fetched.bytes;
     received += bytes.length;
-    if (level < command.upTo) next = fetchLevel(level + 1);
-    next.catch(() => {});
+    if (level < load.upTo) {
+      next = fetchLevel(level + 1);
+      next.catch(() => {});
+    }
     const started = performance.now();
     try {
       if (level === 0) {
@@ -72,13 +97,19 @@ async function points(command) {
       post({ type: 'error', kind: 'decode', level, message: error instanceof Error ? error.message : String(error) });
       return;
     }
+    level++;
   }
-  post({ type: 'done', level: command.upTo });
 }
 
 scope.onmessage = (/** @type {MessageEvent<SplatCommand>} */ event) => {
   const command = event.data;
   if (command.type === 'points') void points(command);
+  else if (command.type === 'extend') {
+    if (loading && command.upTo > loading.upTo) {
+      loading.upTo = command.upTo;
+      loading.wake?.();
+    }
+  }
   else if (command.type === 'mesh') {
     const started = performance.now();
     const set = meshSplats(command.positions, command.indices, command.colours);

@@ -17,7 +17,8 @@ export const webDist = join(root, 'web', 'dist');
  * @property {string} slug
  * @property {string} title
  * @property {string} [description]
- * @property {'torus' | 'sphere' | 'plate' | 'file'} kind a generated sample, or `file` (a mesh the test wrote)
+ * @property {'torus' | 'sphere' | 'plate' | 'cloud' | 'file'} kind a generated sample (`cloud`: a point
+ *   cloud, a PLY without faces), or `file` (a mesh the test wrote)
  * @property {string} [file] with `kind: 'file'`, the mesh to ingest
  * @property {number} [kiloVertices] the sample's detail
  * @property {boolean} [colour] paint a procedural pattern on the vertices
