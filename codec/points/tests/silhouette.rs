@@ -10,8 +10,8 @@ use vitrine_points::splat::{preprocess, ClipMode, SplatOptions, Splats, PLANE_FL
 use vitrine_points::testing::cube;
 
 const SIZE: usize = 512;
-/// The viewer draws each disc at this multiple of its radius
-/// (`DEFAULT_SPLAT_OPTIONS.scale`, web/src/splats/splat-renderer.js). The
+/// The viewer draws a point's disc at this multiple of its radius
+/// (`POINT_RADIUS_SCALE`, web/src/splats/point-stream.js). The
 /// mean distance to the 5 nearest neighbours leaves gaps in a random
 /// sample: on this cube 1,741 hole pixels at 1.0, 61 at 1.2, 1 at 1.35,
 /// none from 1.5.

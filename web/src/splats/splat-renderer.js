@@ -32,10 +32,7 @@ import { SHADERS } from './shaders.js';
  */
 
 /** @type {SplatOptions} */
-// scale 1.5: the radius (mean distance to the 5 nearest neighbours) leaves
-// holes in a random sample; 1.5 leaves none on a jittered cube over 24 views
-// (codec/points/tests/silhouette.rs).
-export const DEFAULT_SPLAT_OPTIONS = { surfaceIds: true, clipping: true, tolerance: 1, scale: 1.5 };
+export const DEFAULT_SPLAT_OPTIONS = { surfaceIds: true, clipping: true, tolerance: 1, scale: 1 };
 
 export class SplatUnsupported extends Error {}
 
