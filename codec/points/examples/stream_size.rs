@@ -2,9 +2,13 @@
 //! files, positions only (and with normals where the file has them):
 //!
 //! ```sh
-//! cargo run --release -p vitrine-points --example stream_size -- 12 scan.ply ...
+//! cargo run --release -p vitrine-points --example stream_size -- 12 [--write DIR] scan.ply ...
 //! ```
 //! Prints: file, points, bits, bytes, bits per point, decode ms (median of 5).
+//! With `--write DIR`, also writes DIR/scan.vpts (positions only) and
+//! DIR/scan.f32 (the imported positions, x y z little-endian f32), which
+//! `scripts/peer_draco_points.py` encodes with Draco for
+//! `web/bench/points-decode.mjs`.
 
 use std::time::Instant;
 
@@ -17,8 +21,14 @@ fn main() {
         .next()
         .and_then(|a| a.parse().ok())
         .expect("usage: stream_size BITS FILE...");
+    let mut paths: Vec<String> = args.collect();
+    let write = paths.iter().position(|a| a == "--write").map(|i| {
+        let dir = paths.get(i + 1).expect("--write DIR").clone();
+        paths.drain(i..i + 2);
+        std::path::PathBuf::from(dir)
+    });
     println!("file\tpoints\tbits\tattrs\tbytes\tbits_per_point\tdecode_ms");
-    for path in args {
+    for path in paths {
         let cloud = import_path(path.as_ref(), 100_000_000).expect("import");
         let name = std::path::Path::new(&path)
             .file_name()
@@ -37,6 +47,17 @@ fn main() {
                 ..Default::default()
             };
             let enc = encode(&cloud, &opts).expect("encode");
+            if let (Some(dir), false) = (&write, normals) {
+                let stem = dir.join(std::path::Path::new(&name).with_extension(""));
+                std::fs::write(stem.with_extension("vpts"), &enc.bytes).expect("write");
+                let raw: Vec<u8> = cloud
+                    .positions
+                    .iter()
+                    .flatten()
+                    .flat_map(|v| v.to_le_bytes())
+                    .collect();
+                std::fs::write(stem.with_extension("f32"), raw).expect("write");
+            }
             let mut times: Vec<f64> = (0..5)
                 .map(|_| {
                     let t = Instant::now();

@@ -187,19 +187,23 @@ pub async fn uploads_as_jobs(db: TestDb) {
     drop(socket);
     // The model is committed (and served) a moment before its job is marked
     // done, so wait on the job itself, then check the model is there.
+    let job_list = || async {
+        let jobs: Value = http
+            .get(server.url("/api/jobs"))
+            .bearer_auth(&curator)
+            .send()
+            .await
+            .unwrap()
+            .json()
+            .await
+            .unwrap();
+        jobs
+    };
     eventually(
         Duration::from_secs(60),
         "the upload job to finish",
         || async {
-            let jobs: Value = http
-                .get(server.url("/api/jobs"))
-                .bearer_auth(&curator)
-                .send()
-                .await
-                .unwrap()
-                .json()
-                .await
-                .unwrap();
+            let jobs = job_list().await;
             matches!(jobs["jobs"][0]["state"].as_str(), Some("done" | "failed"))
         },
     )
@@ -212,15 +216,7 @@ pub async fn uploads_as_jobs(db: TestDb) {
             .status(),
         StatusCode::OK
     );
-    let jobs: Value = http
-        .get(server.url("/api/jobs"))
-        .bearer_auth(&curator)
-        .send()
-        .await
-        .unwrap()
-        .json()
-        .await
-        .unwrap();
+    let jobs = job_list().await;
     let vase = &jobs["jobs"][0];
     assert_eq!(vase["slug"], "vase");
     assert_eq!(vase["state"], "done", "{vase}");
