@@ -125,7 +125,6 @@ pub(super) fn parse_root<'a>(
     let mut root = gltf::json::Root::from_slice(json)
         .map_err(|e| gltf_error(gltf::Error::Deserialize(e), what))?;
     super::extensions::accept_required(&mut root, what)?;
-    check_attribute_accessors(&root, what)?;
     Ok((root, bin))
 }
 
