@@ -124,6 +124,12 @@ impl<'a> Grid<'a> {
     /// (per axis) of cell `c`: one range per (y, z) row.
     fn rows(&self, c: [u64; 3], reach: u64, out: &mut Vec<(u32, u32)>) {
         out.clear();
+        self.each_row(c, reach, |a, b| out.push((self.starts[a], self.starts[b])));
+    }
+
+    /// `f(a, b)` for the occupied cells `keys[a..b]` of each (y, z) row
+    /// within `reach` cells of cell `c` (non-empty rows only).
+    fn each_row(&self, c: [u64; 3], reach: u64, mut f: impl FnMut(usize, usize)) {
         let lo = c.map(|v| v.saturating_sub(reach));
         let hi = [0, 1, 2].map(|a| (c[a] + reach).min(self.dims[a] - 1));
         for z in lo[2]..=hi[2] {
@@ -133,10 +139,32 @@ impl<'a> Grid<'a> {
                 let a = self.keys.partition_point(|&key| key < first);
                 let b = a + self.keys[a..].partition_point(|&key| key <= last);
                 if a < b {
-                    out.push((self.starts[a], self.starts[b]));
+                    f(a, b);
                 }
             }
         }
+    }
+
+    /// The occupied cells within `reach` cells (per axis) of cell `c`, each
+    /// with its box widened by [`BOX_SLACK`] cells on every side (so that a
+    /// point's true position lies inside its cell's box whatever the
+    /// rounding of its cell index), nearest to `c` first.
+    fn near_cells(&self, c: [u64; 3], reach: u64, out: &mut Vec<NearCell>) {
+        out.clear();
+        self.each_row(c, reach, |a, b| {
+            for k in a..b {
+                let cc = self.cell_coords(self.keys[k]);
+                let lo = [0, 1, 2].map(|ax| self.min[ax] + (cc[ax] as f32 - BOX_SLACK) * self.cell);
+                let off = [0, 1, 2].map(|ax| cc[ax].abs_diff(c[ax]));
+                out.push(NearCell {
+                    start: self.starts[k],
+                    end: self.starts[k + 1],
+                    lo,
+                    ring: off[0] * off[0] + off[1] * off[1] + off[2] * off[2],
+                });
+            }
+        });
+        out.sort_unstable_by_key(|n| n.ring);
     }
 
     /// Calls `f(j)` for every point in the cells within `reach` cells (per
@@ -162,12 +190,13 @@ impl<'a> Grid<'a> {
     ) {
         let mut near = Near {
             grid: self,
-            rows: Vec::new(),
+            cells: Vec::new(),
+            extent: self.cell * (1.0 + 2.0 * BOX_SLACK),
         };
         for (k, &key) in self.keys.iter().enumerate() {
             let (s, e) = (self.starts[k] as usize, self.starts[k + 1] as usize);
             let r = reach(&self.order[s..e]);
-            self.rows(self.cell_coords(key), r, &mut near.rows);
+            self.near_cells(self.cell_coords(key), r, &mut near.cells);
             for t in s..e {
                 f(self.order[t], self.sorted[t], &near);
             }
@@ -177,15 +206,22 @@ impl<'a> Grid<'a> {
     /// Calls `f(i, neighbours)` for every point with its `k` nearest other
     /// points (ascending (squared distance, index)), cell by cell.
     pub fn knn_each(&self, k: usize, mut f: impl FnMut(usize, &[(f32, u32)])) {
-        let mut best = Vec::with_capacity(k + 1);
+        let mut best: Vec<(f32, u32)> = Vec::with_capacity(k + 1);
         let covered = self.cell * self.cell;
         self.for_each_point_near(
             |_| 1,
             |i, p, near| {
                 best.clear();
-                for (j, q) in near.iter() {
-                    if j != i {
-                        insert_best(&mut best, k, (dist2(p, q), j));
+                // Nearest cells first; once k are found, a cell whose box is
+                // farther than the k-th cannot improve them.
+                for cell in &near.cells {
+                    if best.len() == k && near.box_dist2(cell, p) > best[k - 1].0 {
+                        continue;
+                    }
+                    for (j, q) in near.points(cell) {
+                        if j != i {
+                            insert_best(&mut best, k, (dist2(p, q), j));
+                        }
                     }
                 }
                 // Everything outside one ring of cells is farther than a cell.
@@ -227,24 +263,58 @@ impl<'a> Grid<'a> {
     }
 }
 
-/// The points of some rows of cells (see [`Grid::for_each_point_near`]).
+/// Widening of a cell's box, in cells, for the rounding of cell indices
+/// (f32 coordinates over at most 2^21 cells err by far less).
+const BOX_SLACK: f32 = 0.25;
+
+/// An occupied cell near a query's cell.
+#[derive(Clone, Copy, Debug)]
+pub struct NearCell {
+    /// `start..end` indexes the sorted order.
+    pub start: u32,
+    pub end: u32,
+    /// Lower corner of the cell's widened box.
+    lo: [f32; 3],
+    /// Squared offset in cells from the query's cell (0 for that cell).
+    ring: u64,
+}
+
+/// The occupied cells around one cell (see [`Grid::for_each_point_near`]).
 pub struct Near<'g> {
     grid: &'g Grid<'g>,
-    rows: Vec<(u32, u32)>,
+    pub cells: Vec<NearCell>,
+    /// Side of a widened box.
+    extent: f32,
 }
 
 impl Near<'_> {
     /// (index, position) of each point.
     #[inline]
     pub fn iter(&self) -> impl Iterator<Item = (u32, [f32; 3])> + '_ {
-        self.rows.iter().flat_map(|&(a, b)| {
-            let (a, b) = (a as usize, b as usize);
-            let g = self.grid;
-            g.order[a..b]
-                .iter()
-                .copied()
-                .zip(g.sorted[a..b].iter().copied())
-        })
+        self.cells.iter().flat_map(|c| self.points(c))
+    }
+
+    /// (index, position) of each point of `cell`.
+    #[inline]
+    pub fn points(&self, cell: &NearCell) -> impl Iterator<Item = (u32, [f32; 3])> + '_ {
+        let (a, b) = (cell.start as usize, cell.end as usize);
+        let g = self.grid;
+        g.order[a..b]
+            .iter()
+            .copied()
+            .zip(g.sorted[a..b].iter().copied())
+    }
+
+    /// A lower bound on the squared distance from `p` to any point of
+    /// `cell` (0 when `p` is inside its widened box).
+    #[inline]
+    pub fn box_dist2(&self, cell: &NearCell, p: [f32; 3]) -> f32 {
+        let mut d2 = 0.0;
+        for (&lo, &x) in cell.lo.iter().zip(&p) {
+            let d = (lo - x).max(x - (lo + self.extent)).max(0.0);
+            d2 += d * d;
+        }
+        d2
     }
 }
 
@@ -292,10 +362,21 @@ mod tests {
     #[test]
     fn knn_matches_brute_force() {
         let mut s = 1u64;
-        let pts: Vec<[f32; 3]> = (0..3000)
+        let random: Vec<[f32; 3]> = (0..3000)
             .map(|_| [0, 1, 2].map(|_| crate::testing::unit(&mut s) * 10.0))
             .collect();
-        let g = Grid::for_knn(&pts);
+        // A lattice: many exact ties (broken by index) and points on the
+        // cells' boundaries.
+        let lattice: Vec<[f32; 3]> = (0..2744)
+            .map(|k| [k % 14, k / 14 % 14, k / 196].map(|c| c as f32 * 0.25))
+            .collect();
+        for pts in [random, lattice] {
+            knn_agrees(&pts);
+        }
+    }
+
+    fn knn_agrees(pts: &[[f32; 3]]) {
+        let g = Grid::for_knn(pts);
         let mut out = Vec::new();
         for i in (0..pts.len()).step_by(37) {
             g.knn(i, 8, &mut out);

@@ -11,7 +11,7 @@ use vitrine_points::testing::{cube, next, sphere, unit};
 fn splat_grid_graph_equals_brute_force() {
     let mut s = 77u64;
     let mut total_edges = 0;
-    for (case, n) in [(0, 2500), (1, 3000), (2, 2000), (3, 2500)] {
+    for (case, n) in [(0, 2500), (1, 3000), (2, 2000), (3, 2500), (4, 2744)] {
         let pts: Vec<[f32; 3]> = (0..n)
             .map(|k| match case {
                 // Dense in a volume.
@@ -25,6 +25,13 @@ fn splat_grid_graph_equals_brute_force() {
                 // Two clusters of very different density.
                 2 if k % 2 == 0 => [unit(&mut s) * 0.05, unit(&mut s) * 0.05, 0.0],
                 2 => [1.0 + unit(&mut s) * 5.0, unit(&mut s) * 5.0, unit(&mut s)],
+                // A lattice: distances tie exactly with r_i + r_j, and
+                // points sit on the grid's cell boundaries.
+                4 => [
+                    (k % 14) as f32 * 0.125,
+                    (k / 14 % 14) as f32 * 0.125,
+                    (k / 196) as f32 * 0.125,
+                ],
                 // A sparse line with duplicates.
                 _ => {
                     let x = (next(&mut s) % 500) as f32 * 0.01;

@@ -98,10 +98,18 @@ pub fn neighbour_graph(positions: &[[f32; 3]], radii: &[f32]) -> Graph {
         },
         |i, ci, near| {
             let (iu, ri) = (i as usize, radii[i as usize]);
-            for (j, cj) in near.iter() {
-                let ju = j as usize;
-                if ju != iu && owns(iu, ju) && is_edge(ci, cj, ri, radii[ju]) {
-                    edges.push((i, j));
+            // A cell whose (widened) box lies 2 r_i away or more holds no
+            // partner i owns; the margin covers the bound's own rounding.
+            let bound = (2.0 * ri) * (2.0 * ri) * (1.0 + 1e-4);
+            for cell in &near.cells {
+                if near.box_dist2(cell, ci) >= bound {
+                    continue;
+                }
+                for (j, cj) in near.points(cell) {
+                    let ju = j as usize;
+                    if ju != iu && is_edge(ci, cj, ri, radii[ju]) && owns(iu, ju) {
+                        edges.push((i, j));
+                    }
                 }
             }
         },
