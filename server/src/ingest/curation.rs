@@ -157,6 +157,92 @@ pub fn render_thumbnail(
     };
     let options = RenderOptions::square(THUMBNAIL_SIZE);
     let frame = render(mesh, shader, &thumbnail_camera(mesh, up), &options);
+    png_thumbnail(&frame)
+}
+
+/// Most points drawn into a point model's thumbnail: a prefix of the stream
+/// (every prefix is an even subsample of the cloud), ample at 512².
+pub const THUMBNAIL_POINTS: usize = 200_000;
+
+/// Renders a point cloud (in stream order) as a PNG, framed as a mesh's:
+/// each point of a prefix becomes a square splat in its tangent plane (the
+/// area of a disc of its splat radius, grown by a fifth so that neighbours
+/// overlap with no holes), facing the camera when the cloud has no normals,
+/// coloured by its colour or clay.
+pub fn render_point_thumbnail(
+    positions: &[[f32; 3]],
+    normals: Option<&[[f32; 3]]>,
+    colours: Option<&[[u8; 3]]>,
+    up: UpAxis,
+) -> anyhow::Result<NewThumbnail> {
+    let m = positions.len().min(THUMBNAIL_POINTS);
+    let centres = &positions[..m];
+    let camera = thumbnail_camera(
+        &IndexedMesh {
+            positions: centres.to_vec(),
+            colors: None,
+            triangles: Vec::new(),
+        },
+        up,
+    );
+    let splats = point_splat_mesh(centres, normals, colours, camera.eye);
+    let vertex;
+    let shader: &dyn SurfaceShader = match VertexColours::new(&splats) {
+        Some(v) => {
+            vertex = v;
+            &vertex
+        }
+        None => &ConstantColour::CLAY,
+    };
+    let frame = render(
+        &splats,
+        shader,
+        &camera,
+        &RenderOptions::square(THUMBNAIL_SIZE),
+    );
+    png_thumbnail(&frame)
+}
+
+/// Squares of side √π · 1.2 · r_i (r_i the splat radius: the mean distance
+/// to the 5 nearest points), two triangles each, wound counter-clockwise
+/// about the point's normal.
+fn point_splat_mesh(
+    centres: &[[f32; 3]],
+    normals: Option<&[[f32; 3]]>,
+    colours: Option<&[[u8; 3]]>,
+    eye: Vec3,
+) -> IndexedMesh {
+    let radii = vitrine_points::splat::splat_radii(centres);
+    let half_side = 0.5 * std::f32::consts::PI.sqrt() * 1.2;
+    let mut mesh = IndexedMesh {
+        positions: Vec::with_capacity(4 * centres.len()),
+        colors: colours.map(|_| Vec::with_capacity(4 * centres.len())),
+        triangles: Vec::with_capacity(2 * centres.len()),
+    };
+    for (i, (&c, &r)) in centres.iter().zip(&radii).enumerate() {
+        let centre = Vec3::from(c);
+        let n = normals
+            .and_then(|n| n.get(i))
+            .map(|&n| Vec3::from(n))
+            .filter(|n| n.is_finite() && n.length_squared() > 0.5)
+            .unwrap_or_else(|| (eye - centre).normalize_or(Vec3::Z));
+        let (t, b) = n.any_orthonormal_pair();
+        let h = half_side * r;
+        let first = mesh.positions.len() as u32;
+        for corner in [-t - b, t - b, t + b, -t + b] {
+            mesh.positions.push((centre + corner * h).to_array());
+        }
+        if let (Some(out), Some(colours)) = (&mut mesh.colors, colours) {
+            let colour = colours.get(i).copied().unwrap_or([200; 3]);
+            out.extend([colour; 4]);
+        }
+        mesh.triangles.push([first, first + 1, first + 2]);
+        mesh.triangles.push([first, first + 2, first + 3]);
+    }
+    mesh
+}
+
+fn png_thumbnail(frame: &vitrine_quality::metrics::Frame) -> anyhow::Result<NewThumbnail> {
     let mut bytes = Vec::new();
     frame
         .to_image()
@@ -216,5 +302,46 @@ mod tests {
             .filter(|&x| covered(x, THUMBNAIL_SIZE / 2))
             .count();
         assert!(rows > cols * 2, "rows {rows}, columns {cols}: not upright");
+    }
+
+    #[test]
+    fn point_thumbnail_covers_what_the_mesh_covers() {
+        // The vertices of a sphere with their normals, against the sphere:
+        // the same silhouette (no holes, no halo), shaded, not background.
+        let sphere = vitrine_samples::icosphere(5);
+        let normals: Vec<[f32; 3]> = sphere
+            .positions
+            .iter()
+            .map(|p| Vec3::from(*p).normalize().to_array())
+            .collect();
+        let mask = |png: &[u8]| -> Vec<bool> {
+            let image = image::load_from_memory(png).unwrap().to_rgb8();
+            image.pixels().map(|p| p.0 != [33, 36, 41]).collect()
+        };
+        let mesh = mask(&render_thumbnail(&sphere, None, UpAxis::Y).unwrap().bytes);
+        let with_normals =
+            render_point_thumbnail(&sphere.positions, Some(&normals), None, UpAxis::Y);
+        let without = render_point_thumbnail(&sphere.positions, None, None, UpAxis::Y);
+        let covered = mesh.iter().filter(|&&c| c).count();
+        assert!(covered > 50_000, "{covered}");
+        // Splats facing the camera stick out of the silhouette by their
+        // radius (a halo a few pixels wide) but leave no holes either.
+        for (what, points, percent) in [
+            ("normals", with_normals, 3),
+            ("facing the camera", without, 15),
+        ] {
+            let points = mask(&points.unwrap().bytes);
+            let differ = mesh.iter().zip(&points).filter(|(a, b)| a != b).count();
+            let holes = mesh
+                .iter()
+                .zip(&points)
+                .filter(|(a, b)| **a && !**b)
+                .count();
+            assert!(
+                differ * 100 < covered * percent,
+                "{what}: {differ} of {covered} pixels differ"
+            );
+            assert!(holes * 1000 < covered, "{what}: {holes} hole pixels");
+        }
     }
 }

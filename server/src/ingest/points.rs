@@ -82,6 +82,7 @@ struct Encoding {
     normals_time: Duration,
     encode_time: Duration,
     bounds: crate::storage::Bounds,
+    thumbnail: crate::storage::NewThumbnail,
 }
 
 /// Encodes `cloud` as a point stream (estimating normals when it has none)
@@ -110,7 +111,7 @@ pub async fn ingest_points(
         .up
         .unwrap_or_else(|| curation::detect_up_of(Some(Path::new(&source.name)), &cloud.positions));
     let task_options = options.clone();
-    let encoding = tokio::task::spawn_blocking(move || encode(cloud, &task_options))
+    let encoding = tokio::task::spawn_blocking(move || encode(cloud, up, &task_options))
         .await
         .context("encoder task failed")??;
     let encoded = &encoding.encoded;
@@ -140,8 +141,7 @@ pub async fn ingest_points(
         up_axis: Some(up),
         unit: meta.unit.clone(),
         bounds: Some(encoding.bounds),
-        // No point rasteriser yet: the gallery shows its placeholder.
-        thumbnail: None,
+        thumbnail: Some(encoding.thumbnail.clone()),
     };
     let stored = stage_and_commit(storage, &new, options.pause_before_commit).await?;
     Ok(IngestReport {
@@ -158,7 +158,11 @@ pub async fn ingest_points(
     })
 }
 
-fn encode(mut cloud: PointCloud, options: &IngestOptions) -> anyhow::Result<Encoding> {
+fn encode(
+    mut cloud: PointCloud,
+    up: crate::storage::UpAxis,
+    options: &IngestOptions,
+) -> anyhow::Result<Encoding> {
     options.report("estimating normals", 0.1);
     let started = Instant::now();
     let normals_estimated = cloud.normals.is_none() && options.points.normals;
@@ -177,7 +181,15 @@ fn encode(mut cloud: PointCloud, options: &IngestOptions) -> anyhow::Result<Enco
     // Read back as a visitor will: the bounds are the decoded positions'.
     let decoded = stream::decode(&encoded.bytes, None, stream::Limits::default())
         .context("reading the point stream back")?;
+    options.report("rendering the thumbnail", 0.8);
+    let thumbnail = curation::render_point_thumbnail(
+        decoded.positions(),
+        decoded.normals(),
+        decoded.colours(),
+        up,
+    )?;
     Ok(Encoding {
+        thumbnail,
         bounds: curation::bounds_of_positions(decoded.positions()),
         encoded,
         normals_estimated,

@@ -125,6 +125,32 @@ pub async fn points_streamed_under_caps(db: TestDb) {
         "a researcher reaches the full cloud"
     );
 
+    // A thumbnail rendered from the decoded points: a 512² PNG in which the
+    // cube covers a good part of the picture, in the cloud's colours.
+    let thumbnail = m["thumbnail"]
+        .as_str()
+        .expect("a point model has a thumbnail");
+    let (status, headers, png) = get(&http, &server.url(thumbnail), Some(&researcher)).await;
+    assert_eq!(status, StatusCode::OK);
+    assert_eq!(headers[reqwest::header::CONTENT_TYPE], "image/png");
+    let image = image::load_from_memory(&png).unwrap().to_rgb8();
+    assert_eq!(image.dimensions(), (512, 512));
+    let covered: Vec<[u8; 3]> = image
+        .pixels()
+        .map(|p| p.0)
+        .filter(|&p| p != [33, 36, 41])
+        .collect();
+    assert!(
+        covered.len() > 512 * 512 / 10 && covered.len() < 512 * 512 * 9 / 10,
+        "{} pixels covered",
+        covered.len()
+    );
+    let grey = covered
+        .iter()
+        .filter(|p| p[0] == p[1] && p[1] == p[2])
+        .count();
+    assert!(grey * 2 < covered.len(), "coloured, not clay: {grey} grey");
+
     // Header + every level, concatenated: the encoder's stream, byte for byte,
     // and it decodes bit for bit as the encoder's own stream does.
     let mut fetched = Vec::new();
