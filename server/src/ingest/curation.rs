@@ -11,7 +11,7 @@ use std::io::Cursor;
 use std::path::Path;
 use vitrine_codec::{Decoder, IndexedMesh, Limits, StreamIndex};
 use vitrine_colour::ccc::CellComplex;
-use vitrine_quality::metrics::views::{bounding_sphere, FOV_Y};
+use vitrine_quality::metrics::views::{bounding_sphere_of, FOV_Y};
 use vitrine_quality::metrics::{
     render, Camera, ConstantColour, HausdorffReference, RenderOptions, SurfaceShader, VertexColours,
 };
@@ -116,7 +116,12 @@ pub fn bounds_of_positions(positions: &[[f32; 3]]) -> Bounds {
 /// distance (the bounding sphere with a 10 % margin), `up` pointing up,
 /// seen from the front and a little above and to the right.
 pub fn thumbnail_camera(mesh: &IndexedMesh, up: UpAxis) -> Camera {
-    let (center, radius) = bounding_sphere(mesh);
+    thumbnail_camera_of(&mesh.positions, up)
+}
+
+/// [`thumbnail_camera`] for bare positions (a point cloud).
+fn thumbnail_camera_of(positions: &[[f32; 3]], up: UpAxis) -> Camera {
+    let (center, radius) = bounding_sphere_of(positions);
     let up_vector = Vec3::from(up.vector());
     // "Front" is +z for a Y-up or X-up model and -y for a Z-up one (the
     // usual conventions of modelling tools and scanners).
@@ -177,14 +182,7 @@ pub fn render_point_thumbnail(
 ) -> anyhow::Result<NewThumbnail> {
     let m = positions.len().min(THUMBNAIL_POINTS);
     let centres = &positions[..m];
-    let camera = thumbnail_camera(
-        &IndexedMesh {
-            positions: centres.to_vec(),
-            colors: None,
-            triangles: Vec::new(),
-        },
-        up,
-    );
+    let camera = thumbnail_camera_of(centres, up);
     let splats = point_splat_mesh(centres, normals, colours, camera.eye);
     let vertex;
     let shader: &dyn SurfaceShader = match VertexColours::new(&splats) {

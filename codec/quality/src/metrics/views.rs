@@ -10,12 +10,17 @@ pub const FOV_Y: f32 = 40.0 * std::f32::consts::PI / 180.0;
 /// The centre and half diagonal of the bounding box of the vertices: the sphere
 /// the viewer frames (radius at least 1e-6; the origin for an empty mesh).
 pub fn bounding_sphere(mesh: &IndexedMesh) -> (Vec3, f32) {
+    bounding_sphere_of(&mesh.positions)
+}
+
+/// [`bounding_sphere`] of bare positions (a point cloud).
+pub fn bounding_sphere_of(positions: &[[f32; 3]]) -> (Vec3, f32) {
     let (mut min, mut max) = (Vec3::INFINITY, Vec3::NEG_INFINITY);
-    for p in &mesh.positions {
+    for p in positions {
         min = min.min(Vec3::from(*p));
         max = max.max(Vec3::from(*p));
     }
-    if mesh.positions.is_empty() {
+    if positions.is_empty() {
         return (Vec3::ZERO, 1e-6);
     }
     ((min + max) * 0.5, ((max - min).length() * 0.5).max(1e-6))
