@@ -6,7 +6,9 @@
 //!
 //!     pip install fast-simplification plyfile numpy
 //!     cargo run --release -p vitrine-simplify --example melax_bench -- \
-//!         [--peer scripts/peer_quadric.py] MESH…
+//!         [--peer scripts/peer_quadric.py] [--seed-cost] MESH…
+//!
+//! `--seed-cost` runs the seed's crease term sin²(θ/2) instead of sin(θ/2).
 
 use std::process::Command;
 use std::time::Instant;
@@ -16,7 +18,7 @@ use vitrine_mesh::export::write_ply;
 use vitrine_mesh::import::{import_path, ImportOptions};
 use vitrine_mesh::repair::{prepare, RepairOptions};
 use vitrine_quality::metrics::hausdorff;
-use vitrine_simplify::melax::{compact, melax_chain, MelaxModel};
+use vitrine_simplify::melax::{compact, melax_chain, MelaxCost, MelaxModel};
 
 const PERCENTS: [u32; 4] = [80, 60, 40, 20];
 const SAMPLES: usize = 200_000;
@@ -61,6 +63,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         script = Some(paths[1].clone());
         paths.drain(..2);
     }
+    let mut cost = MelaxCost::Sine;
+    if paths.first().is_some_and(|a| a == "--seed-cost") {
+        cost = MelaxCost::Seed;
+        paths.remove(0);
+    }
     println!("| scan | vertices | level | Melax: vertices, faces, H/diag | quadric peer: faces, H/diag, s | H ratio |");
     println!("|---|---:|---:|---|---|---:|");
     for path in &paths {
@@ -76,6 +83,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             triangles: &mesh.triangles,
             frames: &frames,
             corner_uvs: None,
+            cost,
         })?;
         let seconds = t.elapsed().as_secs_f64();
         for p in PERCENTS {

@@ -12,7 +12,7 @@ use std::time::Instant;
 use vitrine_codec::IndexedMesh;
 use vitrine_colour::vertex_colours_from_texture;
 use vitrine_quality::metrics::hausdorff;
-use vitrine_simplify::melax::melax_simplify;
+use vitrine_simplify::melax::{melax_simplify, MelaxCost};
 use vitrine_simplify::{
     simplify, Collapse, FeatureThreshold, Features, Placement, SimplifyOptions, StopReason, Target,
 };
@@ -66,6 +66,25 @@ pub enum FeaturesKind {
     Last,
 }
 
+/// Melax's crease term, for `--method melax` and `vitrine lod`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum MelaxCostKind {
+    /// ‖u − v‖·sin(θ/2) for the crease angle θ: first order in θ, so a
+    /// smooth scan does not pile its collapses into one patch.
+    Sine,
+    /// The seed's ‖u − v‖·(1 − f·n)/2 = ‖u − v‖·sin²(θ/2), as Melax wrote it.
+    Seed,
+}
+
+impl From<MelaxCostKind> for MelaxCost {
+    fn from(kind: MelaxCostKind) -> MelaxCost {
+        match kind {
+            MelaxCostKind::Sine => MelaxCost::Sine,
+            MelaxCostKind::Seed => MelaxCost::Seed,
+        }
+    }
+}
+
 /// How `normal-deviation` removes vertices.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
 pub enum CollapseKind {
@@ -103,6 +122,9 @@ pub struct SimplifyArgs {
     /// can (the target is then always met, borders permitting).
     #[arg(long, value_enum, default_value_t = FeaturesKind::Last)]
     pub features: FeaturesKind,
+    /// melax: the crease term of the collapse cost.
+    #[arg(long, value_enum, default_value_t = MelaxCostKind::Sine)]
+    pub melax_cost: MelaxCostKind,
     #[command(flatten)]
     pub voronoi: super::simplify_voronoi::VoronoiArgs,
     /// Area samples per mesh for the Hausdorff distance (plus every vertex).
@@ -305,7 +327,7 @@ fn voronoi(mesh: &IndexedMesh, args: &SimplifyArgs) -> anyhow::Result<Outcome> {
 }
 
 fn melax(mesh: &IndexedMesh, args: &SimplifyArgs) -> anyhow::Result<Outcome> {
-    let out = melax_simplify(mesh, args.target.target()?)?;
+    let out = melax_simplify(mesh, args.target.target()?, args.melax_cost.into())?;
     Ok(Outcome {
         mesh: out.mesh,
         passes: 1,

@@ -11,10 +11,10 @@
 //! level ([`MelaxChain::level`]) is then a prefix of its collapses.
 //!
 //! ```
-//! use vitrine_simplify::melax::{melax_chain, MelaxModel};
+//! use vitrine_simplify::melax::{melax_chain, MelaxCost, MelaxModel};
 //! # let mesh = vitrine_samples::torus(24, 12, 1.0, 0.3);
 //! let frames = [mesh.positions.clone()];
-//! let chain = melax_chain(&MelaxModel { triangles: &mesh.triangles, frames: &frames, corner_uvs: None })?;
+//! let chain = melax_chain(&MelaxModel { triangles: &mesh.triangles, frames: &frames, corner_uvs: None, cost: MelaxCost::Sine })?;
 //! let level = chain.level(chain.percent(40))?;
 //! assert_eq!(level.vertices, 288 * 40 / 100);
 //! # Ok::<(), vitrine_codec::Error>(())
@@ -27,6 +27,7 @@ use vitrine_codec::{Error, IndexedMesh, Result};
 
 use crate::collapse::working::WorkingMesh;
 use crate::Target;
+pub use cost::MelaxCost;
 use run::Run;
 
 /// A model to simplify: one connectivity, one or more frames of positions.
@@ -41,6 +42,8 @@ pub struct MelaxModel<'a> {
     /// index): a vertex whose corners have several ids sits on a seam and
     /// stays, and no collapse carries a coordinate across one.
     pub corner_uvs: Option<&'a [[u32; 3]]>,
+    /// The crease term: [`MelaxCost::Sine`] unless the seed's own is wanted.
+    pub cost: MelaxCost,
 }
 
 /// One collapse: `gone` moves into `keep`; its corners take texture
@@ -107,7 +110,7 @@ fn melax_until(model: &MelaxModel<'_>, stop: usize) -> Result<MelaxChain> {
             })
         })
         .collect::<Result<Vec<_>>>()?;
-    let mut run = Run::new(frames, model.corner_uvs.map(<[_]>::to_vec));
+    let mut run = Run::new(frames, model.corner_uvs.map(<[_]>::to_vec), model.cost);
     let vertices = run.live_vertices();
     let mut collapses = Vec::new();
     run.collapse_to(stop, &mut collapses);
@@ -201,13 +204,18 @@ pub struct MelaxSimplified {
 
 /// `mesh` (an oriented 2-manifold) down to `target` vertices by Melax's
 /// collapses, stopping there.
-pub fn melax_simplify(mesh: &IndexedMesh, target: Target) -> Result<MelaxSimplified> {
+pub fn melax_simplify(
+    mesh: &IndexedMesh,
+    target: Target,
+    cost: MelaxCost,
+) -> Result<MelaxSimplified> {
     target.validate()?;
     let frames = [mesh.positions.clone()];
     let model = MelaxModel {
         triangles: &mesh.triangles,
         frames: &frames,
         corner_uvs: None,
+        cost,
     };
     let used = {
         let mut used = vec![false; mesh.positions.len()];

@@ -10,7 +10,7 @@ use std::collections::BinaryHeap;
 
 use glam::DVec3;
 
-use super::cost::cost;
+use super::cost::{cost, MelaxCost};
 use super::MelaxCollapse;
 use crate::collapse::topology::{keeps_orientation, link_condition, Scratch};
 use crate::collapse::working::{Merge, WorkingMesh};
@@ -50,6 +50,8 @@ pub(super) struct Run {
     pub frames: Vec<WorkingMesh>,
     /// Per face, the texture-coordinate id of each corner.
     pub corner_uvs: Option<Vec<[u32; 3]>>,
+    /// The crease term.
+    kind: MelaxCost,
     /// Borders and seam vertices never go.
     pub locked: Vec<bool>,
     stamp: Vec<u32>,
@@ -60,7 +62,11 @@ pub(super) struct Run {
 }
 
 impl Run {
-    pub fn new(frames: Vec<WorkingMesh>, corner_uvs: Option<Vec<[u32; 3]>>) -> Run {
+    pub fn new(
+        frames: Vec<WorkingMesh>,
+        corner_uvs: Option<Vec<[u32; 3]>>,
+        kind: MelaxCost,
+    ) -> Run {
         let first = &frames[0];
         let n = first.positions.len();
         let mut locked: Vec<bool> = first.border.clone();
@@ -72,6 +78,7 @@ impl Run {
         let mut run = Run {
             frames,
             corner_uvs,
+            kind,
             locked,
             stamp: vec![0; n],
             heap: BinaryHeap::new(),
@@ -146,7 +153,7 @@ impl Run {
         first.neighbours(v, &mut ring);
         let mut options: Vec<(f64, u32)> = ring
             .iter()
-            .map(|&w| (cost(&self.frames, v, w, &mut self.edge), w))
+            .map(|&w| (cost(self.kind, &self.frames, v, w, &mut self.edge), w))
             .collect();
         self.ring = ring;
         options.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));

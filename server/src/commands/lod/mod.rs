@@ -12,6 +12,7 @@
 //! coordinates, so each attribute carries over per kept vertex; a GLB
 //! vertex is a (vertex, texture coordinate) pair, two where a seam runs.
 
+use super::simplify::MelaxCostKind;
 use anyhow::{bail, Context};
 use clap::{Args, ValueEnum};
 use std::io::{BufWriter, Write};
@@ -21,7 +22,9 @@ use vitrine_mesh::export::{
 };
 use vitrine_mesh::import::md2::{Md2, Md2Triangle};
 use vitrine_mesh::import::{ImportOptions, MeshFormat as InputFormat};
-use vitrine_simplify::melax::{compact, melax_chain, MelaxChain, MelaxLevel, MelaxModel};
+use vitrine_simplify::melax::{
+    compact, melax_chain, MelaxChain, MelaxCost, MelaxLevel, MelaxModel,
+};
 
 use crate::source::{describe_repair, load_coloured_mesh};
 
@@ -54,6 +57,9 @@ pub struct LodArgs {
     /// Animation key frames per second (MD2 frames in GLB; Quake II: 10).
     #[arg(long, default_value_t = 10.0)]
     pub fps: f32,
+    /// The crease term of Melax's collapse cost.
+    #[arg(long, value_enum, default_value_t = MelaxCostKind::Sine)]
+    pub melax_cost: MelaxCostKind,
 }
 
 /// The model to cut into levels.
@@ -142,12 +148,13 @@ fn model_of(source: &Source) -> MelaxModelOwned<'_> {
 
 type MelaxModelOwned<'s> = (Vec<Vec<[f32; 3]>>, &'s [[u32; 3]], Option<&'s [[u32; 3]]>);
 
-fn chain_of(source: &Source) -> vitrine_codec::Result<MelaxChain> {
+fn chain_of(source: &Source, cost: MelaxCost) -> vitrine_codec::Result<MelaxChain> {
     let (frames, triangles, corner_uvs) = model_of(source);
     melax_chain(&MelaxModel {
         triangles,
         frames: &frames,
         corner_uvs,
+        cost,
     })
 }
 
@@ -157,7 +164,7 @@ pub fn run(args: LodArgs) -> anyhow::Result<()> {
     }
     let mut source = load(&args.input)?;
     let started = std::time::Instant::now();
-    let chain = match (chain_of(&source), source) {
+    let chain = match (chain_of(&source, args.melax_cost.into()), source) {
         (Ok(chain), s) => {
             source = s;
             Ok(chain)
@@ -167,7 +174,7 @@ pub fn run(args: LodArgs) -> anyhow::Result<()> {
         (Err(e), Source::Textured { fallback, .. }) => {
             eprintln!("warning: the levels leave the texture out: {e}");
             source = Source::Mesh(fallback);
-            chain_of(&source)
+            chain_of(&source, args.melax_cost.into())
         }
         (Err(e), s) => {
             source = s;
