@@ -6,7 +6,9 @@
 //!   regions have θ ≈ 0; ridges, inscriptions and tool marks stand out.
 //! - [`FeatureGuard`]: θ as a decimation guard for the progressive encoder
 //!   (`vitrine_codec::Encoder::guard`), beside the cell complex's: a vertex
-//!   near a feature stays until the finer levels.
+//!   near a feature stays until the finer levels;
+//!   [`search_feature_guard`] picks its setting per scan, within a
+//!   connectivity budget and without raising the image error.
 //! - [`simplify`]: the standalone multiresolution (seed 004, Alg. 1, 4, 5):
 //!   edge, half-edge or triangle collapses of the vertices off the borders
 //!   and away from features, each checked (link condition, no flips), down
@@ -36,6 +38,7 @@
 mod collapse;
 pub mod deviation;
 mod feature_guard;
+mod feature_search;
 pub mod melax;
 pub mod voronoi;
 
@@ -46,5 +49,9 @@ pub use collapse::{
 pub use deviation::{border_vertices, normal_deviation, one_ring_max, VertexFaces};
 pub use feature_guard::{
     FeatureGuard, FeatureThreshold, DEFAULT_FEATURE_SHARE, DEFAULT_RELIEF_GATE,
+};
+pub use feature_search::{
+    decoded_mesh, first_level_with, search_feature_guard, FeatureProbe, GuardSearch, GuardSetting,
+    LevelMeasure, DEFAULT_CONNECTIVITY_BUDGET, SEARCHED_SETTINGS,
 };
 pub use voronoi::{simplify_voronoi, Distance, Order, Radius, VoronoiOptions, VoronoiSimplified};
