@@ -7,7 +7,9 @@ use std::process::{Command, Output};
 use vitrine_codec::{decode, EncodeOptions, Encoder, IndexedMesh, Limits, Quantization};
 use vitrine_mesh::import::{import_path, ImportOptions};
 use vitrine_mesh::repair::{check_manifold, prepare, RepairOptions};
-use vitrine_simplify::{FeatureGuard, FeatureThreshold};
+use vitrine_simplify::{
+    search_feature_guard, FeatureGuard, FeatureThreshold, DEFAULT_CONNECTIVITY_BUDGET,
+};
 
 fn vitrine(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_vitrine"))
@@ -71,15 +73,19 @@ fn encode_without_a_guard_is_the_plain_stream() {
 fn encode_with_the_feature_guard_is_guarded_and_lossless() {
     let dir = tempfile::tempdir().unwrap();
     let (input, output) = (plate(dir.path()), dir.path().join("guarded.vtr"));
+    // A fixed setting: the library's default guard.
     let (_, stderr) = succeeds(&[
         "encode",
         text(&input),
         "--guard",
         "features",
+        "--feature-setting",
+        "0.3:0.3",
         "-o",
         text(&output),
     ]);
     assert!(stderr.contains("feature guard: threshold"), "{stderr}");
+    assert!(stderr.contains("share 0.3, relief gate 0.3"), "{stderr}");
     let bytes = std::fs::read(&output).unwrap();
     let mesh = repaired(&input);
     let options = EncodeOptions::default();
@@ -91,7 +97,10 @@ fn encode_with_the_feature_guard_is_guarded_and_lossless() {
 
     let q = Quantization::for_positions(&mesh.positions, options.quantization_bits).unwrap();
     let guard = FeatureGuard::new(&mesh, &q, FeatureThreshold::MeanPlusTwoSigma);
-    let expected = Encoder::new(options).guard(&guard).encode(&mesh).unwrap();
+    let expected = Encoder::new(options.clone())
+        .guard(&guard)
+        .encode(&mesh)
+        .unwrap();
     assert!(bytes == expected.bytes, "not the library's guarded stream");
     let decoder = decode(&bytes, None, Limits::default()).unwrap();
     assert_eq!(decoder.to_mesh().vertex_count(), mesh.vertex_count());
@@ -102,6 +111,37 @@ fn encode_with_the_feature_guard_is_guarded_and_lossless() {
     let decoded = dir.path().join("decoded.ply");
     succeeds(&["decode", text(&output), "-o", text(&decoded)]);
     assert_eq!(read(&decoded).vertex_count(), mesh.vertex_count());
+
+    // The default searches: the stream is the library's search's, guarded
+    // by the setting it kept or, when it declined, the plain one.
+    let searched = dir.path().join("searched.vtr");
+    let (_, stderr) = succeeds(&[
+        "encode",
+        text(&input),
+        "--guard",
+        "features",
+        "-o",
+        text(&searched),
+    ]);
+    let (guard, search) = search_feature_guard(
+        &mesh,
+        &options,
+        FeatureThreshold::MeanPlusTwoSigma,
+        DEFAULT_CONNECTIVITY_BUDGET,
+    )
+    .unwrap();
+    let expected = match (&guard, search.choice()) {
+        (Some(g), Some((s, _))) => {
+            assert!(stderr.contains(&s.to_string()), "{stderr}");
+            assert!(stderr.contains("searched: features' distance"), "{stderr}");
+            Encoder::new(options).guard(g).encode(&mesh).unwrap()
+        }
+        _ => {
+            assert!(stderr.contains("declined"), "{stderr}");
+            plain
+        }
+    };
+    assert!(std::fs::read(&searched).unwrap() == expected.bytes);
 }
 
 #[test]
@@ -130,6 +170,34 @@ fn a_feature_threshold_needs_the_feature_guard() {
         "sharp",
     ]);
     assert!(stderr.contains("feature threshold must be"), "{stderr}");
+    for bad in ["1.5", "0.3:x", "most"] {
+        let stderr = fails(&[
+            "encode",
+            text(&input),
+            "--guard",
+            "features",
+            "--feature-setting",
+            bad,
+            "-o",
+            text(&out),
+        ]);
+        assert!(
+            stderr.contains("feature setting must be"),
+            "{bad}: {stderr}"
+        );
+    }
+    let stderr = fails(&[
+        "encode",
+        text(&input),
+        "--feature-setting",
+        "auto",
+        "-o",
+        text(&out),
+    ]);
+    assert!(
+        stderr.contains("--feature-setting needs --guard features"),
+        "{stderr}"
+    );
     assert!(!out.exists());
 }
 
@@ -156,6 +224,7 @@ fn ingest_records_the_feature_guard_in_the_compression_options() {
     let options: serde_json::Value = serde_json::from_str(&stored_options(&db)).unwrap();
     assert_eq!(options["guards"], serde_json::json!(["features"]));
     assert_eq!(options["feature_threshold"], "p90");
+    assert_eq!(options["feature_setting"], "auto");
 }
 
 /// The options JSON of the one compression in the database at `url`.

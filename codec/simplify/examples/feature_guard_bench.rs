@@ -13,11 +13,11 @@
 
 use std::time::Instant;
 
-use vitrine_codec::{EncodeOptions, Encoder, IndexedMesh, Limits, Quantization, StreamIndex};
+use vitrine_codec::{EncodeOptions, Encoder, IndexedMesh, Quantization};
 use vitrine_mesh::import::{import_path, ImportOptions};
 use vitrine_mesh::repair::{prepare, RepairOptions};
 use vitrine_simplify::{
-    decoded_mesh, search_feature_guard, FeatureGuard, FeatureProbe, FeatureThreshold,
+    at_vertices, level_curve, search_feature_guard, FeatureGuard, FeatureProbe, FeatureThreshold,
     GuardSetting, LevelMeasure, DEFAULT_CONNECTIVITY_BUDGET,
 };
 
@@ -54,47 +54,6 @@ impl std::fmt::Display for Variant {
     }
 }
 
-/// (vertices, feature RMS, image RMSE) of every level of `stream` with
-/// 2–20 % of the vertices.
-fn curve(stream: &[u8], probe: &FeatureProbe, full: usize) -> Vec<(f64, f64, f64)> {
-    let index = StreamIndex::parse(stream).expect("stream");
-    let mut d =
-        vitrine_codec::Decoder::new(&stream[index.base.clone()], Limits::default()).expect("base");
-    let mut points = Vec::new();
-    for level in 0..index.header.levels.len() {
-        if level > 0 {
-            d.apply_batch(&stream[index.batches[level - 1].clone()])
-                .expect("batch");
-        }
-        let n = index.header.levels[level].vertices as usize;
-        if n * 50 < full || n * 5 > full {
-            continue;
-        }
-        let mesh = decoded_mesh(&d);
-        points.push((n as f64, probe.feature_rms(&mesh), probe.image_rmse(&mesh)));
-    }
-    points
-}
-
-/// `points` (vertices, value) read at `vertices`, linear in log–log
-/// between its neighbours (clamped to its ends).
-fn at_vertices(points: &[(f64, f64)], vertices: f64) -> f64 {
-    let Some(&first) = points.first() else {
-        return f64::NAN;
-    };
-    if vertices <= first.0 {
-        return first.1;
-    }
-    for w in points.windows(2) {
-        let ((n0, r0), (n1, r1)) = (w[0], w[1]);
-        if vertices <= n1 {
-            let t = (vertices.ln() - n0.ln()) / (n1.ln() - n0.ln());
-            return (r0.ln() + t * (r1.ln() - r0.ln())).exp();
-        }
-    }
-    points.last().map_or(f64::NAN, |l| l.1)
-}
-
 /// Sums over the scans of one variant.
 #[derive(Clone, Default)]
 struct Totals {
@@ -109,13 +68,13 @@ struct Totals {
 }
 
 fn diagonal(mesh: &IndexedMesh) -> f64 {
-    let (lo, hi) = mesh.positions.iter().fold(
-        (glam::DVec3::MAX, glam::DVec3::MIN),
-        |(lo, hi), p| {
-            let p = glam::DVec3::from(p.map(f64::from));
-            (lo.min(p), hi.max(p))
-        },
-    );
+    let (lo, hi) =
+        mesh.positions
+            .iter()
+            .fold((glam::DVec3::MAX, glam::DVec3::MIN), |(lo, hi), p| {
+                let p = glam::DVec3::from(p.map(f64::from));
+                (lo.min(p), hi.max(p))
+            });
     (hi - lo).length()
 }
 
@@ -145,9 +104,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let probe = FeatureProbe::new(&mesh);
         let plain = Encoder::new(options.clone()).encode(&mesh)?.bytes;
         let p = probe.measure(&plain)?;
-        let plain_curve = curve(&plain, &probe, full);
-        let rms_curve: Vec<(f64, f64)> = plain_curve.iter().map(|c| (c.0, c.1)).collect();
-        let image_curve: Vec<(f64, f64)> = plain_curve.iter().map(|c| (c.0, c.2)).collect();
+        let rms_curve = level_curve(&plain, full, |m| probe.feature_rms(m))?;
+        let image_curve = level_curve(&plain, full, |m| probe.image_rmse(m))?;
         let diagonal = diagonal(&mesh);
         let name = std::path::Path::new(path)
             .file_name()

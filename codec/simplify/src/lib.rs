@@ -51,7 +51,7 @@ pub use feature_guard::{
     FeatureGuard, FeatureThreshold, DEFAULT_FEATURE_SHARE, DEFAULT_RELIEF_GATE,
 };
 pub use feature_search::{
-    decoded_mesh, first_level_with, search_feature_guard, FeatureProbe, GuardSearch, GuardSetting,
-    LevelMeasure, DEFAULT_CONNECTIVITY_BUDGET, SEARCHED_SETTINGS,
+    at_vertices, decoded_mesh, first_level_with, level_curve, search_feature_guard, FeatureProbe,
+    GuardSearch, GuardSetting, LevelMeasure, DEFAULT_CONNECTIVITY_BUDGET, SEARCHED_SETTINGS,
 };
 pub use voronoi::{simplify_voronoi, Distance, Order, Radius, VoronoiOptions, VoronoiSimplified};

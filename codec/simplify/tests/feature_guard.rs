@@ -9,12 +9,17 @@ use vitrine_simplify::{FeatureGuard, FeatureThreshold};
 
 /// A torus with a sharp groove cut around it: a feature line on a smooth body.
 fn grooved_torus() -> IndexedMesh {
-    let mut mesh = torus(96, 32, 1.0, 0.35);
+    grooved(96, 32, 0.06)
+}
+
+/// A torus of `rings × sides` with a V-groove `depth` deep along the band
+/// |angle| < `depth`.
+fn grooved(rings: u32, sides: u32, groove: f32) -> IndexedMesh {
+    let mut mesh = torus(rings, sides, 1.0, 0.35);
     for p in &mut mesh.positions {
         let (x, y) = (p[0], p[1]);
         let angle = y.atan2(x);
-        // A V-groove 0.06 deep along the band |angle| < 0.06.
-        let depth = (0.06 - angle.abs()).max(0.0);
+        let depth = (groove - angle.abs()).max(0.0);
         let r = (x * x + y * y).sqrt();
         let scale = (r - depth) / r;
         p[0] *= scale;
@@ -98,4 +103,77 @@ fn feature_vertices_stay_in_the_coarse_levels() {
         kept_guarded > 2 * kept_plain,
         "feature vertices after one batch: guarded {kept_guarded}, plain {kept_plain}"
     );
+}
+
+/// The search keeps the setting it says, and only one that fits: within
+/// the budget, no higher image error (at its level and at equal vertices),
+/// closer features, and the closest of those; its guard reproduces the
+/// measured stream.
+#[test]
+fn the_search_keeps_the_closest_setting_within_the_budget() {
+    use vitrine_simplify::{
+        at_vertices, search_feature_guard, FeatureProbe, DEFAULT_CONNECTIVITY_BUDGET,
+        SEARCHED_SETTINGS,
+    };
+    // 12 k vertices, a deep groove: on the 3 k torus above the first level
+    // with 5 % of the vertices has 189, and no setting keeps its picture.
+    let mesh = grooved(192, 64, 0.12);
+    let options = EncodeOptions::default();
+    let (guard, search) = search_feature_guard(
+        &mesh,
+        &options,
+        FeatureThreshold::MeanPlusTwoSigma,
+        DEFAULT_CONNECTIVITY_BUDGET,
+    )
+    .unwrap();
+    assert_eq!(search.tried.len(), SEARCHED_SETTINGS.len());
+    let plain = search.plain;
+    assert_eq!(
+        plain,
+        FeatureProbe::new(&mesh)
+            .measure(&encode(&mesh, &options).unwrap().bytes)
+            .unwrap()
+    );
+    let fits: Vec<usize> = (0..search.tried.len())
+        .filter(|&k| {
+            let m = &search.tried[k].1;
+            let equal = at_vertices(&search.plain_images, m.vertices as f64);
+            m.connectivity_bits as f64 <= 1.05 * plain.connectivity_bits as f64
+                && m.image_rmse <= plain.image_rmse
+                && (equal.is_nan() || m.image_rmse <= equal)
+                && m.feature_rms < plain.feature_rms
+        })
+        .collect();
+    // The groove is what the guard is for: some setting must fit.
+    assert!(!fits.is_empty(), "{search:#?}");
+    let best = fits
+        .iter()
+        .copied()
+        .min_by(|&a, &b| {
+            search.tried[a]
+                .1
+                .feature_rms
+                .total_cmp(&search.tried[b].1.feature_rms)
+        })
+        .unwrap();
+    assert_eq!(search.chosen, Some(best));
+    let (_, chosen) = search.tried[best];
+    let stream = Encoder::new(options.clone())
+        .guard(guard.as_ref().unwrap())
+        .encode(&mesh)
+        .unwrap()
+        .bytes;
+    assert_eq!(FeatureProbe::new(&mesh).measure(&stream).unwrap(), chosen);
+    assert!(
+        chosen.feature_rms < 0.9 * plain.feature_rms,
+        "{chosen:?} {plain:?}"
+    );
+
+    // With no room at all in the budget, nothing that costs bits fits.
+    let (none, strict) =
+        search_feature_guard(&mesh, &options, FeatureThreshold::MeanPlusTwoSigma, 0.0).unwrap();
+    match strict.choice() {
+        Some((_, m)) => assert!(m.connectivity_bits <= plain.connectivity_bits),
+        None => assert!(none.is_none()),
+    }
 }

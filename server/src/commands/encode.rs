@@ -110,12 +110,9 @@ fn encode_with_progress(
         .colour
         .unwrap_or_else(|| default_colour_mode(mesh, texture));
     let options = args.options();
-    let guards = Guards::new(mesh, guards, options.quantization_bits)?;
+    let guards = Guards::new(mesh, guards, &options)?;
     if let Some(f) = guards.features() {
-        eprintln!(
-            "feature guard: threshold {:.2}°, {} feature vertices",
-            f.threshold_degrees, f.vertices
-        );
+        eprintln!("{}", f.describe());
     }
     let bar = ProgressBar::new(mesh.positions.len() as u64);
     bar.set_style(

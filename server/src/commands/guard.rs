@@ -1,7 +1,8 @@
-//! `--guard` and `--feature-threshold`, shared by `encode` and `ingest`:
+//! `--guard`, `--feature-threshold` and `--feature-setting`, shared by
+//! `encode` and `ingest`:
 //! decimation guards beside the colour mode's own.
 
-use crate::ingest::GuardOptions;
+use crate::ingest::{FeatureSetting, GuardOptions};
 use anyhow::bail;
 use clap::ValueEnum;
 use vitrine_simplify::FeatureThreshold;
@@ -25,6 +26,13 @@ pub struct GuardArgs {
     /// (`p95`).
     #[arg(long, value_name = "mean+2sigma|DEG|pP")]
     pub feature_threshold: Option<FeatureThreshold>,
+    /// The feature guard's share and relief gate: `auto` (the default)
+    /// encodes the scan under 8 settings and keeps the one whose coarse
+    /// levels stay nearest its sharpest vertices within +5 % connectivity
+    /// and no higher image error, or none; `SHARE:GATE` (e.g. `0.3:0.3`)
+    /// or `SHARE` (no relief gate) sets it.
+    #[arg(long, value_name = "auto|SHARE[:GATE]")]
+    pub feature_setting: Option<FeatureSetting>,
 }
 
 impl GuardArgs {
@@ -33,8 +41,12 @@ impl GuardArgs {
         if self.feature_threshold.is_some() && !features {
             bail!("--feature-threshold needs --guard features");
         }
+        if self.feature_setting.is_some() && !features {
+            bail!("--feature-setting needs --guard features");
+        }
         Ok(GuardOptions {
             features: features.then(|| self.feature_threshold.unwrap_or_default()),
+            feature_setting: self.feature_setting.unwrap_or_default(),
         })
     }
 }

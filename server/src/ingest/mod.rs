@@ -11,7 +11,7 @@ mod mapping;
 pub mod points;
 mod store;
 
-pub use guards::{threshold_name, FeatureSummary, GuardOptions, Guards};
+pub use guards::{threshold_name, FeatureSetting, FeatureSummary, GuardOptions, Guards};
 
 use crate::source::{default_colour_mode, read_back, QualityReference};
 use crate::storage::{valid_slug, Bounds, NewThumbnail, OnExisting, Storage, StoredModel, UpAxis};
@@ -234,14 +234,18 @@ fn encode_and_measure(
     let started = Instant::now();
     options.report("encoding", 0.2);
     let mode = options.colour.unwrap_or(ColourMode::None);
-    let guards = Guards::new(&mesh, &options.guards, options.encode.quantization_bits)
+    let guards = Guards::new(&mesh, &options.guards, &options.encode)
         .context("building the decimation guards")?;
     let features = guards.features();
     if let Some(f) = &features {
         tracing::info!(
             threshold_degrees = f.threshold_degrees,
             feature_vertices = f.vertices,
-            "feature guard"
+            share = f.share,
+            relief_gate = f.relief_gate,
+            searched = f.searched,
+            "{}",
+            f.describe()
         );
     }
     let encoder = guards.apply(vitrine_codec::Encoder::new(options.encode.clone()));

@@ -225,6 +225,7 @@ fn options_json(options: &IngestOptions) -> serde_json::Value {
         "geometric_guard": o.geometric_guard,
         "guards": options.guards.names(),
         "feature_threshold": options.guards.features.map(threshold_name),
+        "feature_setting": options.guards.features.map(|_| options.guards.feature_setting.name()),
         "colour": colour.map(ColourMode::name),
         "ccc": (colour == Some(ColourMode::Ccc)).then(|| json!({
             "cell_size": ccc.cell_size,
