@@ -338,6 +338,114 @@ pub async fn uploads_as_jobs(db: TestDb) {
         .await
         .unwrap();
     assert_eq!(as_researcher.status(), StatusCode::FORBIDDEN);
+
+    interrupted_jobs_are_said_to_be(&db, &server, &http, &curator).await;
+}
+
+/// A job whose instance stopped (no heartbeat for a minute) is served as
+/// failed by any instance; a live one is not, and a heartbeat keeps it so.
+async fn interrupted_jobs_are_said_to_be(
+    db: &TestDb,
+    server: &TestServer,
+    http: &reqwest::Client,
+    curator: &str,
+) {
+    use vitrine::storage::{JobState, NewJob};
+    let new = |slug: &str| NewJob {
+        slug: slug.into(),
+        title: slug.into(),
+        source_name: format!("{slug}.ply"),
+        token_id: None,
+    };
+    let (dead, live, done) = (
+        db.storage.insert_job(&new("dead")).await.unwrap(),
+        db.storage.insert_job(&new("live")).await.unwrap(),
+        db.storage.insert_job(&new("done")).await.unwrap(),
+    );
+    for id in [dead.id, live.id] {
+        db.storage
+            .update_job(id, JobState::Running, 0.4, "encoding", None, None)
+            .await
+            .unwrap();
+    }
+    db.storage
+        .update_job(done.id, JobState::Done, 1.0, "done", None, Some(1))
+        .await
+        .unwrap();
+    // Every row's clock two minutes back, as if no instance had touched them.
+    let backdate =
+        "UPDATE ingest_job SET updated_at = updated_at - 120000 WHERE id IN ($1, $2, $3)";
+    if db.url.starts_with("sqlite:") {
+        let pool = sqlx::SqlitePool::connect(&db.url).await.unwrap();
+        sqlx::query(backdate)
+            .bind(dead.id)
+            .bind(live.id)
+            .bind(done.id)
+            .execute(&pool)
+            .await
+            .unwrap();
+    } else {
+        let pool = sqlx::PgPool::connect(&db.url).await.unwrap();
+        sqlx::query(backdate)
+            .bind(dead.id)
+            .bind(live.id)
+            .bind(done.id)
+            .execute(&pool)
+            .await
+            .unwrap();
+    }
+    // The live job's instance beats; the others' do not (a done job's
+    // row does not change).
+    db.storage.touch_job(live.id).await.unwrap();
+    db.storage.touch_job(done.id).await.unwrap();
+    let get = |id: i64| {
+        let url = server.url(&format!("/api/jobs/{id}"));
+        async move {
+            http.get(&url)
+                .bearer_auth(curator)
+                .send()
+                .await
+                .unwrap()
+                .json::<Value>()
+                .await
+                .unwrap()
+        }
+    };
+    let dead_now = get(dead.id).await;
+    assert_eq!(dead_now["state"], "failed", "{dead_now}");
+    assert!(
+        dead_now["error"]
+            .as_str()
+            .unwrap()
+            .starts_with("interrupted"),
+        "{dead_now}"
+    );
+    let live_now = get(live.id).await;
+    assert_eq!(live_now["state"], "running", "{live_now}");
+    assert_eq!(live_now["stage"], "encoding");
+    let done_now = get(done.id).await;
+    assert_eq!(done_now["state"], "done", "{done_now}");
+    assert_eq!(done_now["error"], Value::Null);
+    let list: Value = http
+        .get(server.url("/api/jobs"))
+        .bearer_auth(curator)
+        .send()
+        .await
+        .unwrap()
+        .json()
+        .await
+        .unwrap();
+    let listed = |id: i64| {
+        list["jobs"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|j| j["id"] == id)
+            .cloned()
+            .unwrap()
+    };
+    assert_eq!(listed(dead.id)["state"], "failed");
+    assert_eq!(listed(live.id)["state"], "running");
 }
 
 /// A PLY whose second vertex has a word for a coordinate.

@@ -4,6 +4,13 @@
 //! instance can report it. The ingest runs in a tokio task of its own (the
 //! encoder in `spawn_blocking`), at most `concurrent_jobs` at once; up to
 //! `max_queued` more wait, and beyond that an upload is refused with 429.
+//!
+//! While a job waits or runs, its instance touches the row every
+//! [`HEARTBEAT`]; a queued or running job untouched for [`STALE_AFTER`] is
+//! served as failed ("interrupted"), so a curator whose server stopped
+//! mid-ingest learns it from any instance instead of watching a bar that
+//! never moves. The row itself is left as it is: reads decide, so no
+//! instance has to tell a slow one from a dead one.
 
 use super::Curator;
 use crate::ingest::points::{detect_kind, ingest_points, load_cloud};
@@ -18,12 +25,25 @@ use axum::Json;
 use serde::{Deserialize, Serialize};
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Arc;
+use std::time::Duration;
 use tempfile::TempPath;
 use tokio::sync::Semaphore;
 use utoipa::{IntoParams, ToSchema};
 
 /// Jobs `GET /api/jobs` lists.
 const LISTED_JOBS: u32 = 50;
+
+/// How often an instance touches the jobs it holds.
+pub const HEARTBEAT: Duration = Duration::from_secs(10);
+
+/// A queued or running job untouched this long is served as interrupted:
+/// six heartbeats, so a busy database or a long encode step (which
+/// reports no progress for a while) is not mistaken for a dead server.
+pub const STALE_AFTER: Duration = Duration::from_secs(60);
+
+/// What a stale job's `error` says.
+pub const INTERRUPTED: &str = "interrupted: the server running this upload stopped \
+     (no heartbeat for 60 s); upload the file again";
 
 /// The runner every instance has.
 pub struct JobRunner {
@@ -70,12 +90,14 @@ pub struct JobInput {
 /// Runs the job in the background; the request that made it may go.
 pub fn spawn(state: AppState, job: JobRecord, place: QueuePlace, input: JobInput) {
     tokio::spawn(async move {
+        let heartbeat = tokio::spawn(beat(state.storage().clone(), job.id));
         let permit = state.jobs().permits.clone().acquire_owned().await;
         drop(place);
         let outcome = match permit {
             Ok(_permit) => run(&state, &job, input).await,
             Err(_) => Err(anyhow::anyhow!("the job runner stopped")),
         };
+        heartbeat.abort();
         let storage = state.storage();
         let written = match outcome {
             Ok(version) => {
@@ -104,6 +126,19 @@ pub fn spawn(state: AppState, job: JobRecord, place: QueuePlace, input: JobInput
             tracing::warn!(job = job.id, error = %e, "could not record the job's end");
         }
     });
+}
+
+/// Touches job `id` every [`HEARTBEAT`] until aborted.
+async fn beat(storage: Arc<dyn crate::storage::Storage>, id: i64) {
+    let mut every = tokio::time::interval(HEARTBEAT);
+    every.set_missed_tick_behavior(tokio::time::MissedTickBehavior::Delay);
+    every.tick().await; // the first tick is immediate; the row is new
+    loop {
+        every.tick().await;
+        if let Err(e) = storage.touch_job(id).await {
+            tracing::warn!(job = id, error = %e, "could not record the job's heartbeat");
+        }
+    }
 }
 
 /// Imports, encodes, measures and stores; the new version's number. Every
@@ -224,6 +259,20 @@ pub struct Job {
     updated_at: i64,
 }
 
+impl Job {
+    /// `j` as served at `now_ms`: failed when it has been queued or
+    /// running without a heartbeat for [`STALE_AFTER`].
+    fn served(mut j: JobRecord, now_ms: i64) -> Job {
+        let waiting = matches!(j.state, JobState::Queued | JobState::Running);
+        if waiting && now_ms - j.updated_at_ms > STALE_AFTER.as_millis() as i64 {
+            j.state = JobState::Failed;
+            j.stage = "failed".into();
+            j.error = Some(INTERRUPTED.into());
+        }
+        Job::from(j)
+    }
+}
+
 impl From<JobRecord> for Job {
     fn from(j: JobRecord) -> Self {
         Job {
@@ -269,8 +318,9 @@ pub struct JobPath {
 )]
 pub async fn list(State(state): State<AppState>, _: Curator) -> Result<Json<JobList>, AppError> {
     let jobs = state.storage().jobs(LISTED_JOBS).await?;
+    let now = crate::storage::now_ms();
     Ok(Json(JobList {
-        jobs: jobs.into_iter().map(Job::from).collect(),
+        jobs: jobs.into_iter().map(|j| Job::served(j, now)).collect(),
     }))
 }
 
@@ -294,5 +344,6 @@ pub async fn job(
     PathParams(JobPath { id }): PathParams<JobPath>,
 ) -> Result<Json<Job>, AppError> {
     let job = state.storage().job(id).await?;
-    Ok(Json(job.ok_or(AppError::NotFound("job"))?.into()))
+    let job = job.ok_or(AppError::NotFound("job"))?;
+    Ok(Json(Job::served(job, crate::storage::now_ms())))
 }

@@ -202,6 +202,16 @@ macro_rules! curator_storage {
                 Ok(())
             }
 
+            async fn touch_job(&self, id: i64) -> $crate::storage::Result<()> {
+                sqlx::query($crate::storage::curator::sql::TOUCH_JOB)
+                    .bind(id)
+                    .bind($crate::storage::now_ms())
+                    .execute(&self.pool)
+                    .await
+                    .map_err(Self::classify)?;
+                Ok(())
+            }
+
             async fn job(
                 &self,
                 id: i64,

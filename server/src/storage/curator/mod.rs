@@ -255,6 +255,12 @@ pub trait CuratorStorage: Send + Sync {
         no_curators()
     }
 
+    /// The running instance's heartbeat for a queued or running job: its
+    /// `updated_at` becomes now (an ended job is left as it is).
+    async fn touch_job(&self, id: i64) -> Result<()> {
+        no_curators()
+    }
+
     async fn job(&self, id: i64) -> Result<Option<JobRecord>> {
         no_curators()
     }

@@ -19,6 +19,8 @@ pub(crate) const JOB_SELECT: &str = "SELECT id, slug, title, source_name, state,
 pub(crate) const INSERT_JOB: &str = "INSERT INTO ingest_job \
      (slug, title, source_name, state, progress, stage, token_id, created_at, updated_at) \
      VALUES ($1, $2, $3, 'queued', 0, 'queued', $4, $5, $5) RETURNING id";
+pub(crate) const TOUCH_JOB: &str = "UPDATE ingest_job SET updated_at = $2 \
+     WHERE id = $1 AND state IN ('queued', 'running')";
 pub(crate) const UPDATE_JOB: &str = "UPDATE ingest_job SET state = $2, progress = $3, stage = $4, \
      error = $5, model_version = $6, updated_at = $7 WHERE id = $1";
 
