@@ -16,8 +16,8 @@
 //! the unguarded one.
 //!
 //! Cost: one encode and one level's measurement per setting, plus the
-//! plain stream's (nine encodes in all): on the 2-core VM 0.4–2 s for the
-//! shared scans up to 50 k vertices, 4.4 s for igea (134 k).
+//! plain stream's (nine encodes in all): on the 2-core VM 0.3–2 s for the
+//! shared scans up to 50 k vertices, 3.6–4.4 s for igea (134 k).
 
 use glam::DVec3;
 
