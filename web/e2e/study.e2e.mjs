@@ -302,12 +302,15 @@ test('a participant who leaves after two steps resumes at the third; a slow batc
     await new Promise((resolve) => setTimeout(resolve, 2500));
     await route.continue();
   });
+  await page.reload();
+  // Listened to from the new page on: the old page's last views batch,
+  // flushed as it unloads, may carry the slow step's first 'pre' if that
+  // step had begun before the reload.
   /** @type {any[]} */
   const events = [];
   page.on('request', (r) => {
     if (r.method() === 'POST' && r.url().endsWith('/session/views')) events.push(...r.postDataJSON().events);
   });
-  await page.reload();
   await page.getByText('continues where you left off').waitFor();
   await page.getByRole('button', { name: 'Continue' }).click();
   await page.getByLabel(/I agree/).check();

@@ -4,7 +4,7 @@
 use super::guard::GuardArgs;
 use super::ingest::CccArgs;
 use crate::ccc_files::CccFiles;
-use crate::ingest::{GuardOptions, Guards};
+use crate::ingest::{FeatureSetting, GuardOptions, Guards};
 use crate::source::{default_colour_mode, describe_repair, load_coloured_frame, SourceMesh};
 use anyhow::Context;
 use clap::Args;
@@ -110,6 +110,12 @@ fn encode_with_progress(
         .colour
         .unwrap_or_else(|| default_colour_mode(mesh, texture));
     let options = args.options();
+    if guards.features.is_some() && guards.feature_setting == FeatureSetting::Auto {
+        eprintln!(
+            "feature guard: encoding under {} settings to choose one for this scan…",
+            vitrine_simplify::SEARCHED_SETTINGS.len()
+        );
+    }
     let guards = Guards::new(mesh, guards, &options)?;
     if let Some(f) = guards.features() {
         eprintln!("{}", f.describe());
