@@ -123,13 +123,8 @@ fn encode_with_the_feature_guard_is_guarded_and_lossless() {
         "-o",
         text(&searched),
     ]);
-    let (guard, search) = search_feature_guard(
-        &mesh,
-        &options,
-        FeatureThreshold::MeanPlusTwoSigma,
-        DEFAULT_CONNECTIVITY_BUDGET,
-    )
-    .unwrap();
+    let (guard, search) =
+        search_feature_guard(&mesh, &options, &guard, DEFAULT_CONNECTIVITY_BUDGET).unwrap();
     let expected = match (&guard, search.choice()) {
         (Some(g), Some((s, _))) => {
             assert!(stderr.contains(&s.to_string()), "{stderr}");

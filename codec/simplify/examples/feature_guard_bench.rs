@@ -125,12 +125,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                     (probe.measure(&stream)?, s.to_string())
                 }
                 Variant::Auto => {
-                    let (_, search) = search_feature_guard(
-                        &mesh,
-                        &options,
-                        FeatureThreshold::MeanPlusTwoSigma,
-                        DEFAULT_CONNECTIVITY_BUDGET,
-                    )?;
+                    let base = FeatureGuard::new(&mesh, &q, FeatureThreshold::MeanPlusTwoSigma);
+                    let (_, search) =
+                        search_feature_guard(&mesh, &options, &base, DEFAULT_CONNECTIVITY_BUDGET)?;
                     match search.choice() {
                         Some((s, m)) => (*m, s.to_string()),
                         None => (search.plain, "declined (plain stream)".into()),

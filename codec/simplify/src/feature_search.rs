@@ -22,8 +22,7 @@
 use glam::DVec3;
 
 use vitrine_codec::{
-    breakdown, Decoder, EncodeOptions, Encoder, IndexedMesh, Limits, Quantization, Result,
-    StreamIndex,
+    breakdown, Decoder, EncodeOptions, Encoder, IndexedMesh, Limits, Result, StreamIndex,
 };
 use vitrine_quality::metrics::{
     distances_to_surface, ConstantColour, ImageReference, RenderOptions,
@@ -276,19 +275,21 @@ impl GuardSearch {
 /// as the encoder gets it) and returns the guard to encode with, if one
 /// qualifies (see the module's notes). Only geometry is encoded here: the
 /// guard keeps or removes vertices, whatever their colour.
+///
+/// `base` is the guard built for `mesh` with the stream's quantization
+/// (`FeatureGuard::new`); each setting is a copy of it, so θ is not
+/// computed again.
 pub fn search_feature_guard(
     mesh: &IndexedMesh,
     options: &EncodeOptions,
-    threshold: FeatureThreshold,
+    base: &FeatureGuard,
     budget: f64,
 ) -> Result<(Option<FeatureGuard>, GuardSearch)> {
     let geometry = IndexedMesh {
         colors: None,
         ..mesh.clone()
     };
-    let q = Quantization::for_positions(&geometry.positions, options.quantization_bits)?;
     let probe = FeatureProbe::new(&geometry);
-    let base = FeatureGuard::new(&geometry, &q, threshold);
     let plain_stream = Encoder::new(options.clone()).encode(&geometry)?.bytes;
     let plain = probe.measure(&plain_stream)?;
     let plain_images = level_curve(&plain_stream, probe.vertices, |m| probe.image_rmse(m))?;

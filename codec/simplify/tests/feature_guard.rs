@@ -119,13 +119,9 @@ fn the_search_keeps_the_closest_setting_within_the_budget() {
     // with 5 % of the vertices has 189, and no setting keeps its picture.
     let mesh = grooved(192, 64, 0.12);
     let options = EncodeOptions::default();
-    let (guard, search) = search_feature_guard(
-        &mesh,
-        &options,
-        FeatureThreshold::MeanPlusTwoSigma,
-        DEFAULT_CONNECTIVITY_BUDGET,
-    )
-    .unwrap();
+    let base = guard(&mesh, &options);
+    let (chosen_guard, search) =
+        search_feature_guard(&mesh, &options, &base, DEFAULT_CONNECTIVITY_BUDGET).unwrap();
     assert_eq!(search.tried.len(), SEARCHED_SETTINGS.len());
     let plain = search.plain;
     assert_eq!(
@@ -159,7 +155,7 @@ fn the_search_keeps_the_closest_setting_within_the_budget() {
     assert_eq!(search.chosen, Some(best));
     let (_, chosen) = search.tried[best];
     let stream = Encoder::new(options.clone())
-        .guard(guard.as_ref().unwrap())
+        .guard(chosen_guard.as_ref().unwrap())
         .encode(&mesh)
         .unwrap()
         .bytes;
@@ -170,8 +166,7 @@ fn the_search_keeps_the_closest_setting_within_the_budget() {
     );
 
     // With no room at all in the budget, nothing that costs bits fits.
-    let (none, strict) =
-        search_feature_guard(&mesh, &options, FeatureThreshold::MeanPlusTwoSigma, 0.0).unwrap();
+    let (none, strict) = search_feature_guard(&mesh, &options, &base, 0.0).unwrap();
     match strict.choice() {
         Some((_, m)) => assert!(m.connectivity_bits <= plain.connectivity_bits),
         None => assert!(none.is_none()),

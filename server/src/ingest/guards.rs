@@ -174,7 +174,7 @@ impl Guards {
             }
             FeatureSetting::Auto => {
                 let (guard, search) =
-                    search_feature_guard(mesh, encode, threshold, DEFAULT_CONNECTIVITY_BUDGET)?;
+                    search_feature_guard(mesh, encode, &base, DEFAULT_CONNECTIVITY_BUDGET)?;
                 summary.searched = true;
                 if let Some((s, m)) = search.choice() {
                     let plain = &search.plain;
