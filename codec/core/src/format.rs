@@ -6,11 +6,17 @@ use crate::{Error, Result};
 use std::ops::Range;
 
 pub const MAGIC: [u8; 4] = *b"VTRN";
+/// The plain stream: every batch refines the whole mesh.
 pub const VERSION: u8 = 4;
+/// The chart-parallel stream: after its global batches, every batch is cut
+/// into one part per chart, each decoded on its own (`charts` module).
+pub const CHARTED_VERSION: u8 = 5;
 pub(crate) const HEADER_FIXED: usize = 40;
 pub(crate) const LEVEL_ENTRY: usize = 12;
 pub(crate) const BASE_TAG: u8 = b'M';
 pub(crate) const BATCH_TAG: u8 = b'L';
+/// A batch of a charted stream, in one part per chart.
+pub(crate) const PARTED_TAG: u8 = b'P';
 pub(crate) const FLAG_COLOUR: u8 = 1;
 
 /// Vertex, face and byte counts after one level (the base mesh is level 0).
@@ -74,9 +80,9 @@ impl Header {
             return Err(Error::stream("not a Vitrine stream (bad magic)"));
         }
         let version = r.u8()?;
-        if version != VERSION {
+        if version != VERSION && version != CHARTED_VERSION {
             return Err(Error::stream(format!(
-                "unsupported version {version} (this build reads {VERSION})"
+                "unsupported version {version} (this build reads {VERSION} and {CHARTED_VERSION})"
             )));
         }
         let flags = r.u8()?;
@@ -168,6 +174,8 @@ impl StreamIndex {
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) struct ChunkHeader {
     pub tag: u8,
+    /// The stream's version, repeated in every chunk.
+    pub version: u8,
     pub level: u16,
     pub vertices_before: u32,
     pub vertices_after: u32,
@@ -178,7 +186,7 @@ pub(crate) struct ChunkHeader {
 impl ChunkHeader {
     pub(crate) fn write(&self, out: &mut Vec<u8>) {
         out.push(self.tag);
-        out.push(VERSION);
+        out.push(self.version);
         for v in [
             self.level as u32,
             self.vertices_before,
@@ -190,21 +198,28 @@ impl ChunkHeader {
         }
     }
 
-    /// Splits a chunk into its header and payload, checking the payload is all there.
-    pub(crate) fn parse(bytes: &[u8], tag: u8) -> Result<(ChunkHeader, &[u8])> {
+    /// Splits a chunk into its header and payload, checking the payload is
+    /// all there; `tags` are the kinds of chunk expected here.
+    pub(crate) fn parse<'b>(bytes: &'b [u8], tags: &[u8]) -> Result<(ChunkHeader, &'b [u8])> {
         let mut r = Reader::new(bytes);
-        let found = r.u8()?;
-        if found != tag {
+        let tag = r.u8()?;
+        if !tags.contains(&tag) {
             return Err(Error::stream(format!(
-                "expected a {} chunk, found tag {found:#x}",
-                if tag == BASE_TAG { "base" } else { "batch" }
+                "expected a {} chunk, found tag {tag:#x}",
+                if tags.contains(&BASE_TAG) {
+                    "base"
+                } else {
+                    "batch"
+                }
             )));
         }
-        if r.u8()? != VERSION {
+        let version = r.u8()?;
+        if version != VERSION && version != CHARTED_VERSION {
             return Err(Error::stream("chunk version mismatch"));
         }
         let h = ChunkHeader {
             tag,
+            version,
             level: u16::try_from(r.varint()?)
                 .map_err(|_| Error::stream("chunk level exceeds 65535"))?,
             vertices_before: r.varint()?,
@@ -229,7 +244,7 @@ pub struct BatchChunk<'a> {
 impl<'a> BatchChunk<'a> {
     /// Parses a batch chunk, as [`StreamIndex::batches`] delimits one.
     pub fn parse(chunk: &'a [u8]) -> Result<Self> {
-        let (header, payload) = ChunkHeader::parse(chunk, BATCH_TAG)?;
+        let (header, payload) = ChunkHeader::parse(chunk, &[BATCH_TAG, PARTED_TAG])?;
         Ok(BatchChunk { header, payload })
     }
 

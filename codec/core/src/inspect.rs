@@ -1,6 +1,6 @@
 //! Per-level byte breakdown of a stream, read from section lengths only.
 
-use crate::format::{ChunkHeader, Reader, BASE_TAG, BATCH_TAG};
+use crate::format::{ChunkHeader, Reader, BASE_TAG, BATCH_TAG, PARTED_TAG};
 use crate::{Result, StreamIndex};
 
 /// Where the bytes of one level went.
@@ -23,7 +23,7 @@ pub fn breakdown(stream: &[u8]) -> Result<Vec<LevelBreakdown>> {
     let index = StreamIndex::parse(stream)?;
     let levels = &index.header.levels;
     let base_chunk = &stream[index.header.byte_len()..index.base.end];
-    let (_, base_payload) = ChunkHeader::parse(base_chunk, BASE_TAG)?;
+    let (_, base_payload) = ChunkHeader::parse(base_chunk, &[BASE_TAG])?;
     let mut out = vec![LevelBreakdown {
         vertices: levels[0].vertices,
         faces: levels[0].faces,
@@ -32,27 +32,50 @@ pub fn breakdown(stream: &[u8]) -> Result<Vec<LevelBreakdown>> {
         overhead: levels[0].bytes - base_payload.len() as u32,
         ..Default::default()
     }];
+    let mut cut = false;
     for (k, range) in index.batches.iter().enumerate() {
-        let (_, payload) = ChunkHeader::parse(&stream[range.clone()], BATCH_TAG)?;
-        let mut r = Reader::new(payload);
+        let (chunk, payload) =
+            ChunkHeader::parse(&stream[range.clone()], &[BATCH_TAG, PARTED_TAG])?;
         let mut b = LevelBreakdown {
             vertices: levels[k + 1].vertices,
             faces: levels[k + 1].faces,
             bytes: levels[k + 1].bytes,
             ..Default::default()
         };
-        for _pass in 0..2 {
-            let seeds = r.varint()?;
-            for _ in 0..2 * seeds {
-                r.varint()?;
+        let mut r = Reader::new(payload);
+        if chunk.tag == PARTED_TAG {
+            let charts = r.varint()?;
+            if !cut {
+                // The chart labels count as connectivity.
+                b.connectivity += r.section()?.len() as u32;
+                cut = true;
             }
-            r.varint()?;
-            b.connectivity += r.section()?.len() as u32;
-            b.geometry += r.section()?.len() as u32;
-            b.colour += r.section()?.len() as u32;
+            for _ in 0..charts {
+                let part = r.section()?;
+                if !part.is_empty() {
+                    add_passes(&mut Reader::new(part), &mut b)?;
+                }
+            }
+        } else {
+            add_passes(&mut r, &mut b)?;
         }
         b.overhead = b.bytes - b.connectivity - b.geometry - b.colour;
         out.push(b);
     }
     Ok(out)
+}
+
+/// Adds a batch's (or a chart part's) two passes' section sizes to `b`.
+fn add_passes(r: &mut Reader<'_>, b: &mut LevelBreakdown) -> Result<()> {
+    for _pass in 0..2 {
+        let seeds = r.varint()?;
+        for _ in 0..2 * seeds {
+            r.varint()?;
+        }
+        r.varint()?;
+        b.connectivity += r.section()?.len() as u32;
+        b.geometry += r.section()?.len() as u32;
+        b.colour += r.section()?.len() as u32;
+    }
+    Ok(())
 }

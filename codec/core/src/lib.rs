@@ -15,6 +15,7 @@
 #![forbid(unsafe_code)]
 
 mod base_mesh;
+mod charts;
 mod contexts;
 mod decoder;
 pub mod edges;
@@ -33,12 +34,14 @@ mod priors;
 mod quantize;
 mod training;
 
+pub use charts::MAX_CHARTS;
 pub use decoder::{decode, Decoder, Limits};
 pub use encoder::{
-    encode, BaseTarget, CandidatePatch, EncodeOptions, EncodeProgress, Encoded, Encoder, PatchGuard,
+    encode, BaseTarget, CandidatePatch, Charts, EncodeOptions, EncodeProgress, Encoded, Encoder,
+    PatchGuard,
 };
 pub use error::{Error, Result};
-pub use format::{BatchChunk, Header, LevelInfo, StreamIndex, MAGIC, VERSION};
+pub use format::{BatchChunk, Header, LevelInfo, StreamIndex, CHARTED_VERSION, MAGIC, VERSION};
 pub use gates::GateStatistics;
 pub use inspect::{breakdown, LevelBreakdown};
 pub use mesh::IndexedMesh;

@@ -1,13 +1,18 @@
 //! Progressive stream → mesh, one refinement batch at a time.
 
+mod charted;
 mod conquest;
 
 use crate::base_mesh;
-use crate::format::{ChunkHeader, Header, Reader, BASE_TAG, BATCH_TAG};
+use crate::charts::MAX_CHARTS;
+use crate::format::{
+    ChunkHeader, Header, LevelInfo, Reader, BASE_TAG, BATCH_TAG, CHARTED_VERSION, PARTED_TAG,
+};
 use crate::gates::{GateStatistics, PassKind};
 use crate::halfedge::Connectivity;
 use crate::quantize::Quantization;
 use crate::{Error, IndexedMesh, Result};
+use charted::{read_part, Charted};
 use conquest::{PassInput, Scratch};
 
 /// Budget a decoder enforces before it allocates or grows anything.
@@ -78,6 +83,9 @@ pub struct Decoder {
     scratch: Scratch,
     /// A batch failed after it began to change the level.
     broken: bool,
+    /// A charted stream's charts, once its first parted batch cut them.
+    charted: Option<Charted>,
+    threads: usize,
 }
 
 impl Decoder {
@@ -98,7 +106,7 @@ impl Decoder {
                 last.vertices, last.faces, limits.max_vertices, limits.max_faces
             )));
         }
-        let (chunk, payload) = ChunkHeader::parse(&prefix[header.byte_len()..], BASE_TAG)?;
+        let (chunk, payload) = ChunkHeader::parse(&prefix[header.byte_len()..], &[BASE_TAG])?;
         let base = header.levels[0];
         if chunk.vertices_after != base.vertices || chunk.faces_after != base.faces {
             return Err(Error::stream("base chunk disagrees with the level table"));
@@ -128,6 +136,8 @@ impl Decoder {
             limits,
             scratch: Scratch::default(),
             broken: false,
+            charted: None,
+            threads: 1,
         })
     }
 
@@ -160,7 +170,20 @@ impl Decoder {
                 "an earlier batch failed part-way: decode again from the base",
             ));
         }
-        let (chunk, payload) = ChunkHeader::parse(chunk_bytes, BATCH_TAG)?;
+        let (chunk, payload) = ChunkHeader::parse(chunk_bytes, &[BATCH_TAG, PARTED_TAG])?;
+        if chunk.version != self.header.version {
+            return Err(Error::stream("chunk version differs from the stream's"));
+        }
+        let parted = chunk.tag == PARTED_TAG;
+        if parted && self.header.version != CHARTED_VERSION {
+            return Err(Error::stream(format!(
+                "a parted batch in a version {} stream",
+                self.header.version
+            )));
+        }
+        if !parted && self.charted.is_some() {
+            return Err(Error::stream("a whole-mesh batch after parted ones"));
+        }
         let expected = self.applied + 1;
         if chunk.level as usize != expected || expected > self.header.batch_count() {
             return Err(Error::stream(format!(
@@ -180,6 +203,9 @@ impl Decoder {
             return Err(Error::Limit(
                 "batch exceeds the vertex or face limit".into(),
             ));
+        }
+        if parted {
+            return self.apply_parted(payload, info, expected);
         }
         let mut r = Reader::new(payload);
         let cleaning = read_pass(&mut r, PassKind::Cleaning)?;
@@ -223,6 +249,69 @@ impl Decoder {
         Ok(())
     }
 
+    /// A parted batch (format 5): every chart's part, the charts cut first
+    /// when this is the first such batch; its counts are checked already.
+    fn apply_parted(&mut self, payload: &[u8], info: LevelInfo, expected: usize) -> Result<()> {
+        let mut r = Reader::new(payload);
+        let charts = r.varint()? as usize;
+        if !(2..=MAX_CHARTS).contains(&charts) {
+            return Err(Error::stream(format!("{charts} charts is out of range")));
+        }
+        let cut = match &self.charted {
+            Some(c) if c.chart_count() != charts => {
+                return Err(Error::stream("a parted batch changes the number of charts"))
+            }
+            Some(_) => None,
+            None => Some(Charted::cut(&self.level, r.section()?, charts)?),
+        };
+        let mut parts = Vec::with_capacity(charts);
+        for _ in 0..charts {
+            parts.push(read_part(r.section()?)?);
+        }
+        if r.remaining() != 0 {
+            return Err(Error::stream("trailing bytes after the batch's parts"));
+        }
+        let added: u64 = parts
+            .iter()
+            .flatten()
+            .map(|(c, d, _)| c.inserted as u64 + d.inserted as u64)
+            .sum();
+        if added != (info.vertices as usize - self.level.vertex_count()) as u64 {
+            return Err(Error::stream(
+                "parts insert a different number of vertices than the batch",
+            ));
+        }
+        if info.faces as u64 != self.face_count() as u64 + 2 * added {
+            return Err(Error::stream(
+                "level table's face count disagrees with the batch",
+            ));
+        }
+        if let Some(c) = cut {
+            self.charted = Some(c);
+            // The charts hold the connectivity from now on.
+            self.level.conn = Connectivity {
+                origin: Vec::new(),
+                twin: Vec::new(),
+                out: Vec::new(),
+            };
+        }
+        let charted = self.charted.as_mut().expect("cut above");
+        if let Err(e) = charted.apply(parts, self.threads) {
+            self.broken = true;
+            return Err(e);
+        }
+        charted.merge(&mut self.level);
+        self.applied = expected;
+        Ok(())
+    }
+
+    /// Decodes each parted batch's charts on up to `threads` threads (format
+    /// 5 streams, native builds; WebAssembly decodes them in turn). The
+    /// levels are the same bytes whatever the number. Default: 1.
+    pub fn set_threads(&mut self, threads: usize) {
+        self.threads = threads.max(1);
+    }
+
     /// Positions as `x, y, z` per vertex, in model units.
     pub fn positions(&self) -> &[f32] {
         self.level.positions.as_flattened()
@@ -235,7 +324,10 @@ impl Decoder {
 
     /// Triangle list, three indices per face, counter-clockwise.
     pub fn indices(&self) -> &[u32] {
-        &self.level.conn.origin
+        match &self.charted {
+            Some(c) => &c.indices,
+            None => &self.level.conn.origin,
+        }
     }
 
     /// Quantized positions: exactly the encoder's input at this quantization.
@@ -248,7 +340,7 @@ impl Decoder {
     }
 
     pub fn face_count(&self) -> usize {
-        self.level.conn.origin.len() / 3
+        self.indices().len() / 3
     }
 
     /// The current level as an indexed mesh (dequantized positions).
@@ -257,9 +349,7 @@ impl Decoder {
             positions: self.level.positions.clone(),
             colors: self.level.colours.clone(),
             triangles: self
-                .level
-                .conn
-                .origin
+                .indices()
                 .chunks_exact(3)
                 .map(|t| [t[0], t[1], t[2]])
                 .collect(),

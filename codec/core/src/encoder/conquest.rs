@@ -23,6 +23,10 @@ pub(crate) struct Simplifier<'g> {
     pub geometric_guard: bool,
     /// A caller's veto on decimations (the cell complex, a colour metric).
     pub patch_guard: Option<&'g dyn PatchGuard>,
+    /// By input-vertex id, the vertices a chart shares with another (empty
+    /// outside charts): no retriangulation may join two of them, or two
+    /// charts could each make the same edge.
+    pub cut: Vec<bool>,
     /// Mean face area of the mesh at the start of the pass, for guards.
     mean_face_area: f64,
     pub live_vertices: usize,
@@ -59,6 +63,7 @@ impl<'g> Simplifier<'g> {
             colours,
             geometric_guard,
             patch_guard,
+            cut: Vec::new(),
             mean_face_area: 0.0,
             live_vertices: n,
             state: vec![FREE; n],
@@ -297,7 +302,7 @@ impl<'g> Simplifier<'g> {
                 if t < NO_TWIN as usize && corner < t {
                     let a = polygon[pattern.corner_vertex(corner)];
                     let b = polygon[pattern.corner_vertex(t)];
-                    if c.has_edge(a, b) {
+                    if c.has_edge(a, b) || self.on_cut(a) && self.on_cut(b) {
                         return None;
                     }
                 }
@@ -319,6 +324,10 @@ impl<'g> Simplifier<'g> {
             }
         }
         Some(patch)
+    }
+
+    fn on_cut(&self, v: u32) -> bool {
+        !self.cut.is_empty() && self.cut[self.ids[v as usize] as usize]
     }
 
     fn candidate<'p>(&self, p: &'p Patch) -> CandidatePatch<'p> {

@@ -46,6 +46,34 @@ pub struct EncodeOptions {
     /// same bytes either way; about 40 % of the work moves off the main
     /// thread, for up to a second mesh's worth of memory).
     pub pipelined: bool,
+    /// Cut the stream into charts whose batches decode in parallel (format 5).
+    pub charts: Charts,
+}
+
+/// Whether a stream is cut into charts (format 5, `charts` module).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Charts {
+    /// A plain stream (format 4): every batch refines the whole mesh.
+    #[default]
+    Off,
+    /// One chart per this many input vertices, at most 64; a plain stream
+    /// when that makes fewer than two.
+    PerVertices(u32),
+    /// This many charts (2..=64, fewer when the mesh has fewer faces).
+    Count(u32),
+}
+
+impl Charts {
+    /// How many charts a mesh of `vertices` vertices gets (below 2: none).
+    pub fn count(self, vertices: usize) -> usize {
+        match self {
+            Charts::Off => 1,
+            Charts::PerVertices(per) => {
+                (vertices / per.max(1) as usize).min(crate::charts::MAX_CHARTS)
+            }
+            Charts::Count(k) => (k as usize).min(crate::charts::MAX_CHARTS),
+        }
+    }
 }
 
 impl Default for EncodeOptions {
@@ -58,6 +86,7 @@ impl Default for EncodeOptions {
             min_layer_fraction: 0.02,
             geometric_guard: true,
             pipelined: true,
+            charts: Charts::Off,
         }
     }
 }
@@ -79,9 +108,9 @@ pub struct Encoded {
     pub header: Header,
 }
 
-struct Layer {
-    decimating: PassOutput,
-    cleaning: PassOutput,
+pub(crate) struct Layer {
+    pub decimating: PassOutput,
+    pub cleaning: PassOutput,
 }
 
 /// Encodes a manifold mesh (see `vitrine_mesh::repair::prepare`) with no
@@ -193,7 +222,7 @@ fn encode_guarded(
     mesh: &IndexedMesh,
     options: &EncodeOptions,
     guard: Option<&dyn PatchGuard>,
-    mut progress: impl FnMut(EncodeProgress),
+    progress: impl FnMut(EncodeProgress),
 ) -> Result<Encoded> {
     if mesh.triangles.is_empty() {
         return Err(Error::input("mesh", "no triangles"));
@@ -214,14 +243,109 @@ fn encode_guarded(
         .iter()
         .map(|&p| quantization.quantize(p))
         .collect();
+    check_indices(mesh.positions.len(), &mesh.triangles)?;
+    let target = match options.base {
+        BaseTarget::Vertices(n) => n as usize,
+        BaseTarget::Fraction(f) => (mesh.positions.len() as f64 * f as f64) as usize,
+    }
+    .max(options.min_base_vertices as usize);
+    let charts = options.charts.count(mesh.positions.len());
+    if charts >= 2 {
+        let charted = crate::charts::encode::encode_charted(
+            &positions,
+            &mesh.triangles,
+            mesh.colors.as_deref(),
+            quantization,
+            options,
+            charts,
+            target,
+            guard,
+            |e| connectivity(mesh).err().unwrap_or(e),
+            progress,
+        )?;
+        return match charted {
+            Some(encoded) => Ok(encoded),
+            None => plain(
+                mesh,
+                &positions,
+                quantization,
+                options,
+                target,
+                guard,
+                |_| {},
+            ),
+        };
+    }
+    plain(
+        mesh,
+        &positions,
+        quantization,
+        options,
+        target,
+        guard,
+        progress,
+    )
+}
+
+fn plain(
+    mesh: &IndexedMesh,
+    positions: &[[i32; 3]],
+    quantization: Quantization,
+    options: &EncodeOptions,
+    target: usize,
+    guard: Option<&dyn PatchGuard>,
+    progress: impl FnMut(EncodeProgress),
+) -> Result<Encoded> {
+    let (s, coded) = simplify(
+        QuantizedMesh {
+            positions,
+            triangles: &mesh.triangles,
+            colours: mesh.colors.as_deref(),
+            max_value: quantization.max_value(),
+        },
+        Vec::new(),
+        options,
+        target,
+        guard,
+        // Name the culprit in the caller's vertex ids: the input's own order.
+        |e| connectivity(mesh).err().unwrap_or(e),
+        progress,
+    )?;
+    Ok(write_stream(
+        &s,
+        &coded,
+        quantization,
+        positions,
+        mesh.colors.as_deref(),
+    ))
+}
+
+/// A mesh already quantized and checked (every corner indexes a vertex).
+pub(crate) struct QuantizedMesh<'m> {
+    pub positions: &'m [[i32; 3]],
+    pub triangles: &'m [[u32; 3]],
+    pub colours: Option<&'m [[u8; 3]]>,
+    pub max_value: i32,
+}
+
+/// Simplifies `mesh` layer by layer down to `target` vertices and codes
+/// every pass: the coarse mesh left, and its layers finest first.
+/// `culprit` rewrites a connectivity error in the caller's terms.
+pub(crate) fn simplify<'g>(
+    mesh: QuantizedMesh<'_>,
+    cut: Vec<bool>,
+    options: &EncodeOptions,
+    target: usize,
+    guard: Option<&'g dyn PatchGuard>,
+    culprit: impl FnOnce(Error) -> Error,
+    mut progress: impl FnMut(EncodeProgress),
+) -> Result<(Simplifier<'g>, Vec<Layer>)> {
     let input_vertices = mesh.positions.len();
-    check_indices(input_vertices, &mesh.triangles)?;
-    let mut order = LocalityOrder::of(&positions, &mesh.triangles, quantization.max_value());
+    let mut order = LocalityOrder::of(mesh.positions, mesh.triangles, mesh.max_value);
     // Renumbered from checked faces: every corner indexes a vertex.
     let conn = match Connectivity::from_indexed_triangles(input_vertices, &order.triangles) {
         Ok(conn) => conn,
-        // Name the culprit in the caller's vertex ids: the input's own order.
-        Err(e) => return Err(connectivity(mesh).err().unwrap_or(e)),
+        Err(e) => return Err(culprit(e)),
     };
     // The connectivity holds the faces now; a scan's worth of memory back.
     order.triangles = Vec::new();
@@ -230,14 +354,8 @@ fn encode_guarded(
             "mesh has vertices no face uses (run repair first)".into(),
         ));
     }
-    let target = match options.base {
-        BaseTarget::Vertices(n) => n as usize,
-        BaseTarget::Fraction(f) => (input_vertices as f64 * f as f64) as usize,
-    }
-    .max(options.min_base_vertices as usize);
-
-    let local_positions = order.permute(&positions);
-    let local_colours = mesh.colors.as_deref().map(|c| order.permute(c));
+    let local_positions = order.permute(mesh.positions);
+    let local_colours = mesh.colours.map(|c| order.permute(c));
     let mut s = Simplifier::new(
         conn,
         order.vertices,
@@ -246,6 +364,7 @@ fn encode_guarded(
         options.geometric_guard,
         guard,
     );
+    s.cut = cut;
     let mut layers = Vec::new();
     let outputs = std::thread::scope(|scope| -> Result<Vec<PassOutput>> {
         let mut sink = PassSink::start(scope, options.pipelined);
@@ -303,16 +422,57 @@ fn encode_guarded(
             })
         })
         .collect::<Result<Vec<_>>>()?;
-    Ok(write_stream(&s, &coded, quantization, &positions, mesh))
+    Ok((s, coded))
 }
 
-fn write_stream(
+pub(crate) fn write_stream(
     s: &Simplifier,
     layers: &[Layer],
     quantization: Quantization,
     quantized: &[[i32; 3]],
-    mesh: &IndexedMesh,
+    colours: Option<&[[u8; 3]]>,
 ) -> Encoded {
+    let plain = plain_chunks(s, layers, quantization, quantized, colours, VERSION);
+    let header = Header {
+        version: VERSION,
+        has_colour: colours.is_some(),
+        quantization,
+        levels: plain.levels,
+    };
+    let mut bytes = Vec::new();
+    header.write(&mut bytes);
+    bytes.extend_from_slice(&plain.chunks);
+    Encoded {
+        bytes,
+        vertex_order: plain.vertex_order,
+        header,
+    }
+}
+
+/// A simplification written as a base chunk and one batch chunk per layer,
+/// without the stream's header.
+pub(crate) struct PlainChunks {
+    /// The level each chunk makes, the base first.
+    pub levels: Vec<LevelInfo>,
+    /// The chunks, back to back.
+    pub chunks: Vec<u8>,
+    /// Final vertex `i` is input vertex `vertex_order[i]`.
+    pub vertex_order: Vec<u32>,
+    /// Every input vertex's final id.
+    pub new_id: Vec<u32>,
+}
+
+/// Writes `s`'s coarse mesh as the base chunk and `layers` as batches, in
+/// chunks of stream version `version`; `quantized` and `colours` are the
+/// simplification's input.
+pub(crate) fn plain_chunks(
+    s: &Simplifier,
+    layers: &[Layer],
+    quantization: Quantization,
+    quantized: &[[i32; 3]],
+    colours: Option<&[[u8; 3]]>,
+    version: u8,
+) -> PlainChunks {
     let input_vertices = quantized.len();
     // Final numbering: base vertices by first appearance, then each batch's
     // vertices in insertion order (coarsest layer first, cleaning before decimation).
@@ -324,20 +484,13 @@ fn write_stream(
         .collect();
     let mut vertex_order = base_mesh::first_appearance_order(input_vertices, &base_triangles);
     let base_vertices = vertex_order.len();
-    for layer in layers.iter().rev() {
-        vertex_order.extend_from_slice(&layer.cleaning.removed);
-        vertex_order.extend_from_slice(&layer.decimating.removed);
-    }
-    let mut new_id = vec![u32::MAX; input_vertices];
-    for (new, &old) in vertex_order.iter().enumerate() {
-        new_id[old as usize] = new as u32;
-    }
+    let new_id = number_layers(&mut vertex_order, layers, input_vertices);
     let base = BaseMesh {
         positions: vertex_order[..base_vertices]
             .iter()
             .map(|&v| quantized[v as usize])
             .collect(),
-        colours: mesh.colors.as_ref().map(|c| {
+        colours: colours.map(|c| {
             vertex_order[..base_vertices]
                 .iter()
                 .map(|&v| c[v as usize])
@@ -349,34 +502,82 @@ fn write_stream(
             .collect(),
     };
     let base_payload = base_mesh::encode(&base, &walk.pushed, quantization.max_value());
-    let mut base_chunk = Vec::new();
+    let mut chunks = Vec::new();
     ChunkHeader {
         tag: BASE_TAG,
+        version,
         level: 0,
         vertices_before: 0,
         vertices_after: base_vertices as u32,
         faces_after: base.triangles.len() as u32,
         payload_len: base_payload.len() as u32,
     }
-    .write(&mut base_chunk);
-    base_chunk.extend_from_slice(&base_payload);
-
+    .write(&mut chunks);
+    chunks.extend_from_slice(&base_payload);
     let mut levels = vec![LevelInfo {
         vertices: base_vertices as u32,
         faces: base.triangles.len() as u32,
-        bytes: base_chunk.len() as u32,
+        bytes: chunks.len() as u32,
     }];
+    let batches = batch_chunks(
+        layers,
+        &new_id,
+        base_vertices,
+        base.triangles.len(),
+        version,
+    );
+    for (level, chunk) in batches {
+        levels.push(level);
+        chunks.extend_from_slice(&chunk);
+    }
+    PlainChunks {
+        levels,
+        chunks,
+        vertex_order,
+        new_id,
+    }
+}
+
+/// Appends each layer's removed vertices to `vertex_order` (which holds the
+/// base vertices) in insertion order, coarsest layer first and cleaning
+/// before decimation, and returns every input vertex's final id.
+pub(crate) fn number_layers(
+    vertex_order: &mut Vec<u32>,
+    layers: &[Layer],
+    input_vertices: usize,
+) -> Vec<u32> {
+    for layer in layers.iter().rev() {
+        vertex_order.extend_from_slice(&layer.cleaning.removed);
+        vertex_order.extend_from_slice(&layer.decimating.removed);
+    }
+    let mut new_id = vec![u32::MAX; input_vertices];
+    for (new, &old) in vertex_order.iter().enumerate() {
+        new_id[old as usize] = new as u32;
+    }
+    new_id
+}
+
+/// One batch chunk per layer, coarsest first, with the level each makes;
+/// `new_id` gives every input vertex its final id.
+pub(crate) fn batch_chunks(
+    layers: &[Layer],
+    new_id: &[u32],
+    base_vertices: usize,
+    base_faces: usize,
+    version: u8,
+) -> Vec<(LevelInfo, Vec<u8>)> {
     let mut batches = Vec::new();
     let mut vertices = base_vertices;
-    let mut faces = base.triangles.len();
+    let mut faces = base_faces;
     for (i, layer) in layers.iter().rev().enumerate() {
         let mut payload = Vec::new();
-        write_pass(&mut payload, &layer.cleaning, &new_id);
-        write_pass(&mut payload, &layer.decimating, &new_id);
+        write_pass(&mut payload, &layer.cleaning, new_id);
+        write_pass(&mut payload, &layer.decimating, new_id);
         let added = layer.cleaning.removed.len() + layer.decimating.removed.len();
         let mut chunk = Vec::new();
         ChunkHeader {
             tag: BATCH_TAG,
+            version,
             level: (i + 1) as u16,
             vertices_before: vertices as u32,
             vertices_after: (vertices + added) as u32,
@@ -387,33 +588,17 @@ fn write_stream(
         chunk.extend_from_slice(&payload);
         vertices += added;
         faces += 2 * added;
-        levels.push(LevelInfo {
+        let level = LevelInfo {
             vertices: vertices as u32,
             faces: faces as u32,
             bytes: chunk.len() as u32,
-        });
-        batches.push(chunk);
+        };
+        batches.push((level, chunk));
     }
-    let header = Header {
-        version: VERSION,
-        has_colour: mesh.colors.is_some(),
-        quantization,
-        levels,
-    };
-    let mut bytes = Vec::new();
-    header.write(&mut bytes);
-    bytes.extend_from_slice(&base_chunk);
-    for b in &batches {
-        bytes.extend_from_slice(b);
-    }
-    Encoded {
-        bytes,
-        vertex_order,
-        header,
-    }
+    batches
 }
 
-fn write_pass(out: &mut Vec<u8>, pass: &PassOutput, new_id: &[u32]) {
+pub(crate) fn write_pass(out: &mut Vec<u8>, pass: &PassOutput, new_id: &[u32]) {
     write_varint(out, pass.seeds.len() as u32);
     for seed in &pass.seeds {
         write_varint(out, new_id[seed[0] as usize]);

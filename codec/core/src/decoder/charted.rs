@@ -1,0 +1,179 @@
+//! A charted stream (format 5) once its charts are cut: one level per chart,
+//! each refined by its part of every parted batch, on its own thread where
+//! threads exist, then merged into the level the caller sees.
+
+use super::conquest::{PassInput, Scratch};
+use super::{read_pass, Level};
+use crate::charts::{canonical_faces, cut, decode_labels};
+use crate::format::Reader;
+use crate::gates::PassKind;
+use crate::halfedge::Connectivity;
+use crate::{Error, Result};
+
+pub(super) struct Charted {
+    charts: Vec<Chart>,
+    /// The merged level's triangle list, in the level's vertex ids.
+    pub indices: Vec<u32>,
+}
+
+struct Chart {
+    level: Level,
+    scratch: Scratch,
+    /// The merged level's id of each chart vertex.
+    global: Vec<u32>,
+}
+
+/// One chart's part of a parted batch: its cleaning and decimating passes
+/// and its size in bytes; `None` when the chart sits the batch out.
+pub(super) type Part<'a> = Option<(PassInput<'a>, PassInput<'a>, usize)>;
+
+impl Charted {
+    /// Cuts `level` (where the global batches left it) into `charts` charts
+    /// by the labels coded in `labels`; `level` is not changed.
+    pub(super) fn cut(level: &Level, labels: &[u8], charts: usize) -> Result<Charted> {
+        let face_count = level.conn.origin.len() / 3;
+        let labels = decode_labels(labels, face_count, charts)?;
+        let (faces, _) = canonical_faces(
+            level
+                .conn
+                .origin
+                .chunks_exact(3)
+                .map(|t| [t[0], t[1], t[2]]),
+            std::iter::repeat(0),
+        );
+        let charts = cut(&faces, &labels, charts, level.vertex_count())
+            .into_iter()
+            .map(|c| {
+                let conn = Connectivity::from_triangles(c.global.len(), &c.triangles)
+                    .map_err(|e| Error::stream(format!("a chart is not a manifold: {e}")))?;
+                let pick = |v: &u32| *v as usize;
+                Ok(Chart {
+                    level: Level {
+                        conn,
+                        quantization: level.quantization,
+                        positions_q: c
+                            .global
+                            .iter()
+                            .map(|v| level.positions_q[pick(v)])
+                            .collect(),
+                        positions: c.global.iter().map(|v| level.positions[pick(v)]).collect(),
+                        colours: level
+                            .colours
+                            .as_ref()
+                            .map(|colours| c.global.iter().map(|v| colours[pick(v)]).collect()),
+                    },
+                    scratch: Scratch::default(),
+                    global: c.global,
+                })
+            })
+            .collect::<Result<Vec<_>>>()?;
+        Ok(Charted {
+            charts,
+            indices: level.conn.origin.clone(),
+        })
+    }
+
+    pub(super) fn chart_count(&self) -> usize {
+        self.charts.len()
+    }
+
+    /// Applies every chart's part, on up to `threads` threads; the first
+    /// error in chart order, whatever the threads.
+    pub(super) fn apply(&mut self, parts: Vec<Part<'_>>, threads: usize) -> Result<()> {
+        debug_assert_eq!(parts.len(), self.charts.len());
+        #[cfg(not(target_arch = "wasm32"))]
+        if threads > 1 && self.charts.len() > 1 {
+            // Each thread takes the next chart as it frees up: charts differ
+            // in size, and a fixed split would wait on the largest share.
+            let workers = threads.min(self.charts.len());
+            let queue = std::sync::Mutex::new(self.charts.iter_mut().zip(parts).enumerate());
+            let next = || queue.lock().map(|mut q| q.next()).ok().flatten();
+            let mut results: Vec<(usize, Result<()>)> = std::thread::scope(|scope| {
+                let workers: Vec<_> = (0..workers)
+                    .map(|_| {
+                        scope.spawn(|| {
+                            let mut done = Vec::new();
+                            while let Some((i, (chart, part))) = next() {
+                                done.push((i, chart.apply(part)));
+                            }
+                            done
+                        })
+                    })
+                    .collect();
+                workers
+                    .into_iter()
+                    .flat_map(|w| w.join().unwrap_or_else(|p| std::panic::resume_unwind(p)))
+                    .collect()
+            });
+            results.sort_by_key(|&(i, _)| i);
+            return results.into_iter().try_for_each(|(_, r)| r);
+        }
+        let _ = threads;
+        self.charts
+            .iter_mut()
+            .zip(parts)
+            .try_for_each(|(chart, part)| chart.apply(part))
+    }
+
+    /// Appends the vertices the charts gained to `level`, chart by chart in
+    /// insertion order, and rebuilds the merged triangle list.
+    pub(super) fn merge(&mut self, level: &mut Level) {
+        for chart in &mut self.charts {
+            for v in chart.global.len()..chart.level.vertex_count() {
+                chart.global.push(level.positions_q.len() as u32);
+                level.positions_q.push(chart.level.positions_q[v]);
+                level.positions.push(chart.level.positions[v]);
+                if let (Some(out), Some(colours)) = (&mut level.colours, &chart.level.colours) {
+                    out.push(colours[v]);
+                }
+            }
+        }
+        self.indices.clear();
+        for chart in &self.charts {
+            self.indices.extend(
+                chart
+                    .level
+                    .conn
+                    .origin
+                    .iter()
+                    .map(|&v| chart.global[v as usize]),
+            );
+        }
+    }
+}
+
+impl Chart {
+    fn apply(&mut self, part: Part<'_>) -> Result<()> {
+        let Some((cleaning, decimating, bytes)) = part else {
+            return Ok(());
+        };
+        // Reserve no more than the part could possibly describe (a bit per vertex).
+        let grow = (cleaning.inserted as usize + decimating.inserted as usize)
+            .min(bytes.saturating_mul(8));
+        let level = &mut self.level;
+        level.positions_q.reserve(grow);
+        level.positions.reserve(grow);
+        level.conn.out.reserve(grow);
+        if let Some(colours) = &mut level.colours {
+            colours.reserve(grow);
+        }
+        level.conn.origin.reserve(6 * grow);
+        level.conn.twin.reserve(6 * grow);
+        level.undo_pass(&cleaning, &mut self.scratch)?;
+        level.undo_pass(&decimating, &mut self.scratch)
+    }
+}
+
+/// Reads one part: empty, or a cleaning and a decimating pass filling it.
+pub(super) fn read_part(bytes: &[u8]) -> Result<Part<'_>> {
+    if bytes.is_empty() {
+        return Ok(None);
+    }
+    let mut r = Reader::new(bytes);
+    let cleaning = read_pass(&mut r, PassKind::Cleaning)?;
+    let decimating = read_pass(&mut r, PassKind::Decimating)?;
+    if r.remaining() != 0 {
+        return Err(Error::stream("trailing bytes after a chart's passes"));
+    }
+    Ok(Some((cleaning, decimating, bytes.len())))
+}

@@ -1,0 +1,188 @@
+//! Charted streams (format 5): lossless like the plain stream, the same
+//! levels on one thread or many, and hostile parted batches refused.
+
+use vitrine_codec::{
+    decode, encode, Charts, Decoder, EncodeOptions, Encoded, IndexedMesh, Limits, StreamIndex,
+    CHARTED_VERSION, VERSION,
+};
+use vitrine_samples::{add_noise, merge, paint, plate_with_tunnels, punch_holes, torus};
+
+fn charted(k: u32) -> EncodeOptions {
+    EncodeOptions {
+        charts: Charts::Count(k),
+        ..EncodeOptions::default()
+    }
+}
+
+/// A painted, noisy torus of 24 k vertices with holes (borders) in it.
+fn scan_like() -> IndexedMesh {
+    let mut mesh = torus(240, 100, 1.0, 0.35);
+    add_noise(&mut mesh, 0.003, 17);
+    let mut mesh = punch_holes(&mesh, &[[1.35, 0.0, 0.0], [-0.65, 0.0, 0.0]], 0.12);
+    paint(&mut mesh);
+    mesh
+}
+
+/// A level's quantized positions, indices and colours.
+type LevelBuffers = (Vec<[i32; 3]>, Vec<u32>, Option<Vec<u8>>);
+
+/// Every level's buffers, decoded on `threads` threads.
+fn levels(bytes: &[u8], threads: usize) -> Vec<LevelBuffers> {
+    let index = StreamIndex::parse(bytes).unwrap();
+    let mut d = Decoder::new(&bytes[index.base.clone()], Limits::default()).unwrap();
+    d.set_threads(threads);
+    let mut out = Vec::new();
+    for (k, range) in index.batches.iter().enumerate() {
+        d.apply_batch(&bytes[range.clone()])
+            .unwrap_or_else(|e| panic!("batch {k}: {e}"));
+        let level = index.header.levels[k + 1];
+        assert_eq!(d.vertex_count(), level.vertices as usize, "level {k}");
+        assert_eq!(d.face_count(), level.faces as usize, "level {k}");
+        out.push((
+            d.quantized_positions().to_vec(),
+            d.indices().to_vec(),
+            d.colours().map(<[u8]>::to_vec),
+        ));
+    }
+    out
+}
+
+fn assert_lossless(mesh: &IndexedMesh, encoded: &Encoded) {
+    let d = decode(&encoded.bytes, None, Limits::default()).unwrap();
+    if let Some(diff) = vitrine_samples::final_level_mismatch(mesh, 12, &d, &encoded.vertex_order) {
+        panic!("final level differs from the quantized input: {diff}");
+    }
+}
+
+#[test]
+fn a_charted_stream_is_lossless_and_the_same_on_any_number_of_threads() {
+    let mesh = scan_like();
+    let encoded = encode(&mesh, &charted(6)).unwrap();
+    assert_eq!(encoded.header.version, CHARTED_VERSION);
+    assert_eq!(encode(&mesh, &charted(6)).unwrap().bytes, encoded.bytes);
+    assert_lossless(&mesh, &encoded);
+    let serial = levels(&encoded.bytes, 1);
+    assert!(serial.len() >= 6, "{} levels", serial.len());
+    for threads in [2, 3, 8] {
+        assert!(
+            levels(&encoded.bytes, threads) == serial,
+            "{threads} threads"
+        );
+    }
+    // Every level is a closed-up manifold of the final one's vertices: each
+    // vertex of a level has faces.
+    for (k, (positions, indices, _)) in serial.iter().enumerate() {
+        let mut used = vec![false; positions.len()];
+        for &v in indices {
+            used[v as usize] = true;
+        }
+        assert!(
+            used.iter().all(|&u| u),
+            "level {k} has a vertex without faces"
+        );
+    }
+}
+
+#[test]
+fn charts_cost_few_bytes_over_the_plain_stream() {
+    let mesh = scan_like();
+    let plain = encode(&mesh, &EncodeOptions::default()).unwrap();
+    assert_eq!(plain.header.version, VERSION);
+    // Charts of 12 k and 6 k vertices (real scans get 50 k: BENCHMARKS.md);
+    // measured 1.019 and 1.072 when written.
+    for (k, most) in [(2, 1.03), (4, 1.09)] {
+        let charted = encode(&mesh, &charted(k)).unwrap();
+        assert_lossless(&mesh, &charted);
+        let ratio = charted.bytes.len() as f64 / plain.bytes.len() as f64;
+        assert!(
+            ratio < most,
+            "{k} charts: {ratio:.4} of the plain stream's size"
+        );
+    }
+}
+
+#[test]
+fn meshes_in_pieces_and_with_tunnels_stay_lossless() {
+    let mut pieces = merge(
+        &[
+            torus(90, 40, 1.0, 0.3),
+            plate_with_tunnels(3, 14),
+            torus(60, 30, 0.5, 0.2),
+        ],
+        0.5,
+    );
+    paint(&mut pieces);
+    for k in [3, 16, 64] {
+        let encoded = encode(&pieces, &charted(k)).unwrap();
+        assert_lossless(&pieces, &encoded);
+        let serial = levels(&encoded.bytes, 1);
+        assert!(levels(&encoded.bytes, 4) == serial, "{k} charts");
+    }
+}
+
+#[test]
+fn small_meshes_fall_back_to_the_plain_stream() {
+    let mesh = torus(12, 8, 1.0, 0.3);
+    let per = encode(
+        &mesh,
+        &EncodeOptions {
+            charts: Charts::PerVertices(100_000),
+            ..EncodeOptions::default()
+        },
+    )
+    .unwrap();
+    assert_eq!(
+        per.bytes,
+        encode(&mesh, &EncodeOptions::default()).unwrap().bytes
+    );
+}
+
+#[test]
+fn hostile_parted_batches_are_refused_without_panic() {
+    let mesh = scan_like();
+    let encoded = encode(&mesh, &charted(4)).unwrap();
+    let bytes = &encoded.bytes;
+    let index = StreamIndex::parse(bytes).unwrap();
+    let first_parted = index
+        .batches
+        .iter()
+        .position(|r| bytes[r.start] == b'P')
+        .expect("a parted batch");
+    let fresh = |upto: usize| {
+        let mut d = Decoder::new(&bytes[index.base.clone()], Limits::default()).unwrap();
+        d.set_threads(2);
+        for r in &index.batches[..upto] {
+            d.apply_batch(&bytes[r.clone()]).unwrap();
+        }
+        d
+    };
+    let target = index.batches[first_parted].clone();
+    let chunk = &bytes[target.clone()];
+    // Truncated anywhere: an error, never a panic.
+    for cut in [1, 2, 5, chunk.len() / 3, chunk.len() / 2, chunk.len() - 1] {
+        assert!(
+            fresh(first_parted).apply_batch(&chunk[..cut]).is_err(),
+            "cut at {cut}"
+        );
+    }
+    // Flipped bytes in the payload: an error or some level, never a panic,
+    // and the decoder refuses what follows once a batch failed part-way.
+    let mut refused = 0;
+    for at in (12..chunk.len()).step_by(chunk.len() / 97 + 1) {
+        let mut bad = chunk.to_vec();
+        bad[at] ^= 0x5a;
+        let mut d = fresh(first_parted);
+        if d.apply_batch(&bad).is_err() {
+            refused += 1;
+        }
+    }
+    assert!(refused > 0);
+    // A whole-mesh batch after a parted one, and batches out of order.
+    let mut d = fresh(first_parted + 1);
+    let plain_batch = index.batches[0].clone();
+    assert!(d.apply_batch(&bytes[plain_batch]).is_err());
+    if first_parted + 2 < index.batches.len() {
+        let skip = index.batches[first_parted + 2].clone();
+        assert!(fresh(first_parted + 1).apply_batch(&bytes[skip]).is_err());
+    }
+}
