@@ -1,6 +1,7 @@
 //! `vitrine encode`: a mesh file into a progressive stream file, with the
 //! cell complex written beside it in `ccc` mode.
 
+use super::charts::ChartsArg;
 use super::guard::GuardArgs;
 use super::ingest::CccArgs;
 use crate::ccc_files::CccFiles;
@@ -47,6 +48,11 @@ pub struct EncodeArgs {
     pub ccc: CccArgs,
     #[command(flatten)]
     pub guard: GuardArgs,
+    /// Cut the stream into charts that decode on several cores (format 5):
+    /// `off` (the default: format 4), `auto` (one per 50,000 vertices, plain
+    /// below 100,000) or a number of charts, 2–64.
+    #[arg(long, default_value = "off")]
+    pub charts: ChartsArg,
 }
 
 impl EncodeArgs {
@@ -58,6 +64,7 @@ impl EncodeArgs {
                 None => BaseTarget::Fraction(self.base_fraction),
             },
             geometric_guard: !self.no_geometric_guard,
+            charts: self.charts.0,
             ..EncodeOptions::default()
         }
     }

@@ -1,6 +1,7 @@
 //! `vitrine ingest <mesh|cloud> --db … --slug … --title …`: a mesh, or a
 //! point cloud (a PLY without faces, LAS, LAZ) stored as a point stream.
 
+use super::charts::ChartsArg;
 use super::guard::GuardArgs;
 use crate::database::open_storage;
 use crate::ingest::points::{detect_kind, ingest_points, load_cloud};
@@ -56,6 +57,10 @@ pub struct IngestArgs {
     /// a point cloud (default 14).
     #[arg(long)]
     pub quantization_bits: Option<u8>,
+    /// A mesh's stream cut into charts that decode on several cores (format
+    /// 5): `off` (the default), `auto` (one per 50,000 vertices) or 2–64.
+    #[arg(long, default_value = "off")]
+    pub charts: ChartsArg,
     /// How colour travels: `ccc` (a cubic cell complex: a cell texture and
     /// a colour texture shared by every level, sampled from the file's
     /// colour texture (OBJ, glTF) or else its per-vertex colour; the stream
@@ -220,6 +225,7 @@ impl IngestArgs {
         Ok(IngestOptions {
             encode: EncodeOptions {
                 quantization_bits: self.quantization_bits.unwrap_or(12),
+                charts: self.charts.0,
                 ..EncodeOptions::default()
             },
             points: PointEncodeOptions {

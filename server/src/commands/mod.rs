@@ -3,6 +3,7 @@
 //! the developer tools of `vitrine-dev`. The binaries only parse and call
 //! [`Command::run`].
 
+pub mod charts;
 pub mod decode;
 pub mod encode;
 pub mod guard;

@@ -112,11 +112,22 @@ impl ModelKind {
         }
     }
 
-    /// The stream format version this build decodes for this kind.
+    /// The newest stream format version this build writes for this kind.
     pub fn reads(self) -> u8 {
         match self {
             ModelKind::Mesh => vitrine_codec::VERSION,
             ModelKind::Points => vitrine_points::stream::VERSION,
+        }
+    }
+
+    /// Whether this build decodes streams of `version` for this kind (a
+    /// mesh: the plain format and the charted one).
+    pub fn can_read(self, version: u8) -> bool {
+        match self {
+            ModelKind::Mesh => {
+                version == vitrine_codec::VERSION || version == vitrine_codec::CHARTED_VERSION
+            }
+            ModelKind::Points => version == vitrine_points::stream::VERSION,
         }
     }
 }
@@ -175,7 +186,7 @@ impl ModelRecord {
     /// Whether this build's decoder (and so its viewer) reads the stored
     /// payloads: streams of another format version must be re-ingested.
     pub fn servable(&self) -> bool {
-        self.stream_format == self.kind.reads()
+        self.kind.can_read(self.stream_format)
     }
 }
 
@@ -200,7 +211,7 @@ pub struct ModelSummary {
 impl ModelSummary {
     /// See [`ModelRecord::servable`].
     pub fn servable(&self) -> bool {
-        self.stream_format == self.kind.reads()
+        self.kind.can_read(self.stream_format)
     }
 }
 
