@@ -4,11 +4,6 @@
 use std::str::FromStr;
 use vitrine_codec::{Charts, MAX_CHARTS};
 
-/// One chart per this many vertices under `--charts auto`: charts of 50 k
-/// vertices cost igea about 1 % in size and give a 2 M-vertex scan 40
-/// charts, enough for any visitor's cores (BENCHMARKS.md, "Charts").
-pub const AUTO_VERTICES_PER_CHART: u32 = 50_000;
-
 /// `off`, `auto` or a number of charts (2–64).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct ChartsArg(pub Charts);
@@ -19,7 +14,7 @@ impl FromStr for ChartsArg {
     fn from_str(s: &str) -> Result<Self, String> {
         match s {
             "off" | "1" => Ok(ChartsArg(Charts::Off)),
-            "auto" => Ok(ChartsArg(Charts::PerVertices(AUTO_VERTICES_PER_CHART))),
+            "auto" => Ok(ChartsArg(Charts::Auto)),
             n => match n.parse::<u32>() {
                 Ok(k) if (2..=MAX_CHARTS as u32).contains(&k) => Ok(ChartsArg(Charts::Count(k))),
                 _ => Err(format!(
@@ -34,7 +29,7 @@ impl std::fmt::Display for ChartsArg {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self.0 {
             Charts::Off => f.write_str("off"),
-            Charts::PerVertices(_) => f.write_str("auto"),
+            Charts::Auto | Charts::PerVertices(_) => f.write_str("auto"),
             Charts::Count(k) => write!(f, "{k}"),
         }
     }
@@ -47,10 +42,7 @@ mod tests {
     #[test]
     fn parses_off_auto_and_counts() {
         assert_eq!("off".parse(), Ok(ChartsArg(Charts::Off)));
-        assert_eq!(
-            "auto".parse(),
-            Ok(ChartsArg(Charts::PerVertices(AUTO_VERTICES_PER_CHART)))
-        );
+        assert_eq!("auto".parse(), Ok(ChartsArg(Charts::Auto)));
         assert_eq!("8".parse(), Ok(ChartsArg(Charts::Count(8))));
         for bad in ["0", "65", "many", "-2", ""] {
             assert!(bad.parse::<ChartsArg>().is_err(), "{bad}");

@@ -49,8 +49,8 @@ pub struct EncodeArgs {
     #[command(flatten)]
     pub guard: GuardArgs,
     /// Cut the stream into charts that decode on several cores (format 5):
-    /// `off` (the default: format 4), `auto` (one per 50,000 vertices, plain
-    /// below 100,000) or a number of charts, 2–64.
+    /// `off` (the default: format 4), `auto` (one per 50,000 vertices, at most 6;
+    /// plain below 100,000) or a number of charts, 2–64.
     #[arg(long, default_value = "off")]
     pub charts: ChartsArg,
 }

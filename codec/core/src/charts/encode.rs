@@ -15,7 +15,9 @@ use crate::{Error, Result};
 
 /// A chart's fine layers stop once it has this fraction of its vertices
 /// left (or a layer removes too little): what remains, cut vertices and
-/// coarse interiors, goes to the global layers.
+/// coarse interiors, goes to the global layers. (On igea and its 2 M
+/// upsample, 1/3 to 1/16 change the size by under 2 ‰; 1/8 leaves about
+/// 10 % of the vertices to the serial global layers.)
 const CHART_REDUCTION: usize = 8;
 
 /// A chart after its fine layers.
@@ -150,7 +152,7 @@ pub(crate) fn encode_charted(
     );
     let level_vertices = coarse_vertices.len();
     let cuts = cut(&faces, &labels, charts, level_vertices);
-    let labels_bytes = encode_labels(&labels, charts);
+    let labels_bytes = encode_labels(&faces, level_vertices, &labels, charts)?;
 
     // Each chart's ids: its cut's vertices, then its layers' in insertion order.
     let chart_ids: Vec<Vec<u32>> = fine

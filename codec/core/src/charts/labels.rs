@@ -1,39 +1,71 @@
 //! Chart labels of the level where charts begin, one per face in canonical
-//! order, range-coded with the previous face's label as context (faces
-//! sorted by their smallest vertex come in small neighbourhoods, so a label
-//! mostly repeats).
+//! order, range-coded with the label of a neighbouring face already coded
+//! as context: a chart is a connected patch, so a face's label is its
+//! neighbour's everywhere but along the cut.
 
 use crate::entropy::{RangeDecoder, RangeEncoder, SymbolModel};
+use crate::halfedge::{face, Connectivity, NONE};
 use crate::{Error, Result};
 
+/// One model per context label.
 fn models(charts: usize) -> Vec<SymbolModel> {
     (0..charts).map(|_| SymbolModel::new(charts)).collect()
 }
 
-/// `labels` are each below `charts` (2..=64).
-pub(crate) fn encode_labels(labels: &[u32], charts: usize) -> Vec<u8> {
-    let mut models = models(charts);
-    let mut coder = RangeEncoder::with_capacity(labels.len() / 8 + 16);
-    let mut previous = 0;
-    for &label in labels {
-        coder.encode_symbol(&mut models[previous], label as usize);
-        previous = label as usize;
-    }
-    coder.finish()
+/// The context of face `f`: the label of its first neighbour (across its
+/// edges in order) labelled already, else the previous face's (else 0).
+fn context(conn: &Connectivity, labels: &[u32], f: usize) -> usize {
+    (0..3)
+        .map(|k| conn.twin[3 * f + k])
+        .filter(|&t| t != NONE)
+        .map(|t| labels[face(t) as usize])
+        .find(|&l| l != NONE)
+        .or_else(|| f.checked_sub(1).map(|p| labels[p]))
+        .map_or(0, |l| l as usize)
 }
 
-/// The labels of `faces` faces (a count the caller holds in memory already).
-pub(crate) fn decode_labels(bytes: &[u8], faces: usize, charts: usize) -> Result<Vec<u32>> {
+fn adjacency(faces: &[[u32; 3]], vertex_count: usize) -> Result<Connectivity> {
+    Connectivity::from_triangles(vertex_count, faces)
+        .map_err(|e| Error::stream(format!("the level where charts begin: {e}")))
+}
+
+/// `faces` in canonical order (a manifold on `vertex_count` vertices),
+/// `labels` each below `charts` (2..=64).
+pub(crate) fn encode_labels(
+    faces: &[[u32; 3]],
+    vertex_count: usize,
+    labels: &[u32],
+    charts: usize,
+) -> Result<Vec<u8>> {
+    let conn = adjacency(faces, vertex_count)?;
+    let mut models = models(charts);
+    let mut coder = RangeEncoder::with_capacity(labels.len() / 16 + 16);
+    let mut known = vec![NONE; labels.len()];
+    for (f, &label) in labels.iter().enumerate() {
+        let c = context(&conn, &known, f);
+        coder.encode_symbol(&mut models[c], label as usize);
+        known[f] = label;
+    }
+    Ok(coder.finish())
+}
+
+/// The labels of `faces` (canonical order, a level the caller holds).
+pub(crate) fn decode_labels(
+    bytes: &[u8],
+    faces: &[[u32; 3]],
+    vertex_count: usize,
+    charts: usize,
+) -> Result<Vec<u32>> {
     if !(2..=super::MAX_CHARTS).contains(&charts) {
         return Err(Error::stream(format!("{charts} charts is out of range")));
     }
+    let conn = adjacency(faces, vertex_count)?;
     let mut models = models(charts);
     let mut coder = RangeDecoder::new(bytes);
-    let mut labels = Vec::with_capacity(faces);
-    let mut previous = 0;
-    for _ in 0..faces {
-        previous = coder.decode_symbol(&mut models[previous]);
-        labels.push(previous as u32);
+    let mut labels = vec![NONE; faces.len()];
+    for f in 0..faces.len() {
+        let c = context(&conn, &labels, f);
+        labels[f] = coder.decode_symbol(&mut models[c]) as u32;
     }
     coder.check_overrun()?;
     Ok(labels)
@@ -43,14 +75,30 @@ pub(crate) fn decode_labels(bytes: &[u8], faces: usize, charts: usize) -> Result
 mod tests {
     use super::*;
 
+    /// A strip of quads, `n` long, as canonical faces.
+    fn strip(n: u32) -> Vec<[u32; 3]> {
+        let mut faces = Vec::new();
+        for i in 0..n {
+            let (a, b, c, d) = (i, i + 1, n + 1 + i, n + 2 + i);
+            faces.push([a, b, d]);
+            faces.push([a, d, c]);
+        }
+        let (faces, _) = super::super::canonical_faces(faces.into_iter(), std::iter::repeat(0));
+        faces
+    }
+
     #[test]
-    fn labels_round_trip_and_runs_cost_little() {
-        let labels: Vec<u32> = (0..10_000u32).map(|i| (i / 1000) % 7).collect();
-        let bytes = encode_labels(&labels, 7);
-        assert!(bytes.len() < 200, "{} bytes for 10 runs", bytes.len());
-        assert_eq!(decode_labels(&bytes, labels.len(), 7).unwrap(), labels);
+    fn labels_round_trip_and_patches_cost_little() {
+        let n = 5000;
+        let faces = strip(n);
+        // Seven patches along the strip.
+        let labels: Vec<u32> = faces.iter().map(|t| (t[0] * 7 / (n + 1)).min(6)).collect();
+        let bytes = encode_labels(&faces, 2 * n as usize + 2, &labels, 7).unwrap();
+        assert!(bytes.len() < 200, "{} bytes for 7 patches", bytes.len());
+        let decoded = decode_labels(&bytes, &faces, 2 * n as usize + 2, 7).unwrap();
+        assert_eq!(decoded, labels);
         // Truncated: an overrun, never a panic.
-        assert!(decode_labels(&bytes[..bytes.len() / 2], labels.len(), 7).is_err());
-        assert!(decode_labels(&bytes, 10, 65).is_err());
+        assert!(decode_labels(&bytes[..bytes.len() / 2], &faces, 2 * n as usize + 2, 7).is_err());
+        assert!(decode_labels(&bytes, &faces, 2 * n as usize + 2, 65).is_err());
     }
 }

@@ -31,8 +31,6 @@ impl Charted {
     /// Cuts `level` (where the global batches left it) into `charts` charts
     /// by the labels coded in `labels`; `level` is not changed.
     pub(super) fn cut(level: &Level, labels: &[u8], charts: usize) -> Result<Charted> {
-        let face_count = level.conn.origin.len() / 3;
-        let labels = decode_labels(labels, face_count, charts)?;
         let (faces, _) = canonical_faces(
             level
                 .conn
@@ -41,6 +39,7 @@ impl Charted {
                 .map(|t| [t[0], t[1], t[2]]),
             std::iter::repeat(0),
         );
+        let labels = decode_labels(labels, &faces, level.vertex_count(), charts)?;
         let charts = cut(&faces, &labels, charts, level.vertex_count())
             .into_iter()
             .map(|c| {

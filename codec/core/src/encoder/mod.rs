@@ -56,6 +56,9 @@ pub enum Charts {
     /// A plain stream (format 4): every batch refines the whole mesh.
     #[default]
     Off,
+    /// One chart per [`Charts::AUTO_VERTICES`] input vertices, at most
+    /// [`Charts::AUTO_MAX`]: a plain stream below 100,000 vertices.
+    Auto,
     /// One chart per this many input vertices, at most 64; a plain stream
     /// when that makes fewer than two.
     PerVertices(u32),
@@ -64,10 +67,18 @@ pub enum Charts {
 }
 
 impl Charts {
+    /// Vertices per chart under [`Charts::Auto`].
+    pub const AUTO_VERTICES: u32 = 50_000;
+    /// The most charts [`Charts::Auto`] makes: each chart's part of a batch
+    /// restarts its coder's models, and at 6 charts a 2 M-vertex scan's
+    /// stream is 1.8 % larger than format 4 (8: 2.7 %; BENCHMARKS.md).
+    pub const AUTO_MAX: usize = 6;
+
     /// How many charts a mesh of `vertices` vertices gets (below 2: none).
     pub fn count(self, vertices: usize) -> usize {
         match self {
             Charts::Off => 1,
+            Charts::Auto => (vertices / Self::AUTO_VERTICES as usize).min(Self::AUTO_MAX),
             Charts::PerVertices(per) => {
                 (vertices / per.max(1) as usize).min(crate::charts::MAX_CHARTS)
             }
