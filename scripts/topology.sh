@@ -10,7 +10,9 @@
 #   scripts/topology.sh --short   CI: a few hundred visitors (≤ 2.5 minutes)
 #
 # Checks: crowd (p50/p99 over every request, statuses, nginx cache hit ratio,
-# each instance's share), kill (SIGKILL one instance mid-crowd: nobody fails,
+# each instance's share, nginx's own p99, where the CPU went: time on a CPU
+# and time waiting for one of nginx's workers, the harness and the instances,
+# and the kernel's listen-queue drops and retransmissions over the crowd), kill (SIGKILL one instance mid-crowd: nobody fails,
 # it rejoins), ingest (a new version mid-crowd reaches both instances within
 # the bound, nobody mixes versions), rolling (SIGTERM, restart, next, under a
 # crowd: no request lost), pg_restart (cached batches flow, uncached answers
@@ -171,14 +173,88 @@ log_stats() { # from to
 crowd_line() { grep -E '^[0-9]+ visitors' "$1" | tail -n 1; }
 no_failed() { grep -qE '\(([0-9]+) completed, 0 failed' "$1"; }
 
+# Where a crowd's time goes (issue 24). Time on a CPU and time runnable but
+# waiting for one, in ns, summed over the threads of some processes
+# (/proc/PID/task/*/schedstat: run time, run-queue wait, slices).
+sched() { # pid… → "run_ns wait_ns"
+    local p f files=()
+    for p in "$@"; do
+        for f in /proc/"$p"/task/*/schedstat; do [ -r "$f" ] && files+=("$f"); done
+    done
+    [ ${#files[@]} -gt 0 ] || { echo "0 0"; return 0; }
+    # A thread may exit between the glob and the read.
+    { cat "${files[@]}" 2>/dev/null || true; } | awk '{ r += $1; w += $2 } END { printf "%d %d\n", r, w }'
+}
+# The kernel's listen-queue counters (a dropped SYN or handshake costs its
+# visitor a 1 s retransmission) and TCP retransmissions, as "name value".
+tcp_counters() {
+    awk '/^TcpExt:/ { if (!h) { for (i = 2; i <= NF; i++) n[i] = $i; h = 1 }
+                      else for (i = 2; i <= NF; i++)
+                          if (n[i] ~ /^(ListenOverflows|ListenDrops|TCPReqQFullDrop|TCPReqQFullDoCookies)$/) print n[i], $i }' \
+        /proc/net/netstat 2>/dev/null
+    awk '/^Tcp:/ { if (!t) { for (i = 2; i <= NF; i++) n[i] = $i; t = 1 }
+                   else for (i = 2; i <= NF; i++) if (n[i] == "RetransSegs") print n[i], $i }' \
+        /proc/net/snmp 2>/dev/null
+}
+counter_delta() { # before after → "name +delta, …"
+    awk 'NR == FNR { b[$1] = $2; next } { printf "%s%s +%d", sep, $1, $2 - b[$1]; sep = ", " }' "$1" "$2"
+}
+cpu_ticks() { awk '/^cpu / { print $2 + $3 + $4 + $7 + $8, $2 + $3 + $4 + $5 + $6 + $7 + $8 }' /proc/stat; }
+# nginx's own view: p99 of $request_time (from reading a request to its
+# last byte) over the API requests logged between two times.
+nginx_p99() { # from to
+    awk -v from="$1" -v to="$2" '$1 >= from && $1 <= to && $4 ~ /^"\/api\// { print $6 * 1000 }' "$access" |
+        sort -n | awk '{ v[NR] = $1 } END { if (!NR) { printf "-"; exit } k = int(NR * 0.99 + 0.5); if (k < 1) k = 1; printf "%.0f", v[k] }'
+}
+
 # 1. The crowd: every visitor at once, through nginx.
 check_crowd() {
     local t0 out=$work/crowd.out
+    local workers
+    workers=$(ps -o pid= --ppid "$nginx_pid" | tr '\n' ' ')
+    local n0 i0 c0 m0 h=0 hs="0 0" x rc=0
+    # shellcheck disable=SC2086
+    n0=$(sched $workers)
+    i0=$(sched "${inst[@]}")
+    m0=$(cpu_ticks)
+    tcp_counters >"$work/tcp.before"
     t0=$(now)
-    if "$load" crowd --url "$proxy" --slug topo --profile "$profile" --visitors "$visitors" \
+    "$load" crowd --url "$proxy" --slug topo --profile "$profile" --visitors "$visitors" \
         --pattern burst --token "$token" --stay-s 0 --allow 429,503 \
-        --json "$work/crowd.json" >"$out" 2>&1; then
-        report PASS crowd "$visitors visitors at once through nginx: $(crowd_line "$out"). $(log_stats "$t0" "$(now)")"
+        --json "$work/crowd.json" >"$out" 2>&1 &
+    h=$!
+    # The harness's threads are gone once it exits: sampled while it runs,
+    # keeping the largest sample (as it exits, only its main thread is left).
+    while kill -0 "$h" 2>/dev/null; do
+        x=$(sched "$h")
+        [ "${x%% *}" -le "${hs%% *}" ] || hs=$x
+        sleep 0.2
+    done
+    wait "$h" || rc=$?
+    local t1 n1 i1 m1
+    t1=$(now)
+    # shellcheck disable=SC2086
+    n1=$(sched $workers)
+    i1=$(sched "${inst[@]}")
+    m1=$(cpu_ticks)
+    tcp_counters >"$work/tcp.after"
+    local tck
+    tck=$(getconf CLK_TCK 2>/dev/null || echo 100)
+    local cpu
+    cpu=$(awk -v n0="$n0" -v n1="$n1" -v i0="$i0" -v i1="$i1" -v h="$hs" -v m0="$m0" -v m1="$m1" \
+        -v tck="$tck" -v wall="$(awk "BEGIN { print $t1 - $t0 }")" -v cores="$(nproc)" 'BEGIN {
+            split(n0, a); split(n1, b); split(i0, c); split(i1, d); split(h, e); split(m0, f); split(m1, g)
+            busy = (g[1] - f[1]) / tck; total = (g[2] - f[2]) / tck
+            nr = (b[1] - a[1]) / 1e9; nw = (b[2] - a[2]) / 1e9
+            ir = (d[1] - c[1]) / 1e9; iw = (d[2] - c[2]) / 1e9
+            hr = e[1] / 1e9; hw = e[2] / 1e9
+            other = busy - nr - ir - hr; if (other < 0) other = 0
+            printf "CPU over the crowd (%.1f s, %d cores): busy %.1f of %.1f CPU-s; on a CPU / runnable but waiting for one: nginx workers %.2f / %.2f s, the harness %.2f / %.2f s, the instances %.2f / %.2f s; everything else (PostgreSQL, other work on the machine) %.2f CPU-s",
+                wall, cores, busy, total, nr, nw, hr, hw, ir, iw, other }')
+    local detail
+    detail="$visitors visitors at once through nginx: $(crowd_line "$out"). $(log_stats "$t0" "$t1"); nginx-side p99 $(nginx_p99 "$t0" "$t1") ms. $cpu. Kernel: $(counter_delta "$work/tcp.before" "$work/tcp.after") (somaxconn $(cat /proc/sys/net/core/somaxconn 2>/dev/null), tcp_max_syn_backlog $(cat /proc/sys/net/ipv4/tcp_max_syn_backlog 2>/dev/null))"
+    if [ $rc = 0 ]; then
+        report PASS crowd "$detail"
     else
         report FAIL crowd "$(tail -n 6 "$out")"
     fi
