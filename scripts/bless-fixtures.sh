@@ -34,18 +34,20 @@ trap 'rm -rf "$tmp"' EXIT
 sha() { if [ -f "$1" ]; then printf '"%s"' "$(sha256sum "$1" | cut -d' ' -f1)"; else printf 'null'; fi; }
 size() { stat -c %s "$1"; }
 
-# fixture NAME SAMPLE-ARGS...: `vitrine sample SAMPLE-ARGS`, then encode with the defaults.
+# fixture NAME SAMPLE-ARGS...: `vitrine sample SAMPLE-ARGS`, then encode with
+# the defaults and $encode_args.
+encode_args=()
 fixture() {
     local name=$1
     shift
     "$VITRINE_BIN" sample "$@" -o "$tmp/$name.ply" 2>/dev/null
-    "$VITRINE_BIN" encode "$tmp/$name.ply" -o "$out/$name.vtr" >/dev/null 2>&1
+    "$VITRINE_BIN" encode "$tmp/$name.ply" -o "$out/$name.vtr" "${encode_args[@]}" >/dev/null 2>&1
     "$VITRINE_DEV_BIN" dump-levels "$out/$name.vtr" "$tmp/$name"
     local levels
     levels=$(find "$tmp/$name" -name 'level-*.positions' | wc -l)
     {
         printf '{\n'
-        printf '  "made_by": "vitrine sample %s; vitrine encode; bash scripts/bless-fixtures.sh",\n' "$*"
+        printf '  "made_by": "vitrine sample %s; vitrine encode%s; bash scripts/bless-fixtures.sh",\n' "$*" "${encode_args[*]:+ ${encode_args[*]}}"
         printf '  "stream": { "bytes": %s, "sha256": %s },\n' "$(size "$out/$name.vtr")" "$(sha "$out/$name.vtr")"
         printf '  "levels": [\n'
         for ((k = 0; k < levels; k++)); do
@@ -65,3 +67,7 @@ fixture torus torus --kilo-vertices 1
 fixture painted-torus torus --kilo-vertices 1 --colour --noise 0.003
 fixture plate plate --kilo-vertices 1
 fixture sphere sphere --kilo-vertices 1 --noise 0.002
+# A charted stream (format 5): four charts, each decoded on its own.
+encode_args=(--charts 4)
+fixture charted-torus torus --kilo-vertices 3 --colour --noise 0.003
+encode_args=()

@@ -36,7 +36,7 @@ function digest(level) {
 
 test('the committed fixtures: small, each the stream its sidecar was blessed from', () => {
   const names = fixtureNames();
-  assert.deepEqual(names, ['painted-torus', 'plate', 'sphere', 'torus']);
+  assert.deepEqual(names, ['charted-torus', 'painted-torus', 'plate', 'sphere', 'torus']);
   for (const name of names) {
     const f = fixture(name);
     assert.ok(f.stream.length < 16 << 10, `${name}.vtr is ${f.stream.length} bytes`);
@@ -44,6 +44,9 @@ test('the committed fixtures: small, each the stream its sidecar was blessed fro
     assert.equal(sha256(f.stream), f.streamDigest.sha256, `${name}.vtr is not the stream ${name}.json describes: ${BLESS}`);
     assert.ok(f.levels.length >= 3, `${name}: a base and several batches`);
     f.levels.forEach((level, k) => assert.equal(level.level, k));
+    // Byte 4 is the stream's version: 5 for the charted stream (its later
+    // batches in one part per chart), 4 for the plain ones.
+    assert.equal(f.stream[4], name === 'charted-torus' ? 5 : 4, `${name}.vtr version`);
   }
 });
 
@@ -59,7 +62,7 @@ for (const name of fixtureNames()) {
       // The zero-copy views the decode worker reads are the same bytes.
       assert.deepEqual(digest(decoder.view()), f.levels[k], `${name} level ${k} through view()`);
     }
-    if (name === 'painted-torus') assert.ok(f.levels.every((l) => l.colours !== null), 'colour at every level');
+    if (name === 'painted-torus' || name === 'charted-torus') assert.ok(f.levels.every((l) => l.colours !== null), 'colour at every level');
     else assert.ok(f.levels.every((l) => l.colours === null), 'no colour');
     decoder.free();
   });
@@ -90,23 +93,21 @@ function leb128(value) {
 
 /**
  * @typedef {{ seeds: Array<[number, number]>, inserted: number, sections: Uint8Array[] }} Pass
- * @typedef {{ head: Uint8Array, level: number, before: number, after: number, faces: number, passes: Pass[] }} Batch
+ * @typedef {{ charts: number, labels: Uint8Array | null, parts: Array<Pass[] | null> }} Parted
+ * @typedef {{ head: Uint8Array, level: number, before: number, after: number, faces: number, passes: Pass[], parted: Parted | null }} Batch
  */
 
+/** The tag of a parted batch (a charted stream's, format 5). */
+const PARTED = 0x50;
+
 /**
- * A batch chunk taken apart as codec/core/FORMAT.md lays it out: tag and
- * version, five header varints, then two passes (seeds, inserted vertices,
- * connectivity, geometry and colour sections).
+ * Two passes (seeds, inserted vertices, connectivity, geometry and colour
+ * sections) from `at`.
  * @param {Uint8Array} bytes
- * @returns {Batch}
+ * @param {number} at
+ * @returns {[Pass[], number]}
  */
-function parseBatch(bytes) {
-  let at = 2;
-  /** @type {number[]} */
-  const header = [];
-  for (let i = 0; i < 5; i++) [header[i], at] = varint(bytes, at);
-  const [level, before, after, faces, length] = header;
-  assert.equal(at + length, bytes.length, 'payload length');
+function parsePasses(bytes, at) {
   /** @type {Pass[]} */
   const passes = [];
   for (let p = 0; p < 2; p++) {
@@ -131,22 +132,99 @@ function parseBatch(bytes) {
     }
     passes.push({ seeds, inserted, sections });
   }
-  assert.equal(at, bytes.length, 'the two passes fill the payload');
-  return { head: bytes.slice(0, 2), level, before, after, faces, passes };
+  return [passes, at];
+}
+
+/**
+ * A batch chunk taken apart as codec/core/FORMAT.md lays it out: tag and
+ * version, five header varints, then two passes, or for a parted batch the
+ * number of charts, the chart labels (`labelled`: the stream's first parted
+ * batch) and each chart's part (empty, or two passes).
+ * @param {Uint8Array} bytes
+ * @param {boolean} [labelled]
+ * @returns {Batch}
+ */
+function parseBatch(bytes, labelled = false) {
+  let at = 2;
+  /** @type {number[]} */
+  const header = [];
+  for (let i = 0; i < 5; i++) [header[i], at] = varint(bytes, at);
+  const [level, before, after, faces, length] = header;
+  assert.equal(at + length, bytes.length, 'payload length');
+  /** @type {Pass[]} */
+  let passes = [];
+  /** @type {Parted | null} */
+  let parted = null;
+  if (bytes[0] === PARTED) {
+    let charts, n;
+    [charts, at] = varint(bytes, at);
+    /** @type {Uint8Array | null} */
+    let labels = null;
+    if (labelled) {
+      [n, at] = varint(bytes, at);
+      labels = bytes.slice(at, at + n);
+      at += n;
+    }
+    /** @type {Array<Pass[] | null>} */
+    const parts = [];
+    for (let k = 0; k < charts; k++) {
+      [n, at] = varint(bytes, at);
+      if (n === 0) {
+        parts.push(null);
+        continue;
+      }
+      const [chartPasses, end] = parsePasses(bytes, at);
+      assert.equal(end, at + n, 'the two passes fill the part');
+      parts.push(chartPasses);
+      at = end;
+    }
+    parted = { charts, labels, parts };
+  } else {
+    [passes, at] = parsePasses(bytes, at);
+  }
+  assert.equal(at, bytes.length, 'the passes fill the payload');
+  return { head: bytes.slice(0, 2), level, before, after, faces, passes, parted };
+}
+
+/** @param {Pass[]} passes */
+function writePasses(passes) {
+  /** @type {number[]} */
+  const out = [];
+  for (const pass of passes) {
+    out.push(...leb128(pass.seeds.length));
+    for (const [a, b] of pass.seeds) out.push(...leb128(a), ...leb128(b));
+    out.push(...leb128(pass.inserted));
+    for (const section of pass.sections) out.push(...leb128(section.length), ...section);
+  }
+  return out;
 }
 
 /** @param {Batch} batch */
 function writeBatch(batch) {
   /** @type {number[]} */
-  const payload = [];
-  for (const pass of batch.passes) {
-    payload.push(...leb128(pass.seeds.length));
-    for (const [a, b] of pass.seeds) payload.push(...leb128(a), ...leb128(b));
-    payload.push(...leb128(pass.inserted));
-    for (const section of pass.sections) payload.push(...leb128(section.length), ...section);
+  let payload = [];
+  if (batch.parted) {
+    payload.push(...leb128(batch.parted.charts));
+    if (batch.parted.labels) payload.push(...leb128(batch.parted.labels.length), ...batch.parted.labels);
+    for (const part of batch.parted.parts) {
+      const bytes = part ? writePasses(part) : [];
+      payload.push(...leb128(bytes.length), ...bytes);
+    }
+  } else {
+    payload = writePasses(batch.passes);
   }
   const header = [batch.level, batch.before, batch.after, batch.faces, payload.length].flatMap(leb128);
   return Uint8Array.from([...batch.head, ...header, ...payload]);
+}
+
+/**
+ * Whether batch `i` of `batches` is the stream's first parted batch (the
+ * one that carries the chart labels).
+ * @param {Uint8Array[]} batches
+ * @param {number} i
+ */
+function labelled(batches, i) {
+  return i === batches.findIndex((b) => b[0] === PARTED);
 }
 
 /**
@@ -161,9 +239,16 @@ function edited(edit) {
 }
 
 test('the test can take a batch apart and put it together again byte for byte', () => {
+  let parted = 0;
   for (const name of fixtureNames()) {
-    for (const bytes of splitStream(fixture(name).stream).batches) assert.deepEqual(writeBatch(parseBatch(bytes)), bytes);
+    const { batches } = splitStream(fixture(name).stream);
+    batches.forEach((bytes, i) => {
+      const batch = parseBatch(bytes, labelled(batches, i));
+      if (batch.parted) parted++;
+      assert.deepEqual(writeBatch(batch), bytes);
+    });
   }
+  assert.ok(parted >= 3, `${parted} parted batches in the fixtures`);
 });
 
 test('wasm reports truncated and out-of-order streams as errors', async () => {
@@ -248,9 +333,10 @@ test('wasm refuses corrupt batches: apply fails with the reason', async () => {
 test('wasm refuses every batch of every fixture with flipped bytes', async () => {
   const c = await codec();
   /** Every byte of the connectivity codes: the traversal finds other patches than the pass declares, or runs out of codes. */
-  const connectivity = (/** @type {Uint8Array} */ bytes) => {
-    const b = parseBatch(bytes);
-    for (const pass of b.passes) pass.sections[0] = pass.sections[0].map((x) => x ^ 0x5a);
+  const connectivity = (/** @type {Uint8Array} */ bytes, /** @type {boolean} */ first) => {
+    const b = parseBatch(bytes, first);
+    const passes = b.parted ? b.parted.parts.flatMap((part) => part ?? []) : b.passes;
+    for (const pass of passes) pass.sections[0] = pass.sections[0].map((x) => x ^ 0x5a);
     return writeBatch(b);
   };
   /** Every seventh byte from the 40th on, wherever it falls (header fields, seeds, any section). */
@@ -261,13 +347,13 @@ test('wasm refuses every batch of every fixture with flipped bytes', async () =>
   };
   for (const name of fixtureNames()) {
     const { base, batches } = splitStream(fixture(name).stream);
-    for (const [flip, reason] of /** @type {Array<[(b: Uint8Array) => Uint8Array, RegExp]>} */ ([
+    for (const [flip, reason] of /** @type {Array<[(b: Uint8Array, first: boolean) => Uint8Array, RegExp]>} */ ([
       [connectivity, /pass insert|patch faces do not match their pattern|truncated entropy-coded payload/],
       [scattered, /./],
     ])) {
       batches.forEach((batch, i) => {
         // Batch i + 1 flipped, on a decoder at level i: apply must throw, and the level stay at i.
-        const corrupt = flip(batch);
+        const corrupt = flip(batch, labelled(batches, i));
         assert.notDeepEqual(corrupt, batch);
         const probe = c.decoder(base);
         for (let k = 0; k < i; k++) probe.apply(batches[k]);

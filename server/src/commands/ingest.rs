@@ -59,7 +59,7 @@ pub struct IngestArgs {
     pub quantization_bits: Option<u8>,
     /// A mesh's stream cut into charts that decode on several cores (format
     /// 5): `off` (the default), `auto` (one per 50,000 vertices, at most
-    /// 6) or 2–64.
+    /// 5) or 2–64.
     #[arg(long, default_value = "off")]
     pub charts: ChartsArg,
     /// How colour travels: `ccc` (a cubic cell complex: a cell texture and

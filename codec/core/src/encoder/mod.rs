@@ -70,9 +70,10 @@ impl Charts {
     /// Vertices per chart under [`Charts::Auto`].
     pub const AUTO_VERTICES: u32 = 50_000;
     /// The most charts [`Charts::Auto`] makes: each chart's part of a batch
-    /// restarts its coder's models, and at 6 charts a 2 M-vertex scan's
-    /// stream is 1.8 % larger than format 4 (8: 2.7 %; BENCHMARKS.md).
-    pub const AUTO_MAX: usize = 6;
+    /// restarts its coder's models, so every chart costs bytes. igea
+    /// upsampled to 2.1 M vertices: +1.2 % over format 4 at 3 charts,
+    /// +1.8 % at 5, +2.0 % at 6, +2.7 % at 8 (BENCHMARKS.md, "Charts").
+    pub const AUTO_MAX: usize = 5;
 
     /// How many charts a mesh of `vertices` vertices gets (below 2: none).
     pub fn count(self, vertices: usize) -> usize {
