@@ -5,8 +5,8 @@
 use std::path::Path;
 
 use vitrine_mesh::export::{sample_md2, write_glb, write_md2, write_obj, write_ply};
-use vitrine_samples::{icosphere, plate_with_tunnels};
-use vitrine_codec::{encode, EncodeOptions, StreamIndex};
+use vitrine_samples::{icosphere, paint, plate_with_tunnels, torus};
+use vitrine_codec::{encode, Charts, EncodeOptions, StreamIndex};
 use vitrine_codec_fuzz::{sample_meshes, sample_streams};
 
 fn base64(data: &[u8]) -> String {
@@ -63,6 +63,20 @@ fn main() {
         },
     );
     write("decode_stream", "coarse", &coarse.unwrap().bytes);
+    // A charted stream (format 5): labels and parted batches.
+    let mut painted = torus(40, 24, 1.0, 0.3);
+    paint(&mut painted);
+    let charted = encode(
+        &painted,
+        &EncodeOptions {
+            min_base_vertices: 8,
+            charts: Charts::Count(3),
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    assert_eq!(charted.header.version, vitrine_codec::CHARTED_VERSION);
+    write("decode_stream", "charted", &charted.bytes);
 
     // decode_points: small point streams, with and without attributes.
     for (i, (n, attrs)) in [(40usize, false), (300, true)].into_iter().enumerate() {
