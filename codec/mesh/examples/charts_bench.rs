@@ -4,7 +4,7 @@
 //!
 //! `cargo run --release -p vitrine-mesh --example charts_bench -- [--per N]... [--runs R] mesh...`
 //! (`--per`: one chart per N vertices, repeatable, 0 for `--charts auto`;
-//! default 0).
+//! `--count K`: K charts; default `--per 0`).
 use std::time::Instant;
 use vitrine_codec::{decode, encode, Charts, Decoder, EncodeOptions, Limits, StreamIndex};
 use vitrine_mesh::import::{import_path, ImportOptions};
@@ -66,6 +66,10 @@ fn main() {
     while let Some(a) = args.next() {
         match a.as_str() {
             "--per" => per.push(args.next().expect("--per N").parse::<u32>().unwrap()),
+            // `--count K`: K charts whatever the size (stored as u32::MAX - K).
+            "--count" => {
+                per.push(u32::MAX - args.next().expect("--count K").parse::<u32>().unwrap())
+            }
             "--runs" => runs = args.next().expect("--runs R").parse().unwrap(),
             _ => paths.push(a),
         }
@@ -99,10 +103,10 @@ fn main() {
         );
         for &p in &per {
             // `--per 0`: what `--charts auto` makes.
-            let setting = if p == 0 {
-                Charts::Auto
-            } else {
-                Charts::PerVertices(p)
+            let setting = match p {
+                0 => Charts::Auto,
+                p if p > u32::MAX - 65 => Charts::Count(u32::MAX - p),
+                p => Charts::PerVertices(p),
             };
             let options = EncodeOptions {
                 charts: setting,

@@ -15,9 +15,10 @@ use crate::{Error, Result};
 
 /// A chart's fine layers stop once it has this fraction of its vertices
 /// left (or a layer removes too little): what remains, cut vertices and
-/// coarse interiors, goes to the global layers. (On igea and its 2 M
-/// upsample, 1/3 to 1/16 change the size by under 2 ‰; 1/8 leaves about
-/// 10 % of the vertices to the serial global layers.)
+/// coarse interiors, goes to the global layers. (1/3 to 1/16 change igea's
+/// size by under 4 ‰ and its 2 M upsample's at 42 charts by 1.8 %, earlier
+/// stops smaller; 1/8 leaves about 10 % of the vertices to the serial
+/// global layers. docs/bench-log/2026-12-04-session-17-charts.md)
 const CHART_REDUCTION: usize = 8;
 
 /// A chart after its fine layers.

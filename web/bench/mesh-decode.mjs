@@ -1,0 +1,99 @@
+// @ts-check
+// Mesh decode speed in Node, one core, against Google's draco3d: every level
+// of a plain stream (format 4) and of a charted one (format 5, its charts
+// decoded in turn, as a viewer without workers does), by the viewer's .wasm,
+// and the same mesh as a single-rate Draco mesh (Edgebreaker, positions
+// only, 12 bits) decoded by draco3d's WebAssembly decoder, positions and
+// indices read out. Median of --runs, one process. The files come from
+// scripts/bench-charts.sh (STEM.vtr, STEM.v5.vtr, STEM.drc):
+//   node bench/mesh-decode.mjs --draco3d /tmp/draco3d/node_modules/draco3d DIR/igea …
+import { existsSync, readFileSync } from 'node:fs';
+import { createRequire } from 'node:module';
+import { basename, join } from 'node:path';
+import { parseArgs } from 'node:util';
+import { VitrineCodec, splitStream } from '../src/codec.js';
+import { wasmPath } from '../test/support/fixtures.mjs';
+
+const { values, positionals } = parseArgs({
+  allowPositionals: true,
+  options: {
+    draco3d: { type: 'string' },
+    runs: { type: 'string', default: '5' },
+  },
+});
+if (!values.draco3d || positionals.length === 0) {
+  console.error('usage: node bench/mesh-decode.mjs --draco3d DIR FILE_STEM…');
+  process.exit(2);
+}
+const runs = Number(values.runs);
+const require = createRequire(import.meta.url);
+const draco3d = require(join(values.draco3d, 'draco3d.js'));
+const dracoModule = await draco3d.createDecoderModule({});
+const codec = await VitrineCodec.instantiate(readFileSync(wasmPath));
+
+/** @param {() => number} f @returns {{ ms: number, n: number }} */
+function median(f) {
+  f(); // warm-up (the wasm's tiers)
+  let n = 0;
+  const times = [];
+  for (let r = 0; r < runs; r++) {
+    const t0 = performance.now();
+    n = f();
+    times.push(performance.now() - t0);
+  }
+  times.sort((a, b) => a - b);
+  return { ms: times[times.length >> 1], n };
+}
+
+/** Every level of a stream; the final vertex count. @param {Uint8Array} bytes */
+function decodeVtr(bytes) {
+  const { base, batches } = splitStream(bytes);
+  const decoder = codec.decoder(base);
+  for (const batch of batches) decoder.apply(batch);
+  const n = decoder.level().vertices;
+  decoder.free();
+  return n;
+}
+
+/** A Draco mesh, positions (float32) and indices read out; the vertex count. @param {Uint8Array} bytes */
+function decodeDraco(bytes) {
+  const m = dracoModule;
+  const decoder = new m.Decoder();
+  const buffer = new m.DecoderBuffer();
+  buffer.Init(new Int8Array(bytes.buffer, bytes.byteOffset, bytes.byteLength), bytes.byteLength);
+  const mesh = new m.Mesh();
+  const status = decoder.DecodeBufferToMesh(buffer, mesh);
+  if (!status.ok()) throw new Error(`draco3d: ${status.error_msg()}`);
+  const n = mesh.num_points();
+  const attribute = decoder.GetAttribute(mesh, decoder.GetAttributeId(mesh, m.POSITION));
+  const floats = n * 3;
+  const ptr = m._malloc(floats * 4);
+  decoder.GetAttributeDataArrayForAllPoints(mesh, attribute, m.DT_FLOAT32, floats * 4, ptr);
+  const positions = new Float32Array(m.HEAPF32.buffer, ptr, floats).slice();
+  m._free(ptr);
+  const indexBytes = mesh.num_faces() * 12;
+  const iptr = m._malloc(indexBytes);
+  decoder.GetTrianglesUInt32Array(mesh, indexBytes, iptr);
+  const indices = new Uint32Array(m.HEAPU32.buffer, iptr, indexBytes / 4).slice();
+  m._free(iptr);
+  const faces = mesh.num_faces();
+  m.destroy(mesh);
+  m.destroy(buffer);
+  m.destroy(decoder);
+  if (positions.length !== 3 * n || indices.length !== 3 * faces) throw new Error('draco3d: short read');
+  return n;
+}
+
+console.log('| mesh | vertices | format 4, wasm | format 5, wasm, 1 worker | draco3d | format 4 / draco3d | format 5 (1 worker) / format 4 |');
+console.log('|---|---:|---:|---:|---:|---:|---:|');
+for (const stem of positionals) {
+  const [vtr, drc] = [readFileSync(`${stem}.vtr`), readFileSync(`${stem}.drc`)];
+  const v5 = existsSync(`${stem}.v5.vtr`) ? readFileSync(`${stem}.v5.vtr`) : null;
+  const plain = median(() => decodeVtr(vtr));
+  const charted = v5 ? median(() => decodeVtr(v5)) : null;
+  const draco = median(() => decodeDraco(drc));
+  const ms = (/** @type {number} */ x) => `${x.toFixed(1)} ms`;
+  console.log(
+    `| ${basename(stem)} | ${plain.n} | ${ms(plain.ms)} | ${charted ? ms(charted.ms) : '–'} | ${ms(draco.ms)} | ${(plain.ms / draco.ms).toFixed(2)} | ${charted ? (charted.ms / plain.ms).toFixed(2) : '–'} |`,
+  );
+}
