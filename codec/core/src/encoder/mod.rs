@@ -69,8 +69,9 @@ pub enum Charts {
 impl Charts {
     /// Vertices per chart under [`Charts::Auto`].
     pub const AUTO_VERTICES: u32 = 50_000;
-    /// The most charts [`Charts::Auto`] makes: each chart's part of a batch
-    /// restarts its coder's models, so every chart costs bytes. igea
+    /// The most charts [`Charts::Auto`] makes: every chart costs bytes (its
+    /// parts restart their coders' models, its cut stays out of the fine
+    /// layers). igea
     /// upsampled to 2.1 M vertices: +1.2 % over format 4 at 3 charts,
     /// +1.8 % at 5, +2.0 % at 6, +2.7 % at 8 (BENCHMARKS.md, "Charts").
     pub const AUTO_MAX: usize = 5;
