@@ -17,7 +17,8 @@ use std::sync::OnceLock;
 use std::time::{Duration, Instant};
 
 use vitrine_codec::{
-    decode, encode, Decoder, EncodeOptions, Error, Header, Limits, StreamIndex, MAGIC, VERSION,
+    decode, encode, Decoder, EncodeOptions, Error, Header, Limits, StreamIndex, CHARTED_VERSION,
+    MAGIC, VERSION,
 };
 use vitrine_samples::icosphere;
 
@@ -288,7 +289,7 @@ fn wrong_magic_is_refused() {
 #[test]
 fn unsupported_version_is_refused() {
     // VERSION − 1: a stream from the previous format, as a database may hold.
-    for v in [0, VERSION - 1, VERSION + 1, 0x7f, 0xff] {
+    for v in [0, VERSION - 1, CHARTED_VERSION + 1, 0x7f, 0xff] {
         let mut b = sphere_stream().to_vec();
         b[AT_VERSION] = v;
         assert_stream_err(
@@ -296,6 +297,16 @@ fn unsupported_version_is_refused() {
             &["unsupported version", &v.to_string()],
         );
     }
+    // A plain stream's header claiming the charted format: its chunks say 4.
+    let mut b = sphere_stream().to_vec();
+    b[AT_VERSION] = CHARTED_VERSION;
+    assert_stream_err(
+        decode(&b, None, Limits::default()),
+        &[
+            "chunk version mismatch",
+            "version 4 chunk in a version 5 stream",
+        ],
+    );
 }
 
 #[test]

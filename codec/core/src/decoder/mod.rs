@@ -107,6 +107,9 @@ impl Decoder {
             )));
         }
         let (chunk, payload) = ChunkHeader::parse(&prefix[header.byte_len()..], &[BASE_TAG])?;
+        if chunk.version != header.version {
+            return Err(version_mismatch(chunk.version, header.version));
+        }
         let base = header.levels[0];
         if chunk.vertices_after != base.vertices || chunk.faces_after != base.faces {
             return Err(Error::stream("base chunk disagrees with the level table"));
@@ -172,7 +175,7 @@ impl Decoder {
         }
         let (chunk, payload) = ChunkHeader::parse(chunk_bytes, &[BATCH_TAG, PARTED_TAG])?;
         if chunk.version != self.header.version {
-            return Err(Error::stream("chunk version differs from the stream's"));
+            return Err(version_mismatch(chunk.version, self.header.version));
         }
         let parted = chunk.tag == PARTED_TAG;
         if parted && self.header.version != CHARTED_VERSION {
@@ -355,6 +358,12 @@ impl Decoder {
                 .collect(),
         }
     }
+}
+
+fn version_mismatch(chunk: u8, stream: u8) -> Error {
+    Error::stream(format!(
+        "chunk version mismatch: a version {chunk} chunk in a version {stream} stream"
+    ))
 }
 
 fn read_pass<'a>(r: &mut Reader<'a>, kind: PassKind) -> Result<PassInput<'a>> {
