@@ -62,6 +62,10 @@ fn main() {
     let mut per = Vec::new();
     let mut runs = 7;
     let mut paths = Vec::new();
+    // `--twin`: each mesh beside a copy of itself along z, so that two
+    // charts can fall exactly on the two copies (no cut): what charts cost
+    // without a cut.
+    let mut twin = false;
     let mut args = std::env::args().skip(1);
     while let Some(a) = args.next() {
         match a.as_str() {
@@ -71,6 +75,7 @@ fn main() {
                 per.push(u32::MAX - args.next().expect("--count K").parse::<u32>().unwrap())
             }
             "--runs" => runs = args.next().expect("--runs R").parse().unwrap(),
+            "--twin" => twin = true,
             _ => paths.push(a),
         }
     }
@@ -86,6 +91,7 @@ fn main() {
         )
         .unwrap()
         .0;
+        let mesh = if twin { beside_itself(mesh) } else { mesh };
         let name = std::path::Path::new(path)
             .file_stem()
             .unwrap()
@@ -186,4 +192,28 @@ fn main() {
             );
         }
     }
+}
+
+/// The mesh and a copy of it, moved along z past its own extent.
+fn beside_itself(mut mesh: vitrine_codec::IndexedMesh) -> vitrine_codec::IndexedMesh {
+    let (lo, hi) = mesh
+        .positions
+        .iter()
+        .fold((f32::MAX, f32::MIN), |(lo, hi), p| {
+            (lo.min(p[2]), hi.max(p[2]))
+        });
+    let shift = 1.1 * (hi - lo);
+    let n = mesh.positions.len() as u32;
+    let copy: Vec<[f32; 3]> = mesh
+        .positions
+        .iter()
+        .map(|p| [p[0], p[1], p[2] + shift])
+        .collect();
+    mesh.positions.extend(copy);
+    if let Some(c) = &mut mesh.colors {
+        c.extend_from_within(..);
+    }
+    let faces: Vec<[u32; 3]> = mesh.triangles.iter().map(|t| t.map(|v| v + n)).collect();
+    mesh.triangles.extend(faces);
+    mesh
 }
