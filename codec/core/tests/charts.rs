@@ -88,9 +88,12 @@ fn charts_cost_few_bytes_over_the_plain_stream() {
     let mesh = scan_like();
     let plain = encode(&mesh, &EncodeOptions::default()).unwrap();
     assert_eq!(plain.header.version, VERSION);
-    // Charts of 12 k and 6 k vertices (real scans get 50 k: BENCHMARKS.md);
-    // measured 1.019 and 1.072 when written.
-    for (k, most) in [(2, 1.03), (4, 1.09)] {
+    // Charts of 12 k and 6 k vertices (real scans get 50 k: BENCHMARKS.md).
+    // Measured 1.019 and 1.072 with Morton runs; at 4 charts 1.092 once the
+    // charts were regrown from their centres (a torus's rings wrap around;
+    // 11 of the 12 scan-and-count pairs measured got smaller: docs/bench-log,
+    // session 17).
+    for (k, most) in [(2, 1.03), (4, 1.10)] {
         let charted = encode(&mesh, &charted(k)).unwrap();
         assert_lossless(&mesh, &charted);
         let ratio = charted.bytes.len() as f64 / plain.bytes.len() as f64;
