@@ -71,9 +71,8 @@ impl Charts {
     pub const AUTO_VERTICES: u32 = 50_000;
     /// The most charts [`Charts::Auto`] makes: every chart costs bytes (its
     /// parts restart their coders' models, its cut stays out of the fine
-    /// layers). igea
-    /// upsampled to 2.1 M vertices: +1.2 % over format 4 at 3 charts,
-    /// +1.8 % at 5, +2.0 % at 6, +2.7 % at 8 (BENCHMARKS.md, "Charts").
+    /// layers). igea upsampled to 2.1 M vertices: +1.3 % over format 4 at
+    /// 4 charts, +1.4 % at 5, +2.0 % at 8 (BENCHMARKS.md, "Charts").
     pub const AUTO_MAX: usize = 5;
 
     /// How many charts a mesh of `vertices` vertices gets (below 2: none).
