@@ -10,6 +10,7 @@
 const POSITIONS = 0;
 const COLOURS = 1;
 const INDICES = 2;
+const LEVEL_IDS = 3;
 
 /**
  * @typedef {object} Level
@@ -18,6 +19,17 @@ const INDICES = 2;
  * @property {Float32Array} positions  x, y, z per vertex
  * @property {Uint8Array | null} colours  r, g, b per vertex
  * @property {Uint32Array} indices   three per triangle
+ */
+
+/**
+ * One chart of a charted level (format 5), in the chart's own vertex ids.
+ * @typedef {object} ChartView
+ * @property {Float32Array} positions x, y, z per chart vertex
+ * @property {Uint8Array | null} colours r, g, b per chart vertex
+ * @property {Uint32Array} indices the chart's triangles
+ * @property {Uint32Array} levelIds the level's id of each of the chart's first vertices:
+ *   all of them while the decoder merges its charts; once it refines only some, those
+ *   it had then, and the vertices after them are the ones its parts inserted since
  */
 
 export class DecodeError extends Error {}
@@ -178,6 +190,50 @@ export class StreamDecoder {
     };
   }
 
+  /**
+   * Refine only these charts of a charted stream from the next parted
+   * batch on, leaving the others to the pool's other members
+   * (decode-pool.js); final once made.
+   * @param {number[]} charts
+   */
+  refineOnly(charts) {
+    let lo = 0;
+    let hi = 0;
+    for (const c of charts) {
+      if (c < 32) lo |= 1 << c;
+      else hi |= 1 << (c - 32);
+    }
+    if (this.codec.exports.decoder_refine_only(this.handle, lo, hi) !== 0) throw this.codec.lastError();
+  }
+
+  /** Charts of the stream once its first parted batch is in (0 before, and for a plain stream). */
+  chartCount() {
+    return this.codec.exports.decoder_charts(this.handle);
+  }
+
+  /**
+   * Chart `chart` as views into the decoder's memory (read or copy them
+   * before the next call into the decoder).
+   * @param {number} chart
+   * @returns {ChartView}
+   */
+  chartView(chart) {
+    const e = this.codec.exports;
+    const buffer = e.memory.buffer;
+    /** @param {number} kind */
+    const span = (kind) => ({ ptr: e.chart_buffer_ptr(this.handle, chart, kind), len: e.chart_buffer_len(this.handle, chart, kind) });
+    const p = span(POSITIONS);
+    const c = span(COLOURS);
+    const i = span(INDICES);
+    const g = span(LEVEL_IDS);
+    return {
+      positions: new Float32Array(buffer, p.ptr, p.len),
+      colours: c.ptr === 0 ? null : new Uint8Array(buffer, c.ptr, c.len),
+      indices: new Uint32Array(buffer, i.ptr, i.len),
+      levelIds: new Uint32Array(buffer, g.ptr, g.len),
+    };
+  }
+
   free() {
     this.codec.exports.decoder_free(this.handle);
   }
@@ -251,3 +307,6 @@ export function splitStream(stream) {
   }
   return { base: parts[0], batches: parts.slice(1) };
 }
+
+/** The chunk tag of a parted batch (a charted stream's fine levels). */
+export const PARTED_TAG = 0x50;

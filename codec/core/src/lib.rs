@@ -35,7 +35,7 @@ mod quantize;
 mod training;
 
 pub use charts::MAX_CHARTS;
-pub use decoder::{decode, Decoder, Limits};
+pub use decoder::{decode, ChartLevel, Decoder, Limits};
 pub use encoder::{
     encode, BaseTarget, CandidatePatch, Charts, EncodeOptions, EncodeProgress, Encoded, Encoder,
     PatchGuard,

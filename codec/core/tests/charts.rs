@@ -189,3 +189,131 @@ fn hostile_parted_batches_are_refused_without_panic() {
         assert!(fresh(first_parted + 1).apply_batch(&bytes[skip]).is_err());
     }
 }
+
+/// Merges pool members' charts as `web/src/decode-pool.js` does: each
+/// chart's new vertices appended in chart order (positions and colours),
+/// then every chart's triangles mapped to level ids.
+struct PoolMerge {
+    positions: Vec<f32>,
+    colours: Option<Vec<u8>>,
+    /// Level id of each chart vertex known so far.
+    ids: Vec<Vec<u32>>,
+    indices: Vec<u32>,
+}
+
+impl PoolMerge {
+    fn new(cut: &Decoder) -> PoolMerge {
+        PoolMerge {
+            positions: cut.positions().to_vec(),
+            colours: cut.colours().map(<[u8]>::to_vec),
+            ids: vec![Vec::new(); cut.chart_count()],
+            indices: Vec::new(),
+        }
+    }
+
+    fn add(&mut self, owner: &[&Decoder]) {
+        for (c, member) in owner.iter().enumerate() {
+            let chart = member.chart(c).expect("the chart exists");
+            let ids = &mut self.ids[c];
+            if ids.is_empty() {
+                ids.extend_from_slice(chart.level_ids);
+            }
+            for v in ids.len()..chart.positions.len() / 3 {
+                ids.push((self.positions.len() / 3) as u32);
+                self.positions
+                    .extend_from_slice(&chart.positions[3 * v..3 * v + 3]);
+                if let (Some(out), Some(colours)) = (&mut self.colours, chart.colours) {
+                    out.extend_from_slice(&colours[3 * v..3 * v + 3]);
+                }
+            }
+        }
+        self.indices.clear();
+        for (c, member) in owner.iter().enumerate() {
+            let chart = member.chart(c).unwrap();
+            self.indices
+                .extend(chart.indices.iter().map(|&v| self.ids[c][v as usize]));
+        }
+    }
+}
+
+#[test]
+fn pool_members_that_refine_some_charts_each_merge_into_the_same_levels() {
+    let mesh = scan_like();
+    let encoded = encode(&mesh, &charted(5)).unwrap();
+    let bytes = &encoded.bytes;
+    let index = StreamIndex::parse(bytes).unwrap();
+    // Members choose their charts before the cut, or (as the browser's pool
+    // does, to share them by size) once every member has applied the whole
+    // first parted batch.
+    for (members, after_first) in [
+        (1usize, false),
+        (2, false),
+        (3, false),
+        (5, false),
+        (2, true),
+        (4, true),
+    ] {
+        let base = &bytes[index.base.clone()];
+        let mut pool: Vec<Decoder> = (0..members)
+            .map(|_| Decoder::new(base, Limits::default()).unwrap())
+            .collect();
+        // Chart c to member c mod W; bits past the chart count are ignored.
+        let mask = |m: usize| {
+            (0..64)
+                .filter(|c| c % members == m)
+                .fold(0u64, |a, c| a | 1 << c)
+        };
+        if !after_first {
+            for (m, d) in pool.iter_mut().enumerate() {
+                d.refine_only(mask(m)).unwrap();
+            }
+        }
+        let mut full = Decoder::new(base, Limits::default()).unwrap();
+        let mut merge: Option<PoolMerge> = None;
+        let mut parted = 0;
+        for range in &index.batches {
+            let batch = &bytes[range.clone()];
+            full.apply_batch(batch).unwrap();
+            for d in &mut pool {
+                d.apply_batch(batch).unwrap();
+            }
+            if pool[0].chart_count() == 0 {
+                assert_eq!(pool[0].positions(), full.positions());
+                continue;
+            }
+            parted += 1;
+            if after_first && parted == 1 {
+                // Every member holds the merged level: share the charts now.
+                assert_eq!(pool[1].indices(), full.indices());
+                for (m, d) in pool.iter_mut().enumerate() {
+                    d.refine_only(mask(m)).unwrap();
+                }
+                continue;
+            }
+            if members == 1 {
+                // One member refines every chart and holds the merged level.
+                assert_eq!(pool[0].positions(), full.positions());
+                assert_eq!(pool[0].indices(), full.indices());
+                continue;
+            }
+            assert!(
+                pool[0].refine_only(u64::MAX).is_err(),
+                "the choice is final"
+            );
+            let owner: Vec<&Decoder> = (0..pool[0].chart_count())
+                .map(|c| &pool[c % members])
+                .collect();
+            // A member that leaves charts to others keeps its level as it
+            // was when it stopped merging: the merge starts from there.
+            let m = merge.get_or_insert_with(|| PoolMerge::new(&pool[0]));
+            m.add(&owner);
+            let what = format!("{members} members, after the first: {after_first}");
+            assert_eq!(m.positions, full.positions(), "{what}");
+            assert_eq!(m.colours.as_deref(), full.colours(), "{what}");
+            assert_eq!(m.indices, full.indices(), "{what}");
+            assert!(pool[0].vertex_count() < full.vertex_count());
+        }
+        assert!(parted >= 3, "{parted} parted batches");
+        assert!(full.is_complete());
+    }
+}

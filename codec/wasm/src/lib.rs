@@ -12,6 +12,12 @@
 //!    before the next call, which may move memory.
 //! 4. On error `error_ptr()` / `error_len()` give a UTF-8 message.
 //!
+//! A charted stream (format 5) can be decoded by a pool of workers, each
+//! with its own instance: `decoder_refine_only(handle, lo, hi)` before the
+//! next parted batch makes a decoder refine only the charts in the 64-bit
+//! mask; `decoder_charts`, `chart_buffer_ptr` and `chart_buffer_len` read
+//! one chart (`web/src/decode-pool.js` merges them).
+//!
 //! [`geodesic`] adds distance along the surface of a decoded level, for
 //! the viewer's measurement tool; [`points`] decodes point streams and
 //! preprocesses splats.
@@ -36,6 +42,8 @@ thread_local! {
 pub const POSITIONS: u32 = 0;
 pub const COLOURS: u32 = 1;
 pub const INDICES: u32 = 2;
+/// A chart's level ids (u32, `ChartLevel::level_ids`), for [`chart_buffer_ptr`] only.
+pub const LEVEL_IDS: u32 = 3;
 
 fn fail(message: String) -> i32 {
     ERROR.with(|e| *e.borrow_mut() = message);
@@ -134,6 +142,54 @@ pub extern "C" fn buffer_ptr(handle: u32, kind: u32) -> u32 {
 #[no_mangle]
 pub extern "C" fn buffer_len(handle: u32, kind: u32) -> u32 {
     with_decoder(handle, |d| buffer(d, kind).1 as u32).unwrap_or(0)
+}
+
+/// Refine only the charts in the mask `hi << 32 | lo` from the next
+/// parted batch on (see `Decoder::refine_only`). 0, or −1 when the decoder
+/// refines only some charts already.
+#[allow(unsafe_code)]
+#[no_mangle]
+pub extern "C" fn decoder_refine_only(handle: u32, lo: u32, hi: u32) -> i32 {
+    match with_decoder(handle, |d| {
+        d.refine_only(u64::from(hi) << 32 | u64::from(lo))
+    }) {
+        Some(Ok(())) => 0,
+        Some(Err(e)) => fail(e.to_string()),
+        None => fail(format!("no decoder with handle {handle}")),
+    }
+}
+
+/// Charts of the stream once its first parted batch is applied (else 0).
+#[allow(unsafe_code)]
+#[no_mangle]
+pub extern "C" fn decoder_charts(handle: u32) -> u32 {
+    with_decoder(handle, |d| d.chart_count() as u32).unwrap_or(0)
+}
+
+fn chart_buffer(d: &Decoder, chart: u32, kind: u32) -> (usize, usize) {
+    let Some(c) = d.chart(chart as usize) else {
+        return (0, 0);
+    };
+    match kind {
+        POSITIONS => (c.positions.as_ptr() as usize, c.positions.len()),
+        COLOURS => c.colours.map_or((0, 0), |c| (c.as_ptr() as usize, c.len())),
+        INDICES => (c.indices.as_ptr() as usize, c.indices.len()),
+        _ => (c.level_ids.as_ptr() as usize, c.level_ids.len()),
+    }
+}
+
+/// Address of one chart's buffer (kinds as above, and [`LEVEL_IDS`]); 0 when absent.
+#[allow(unsafe_code)]
+#[no_mangle]
+pub extern "C" fn chart_buffer_ptr(handle: u32, chart: u32, kind: u32) -> u32 {
+    with_decoder(handle, |d| chart_buffer(d, chart, kind).0 as u32).unwrap_or(0)
+}
+
+/// Length of one chart's buffer in elements.
+#[allow(unsafe_code)]
+#[no_mangle]
+pub extern "C" fn chart_buffer_len(handle: u32, chart: u32, kind: u32) -> u32 {
+    with_decoder(handle, |d| chart_buffer(d, chart, kind).1 as u32).unwrap_or(0)
 }
 
 #[allow(unsafe_code)]

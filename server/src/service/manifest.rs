@@ -20,6 +20,10 @@ pub struct Manifest<'a> {
     /// (`codec/points/FORMAT.md`, VPTS), concatenated in order to decode.
     kind: ModelKind,
     compression_id: i64,
+    /// The stream's format version (`codec/core/FORMAT.md`): for a mesh 4
+    /// (plain) or 5 (charted: a viewer may refine its charts on several
+    /// workers at once); for a point cloud its VPTS version.
+    stream_format: u8,
     /// Position bits per axis (for a point cloud, the octree's depth).
     quantization_bits: u8,
     has_colour: bool,
@@ -219,6 +223,7 @@ pub fn build<'a>(
         description: &record.description,
         kind: record.kind,
         compression_id: record.compression_id,
+        stream_format: record.stream_format,
         quantization_bits: record.quantization_bits,
         has_colour: record.has_colour,
         last_level: record.batch_count(),

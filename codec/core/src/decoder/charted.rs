@@ -19,8 +19,26 @@ pub(super) struct Charted {
 struct Chart {
     level: Level,
     scratch: Scratch,
-    /// The merged level's id of each chart vertex.
+    /// The merged level's id of each chart vertex (of those merged: a
+    /// decoder that refines only some charts stops merging).
     global: Vec<u32>,
+}
+
+/// One chart of a charted level, in the chart's own vertex ids (see
+/// [`crate::Decoder::chart`]).
+#[derive(Clone, Copy, Debug)]
+pub struct ChartLevel<'a> {
+    /// `x, y, z` per chart vertex, in model units.
+    pub positions: &'a [f32],
+    /// `r, g, b` per chart vertex, when the stream has colour.
+    pub colours: Option<&'a [u8]>,
+    /// The chart's triangles, three chart vertex ids each.
+    pub indices: &'a [u32],
+    /// The level's id of each of the chart's first vertices: all of them
+    /// while the decoder merges its charts into its level; once it refines
+    /// only some charts, those it had when it stopped merging, and the
+    /// vertices after them are the ones its parts inserted since, in order.
+    pub level_ids: &'a [u32],
 }
 
 /// One chart's part of a parted batch: its cleaning and decimating passes
@@ -74,6 +92,16 @@ impl Charted {
 
     pub(super) fn chart_count(&self) -> usize {
         self.charts.len()
+    }
+
+    pub(super) fn chart(&self, chart: usize) -> Option<ChartLevel<'_>> {
+        let c = self.charts.get(chart)?;
+        Some(ChartLevel {
+            positions: c.level.positions.as_flattened(),
+            colours: c.level.colours.as_ref().map(|c| c.as_flattened()),
+            indices: &c.level.conn.origin,
+            level_ids: &c.global,
+        })
     }
 
     /// Applies every chart's part, on up to `threads` threads; the first

@@ -12,6 +12,7 @@ use crate::gates::{GateStatistics, PassKind};
 use crate::halfedge::Connectivity;
 use crate::quantize::Quantization;
 use crate::{Error, IndexedMesh, Result};
+pub use charted::ChartLevel;
 use charted::{read_part, Charted};
 use conquest::{PassInput, Scratch};
 
@@ -86,6 +87,8 @@ pub struct Decoder {
     /// A charted stream's charts, once its first parted batch cut them.
     charted: Option<Charted>,
     threads: usize,
+    /// The charts this decoder refines, bit c for chart c (all by default).
+    refined: u64,
 }
 
 impl Decoder {
@@ -141,6 +144,7 @@ impl Decoder {
             broken: false,
             charted: None,
             threads: 1,
+            refined: u64::MAX,
         })
     }
 
@@ -195,8 +199,8 @@ impl Decoder {
             )));
         }
         let info = self.header.levels[expected];
-        let n = self.level.vertex_count() as u32;
-        if chunk.vertices_before != n
+        let (n, faces_now) = self.level_counts();
+        if chunk.vertices_before as usize != n
             || chunk.vertices_after != info.vertices
             || chunk.faces_after != info.faces
         {
@@ -208,7 +212,7 @@ impl Decoder {
             ));
         }
         if parted {
-            return self.apply_parted(payload, info, expected);
+            return self.apply_parted(payload, info, (n, faces_now), expected);
         }
         let mut r = Reader::new(payload);
         let cleaning = read_pass(&mut r, PassKind::Cleaning)?;
@@ -217,13 +221,13 @@ impl Decoder {
             return Err(Error::stream("trailing bytes after the batch's passes"));
         }
         let added = cleaning.inserted as u64 + decimating.inserted as u64;
-        if added != (info.vertices - n) as u64 {
+        if added != (info.vertices as usize - n) as u64 {
             return Err(Error::stream(
                 "passes insert a different number of vertices than the batch",
             ));
         }
         // Each inserted vertex adds exactly two faces (AD01 patches are discs).
-        if info.faces as u64 != self.face_count() as u64 + 2 * added {
+        if info.faces as u64 != faces_now as u64 + 2 * added {
             return Err(Error::stream(
                 "level table's face count disagrees with the batch",
             ));
@@ -252,9 +256,34 @@ impl Decoder {
         Ok(())
     }
 
+    /// Vertices and faces of the level applied last: the level table's once
+    /// this decoder refines only some charts (it no longer holds the level).
+    fn level_counts(&self) -> (usize, usize) {
+        if self.refines_some() {
+            let info = self.header.levels[self.applied];
+            (info.vertices as usize, info.faces as usize)
+        } else {
+            (self.level.vertex_count(), self.face_count())
+        }
+    }
+
+    /// The charts are cut and this decoder leaves some of them to others.
+    fn refines_some(&self) -> bool {
+        self.charted
+            .as_ref()
+            .is_some_and(|c| (0..c.chart_count()).any(|k| self.refined & (1 << k) == 0))
+    }
+
     /// A parted batch (format 5): every chart's part, the charts cut first
-    /// when this is the first such batch; its counts are checked already.
-    fn apply_parted(&mut self, payload: &[u8], info: LevelInfo, expected: usize) -> Result<()> {
+    /// when this is the first such batch; its counts are checked already
+    /// (`now`: the vertices and faces before it).
+    fn apply_parted(
+        &mut self,
+        payload: &[u8],
+        info: LevelInfo,
+        now: (usize, usize),
+        expected: usize,
+    ) -> Result<()> {
         let mut r = Reader::new(payload);
         let charts = r.varint()? as usize;
         if !(2..=MAX_CHARTS).contains(&charts) {
@@ -279,12 +308,12 @@ impl Decoder {
             .flatten()
             .map(|(c, d, _)| c.inserted as u64 + d.inserted as u64)
             .sum();
-        if added != (info.vertices as usize - self.level.vertex_count()) as u64 {
+        if added != (info.vertices as usize - now.0) as u64 {
             return Err(Error::stream(
                 "parts insert a different number of vertices than the batch",
             ));
         }
-        if info.faces as u64 != self.face_count() as u64 + 2 * added {
+        if info.faces as u64 != now.1 as u64 + 2 * added {
             return Err(Error::stream(
                 "level table's face count disagrees with the batch",
             ));
@@ -298,14 +327,56 @@ impl Decoder {
                 out: Vec::new(),
             };
         }
+        let some = self.refines_some();
+        if some {
+            for (k, part) in parts.iter_mut().enumerate() {
+                if self.refined & (1 << k) == 0 {
+                    *part = None;
+                }
+            }
+        }
         let charted = self.charted.as_mut().expect("cut above");
         if let Err(e) = charted.apply(parts, self.threads) {
             self.broken = true;
             return Err(e);
         }
-        charted.merge(&mut self.level);
+        if !some {
+            charted.merge(&mut self.level);
+        }
         self.applied = expected;
         Ok(())
+    }
+
+    /// Makes this decoder one member of a pool that decodes a charted
+    /// stream (format 5) together: from the next parted batch on it refines
+    /// only the charts in `charts` (bit c for chart c), checking every
+    /// part's counts but decoding only its own. Its level then stays as it
+    /// is ([`Decoder::positions`], [`Decoder::indices`] and the counts stop
+    /// changing); read its charts with [`Decoder::chart`] and merge them
+    /// with the other members' as the full decoder does: each chart's new
+    /// vertices appended in chart order, then every chart's triangles
+    /// (`web/src/decode-pool.js`). Once it refines only some charts, the
+    /// choice is final.
+    pub fn refine_only(&mut self, charts: u64) -> Result<()> {
+        if self.refines_some() {
+            return Err(Error::stream(
+                "this decoder refines some charts already: the choice is final",
+            ));
+        }
+        self.refined = charts;
+        Ok(())
+    }
+
+    /// Charts of a charted stream once its first parted batch is applied;
+    /// 0 before, and for a plain stream.
+    pub fn chart_count(&self) -> usize {
+        self.charted.as_ref().map_or(0, Charted::chart_count)
+    }
+
+    /// Chart `chart` as this decoder holds it (refined by this decoder's
+    /// parts, or where the cut left it when another member refines it).
+    pub fn chart(&self, chart: usize) -> Option<ChartLevel<'_>> {
+        self.charted.as_ref()?.chart(chart)
     }
 
     /// Decodes each parted batch's charts on up to `threads` threads (format

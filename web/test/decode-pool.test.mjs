@@ -1,0 +1,114 @@
+// @ts-check
+// The decode pool (src/decode-pool.js): a charted stream decoded by 2–4
+// members gives every level byte for byte as the native decoder does (the
+// fixture's hashes); charts are shared out fairly; damage in a helper's
+// chart or in the batch is an error, never a wrong level. The helpers run
+// in-process here (the Node bench and the browser test run them on threads).
+import assert from 'node:assert/strict';
+import { readFileSync } from 'node:fs';
+import test from 'node:test';
+import { ChartHelper } from '../src/chart-helper.js';
+import { DecodeError, PARTED_TAG, VitrineCodec, splitStream } from '../src/codec.js';
+import { PooledDecoder, shareCharts } from '../src/decode-pool.js';
+import { fixture, sha256, wasmPath } from './support/fixtures.mjs';
+
+const wasm = readFileSync(wasmPath);
+const charted = fixture('charted-torus');
+
+/**
+ * `n` helpers, each with its own instance of the codec, answering on a
+ * later task as a worker would; a reply is cloned, as postMessage does.
+ * @param {number} n
+ * @returns {Promise<import('../src/decode-pool.js').HelperPort[]>}
+ */
+async function helpers(n) {
+  const ports = [];
+  for (let i = 0; i < n; i++) {
+    const helper = new ChartHelper(await VitrineCodec.instantiate(wasm));
+    /** @type {import('../src/decode-pool.js').HelperPort} */
+    const port = {
+      onmessage: null,
+      postMessage(command) {
+        const copy = structuredClone(command);
+        setImmediate(() => {
+          const { reply } = helper.handle(copy);
+          port.onmessage?.({ data: structuredClone(reply) });
+        });
+      },
+    };
+    ports.push(port);
+  }
+  return ports;
+}
+
+/** @param {import('../src/codec.js').Level} level */
+function digest(level) {
+  return {
+    vertices: level.vertices,
+    positions: sha256(level.positions),
+    indices: sha256(level.indices),
+    colours: level.colours && sha256(level.colours),
+  };
+}
+
+test('a charted stream decoded by a pool of 2, 3 or 4 gives the native levels', async () => {
+  const { base, batches } = splitStream(charted.stream);
+  assert.ok(batches.some((b) => b[0] === PARTED_TAG), 'the fixture has parted batches');
+  for (const members of [2, 3, 4]) {
+    const codec = await VitrineCodec.instantiate(wasm);
+    const pool = new PooledDecoder(codec, base, await helpers(members - 1));
+    assert.equal(pool.members, members);
+    for (const [k, batch] of batches.entries()) {
+      await pool.apply(batch);
+      const want = charted.levels[k + 1];
+      assert.deepEqual(
+        digest(pool.view()),
+        { vertices: want.vertices, positions: want.positions, indices: want.indices, colours: want.colours },
+        `${members} members, level ${k + 1}`,
+      );
+    }
+    const shares = /** @type {number[][]} */ (pool.shares);
+    assert.deepEqual(shares.flat().sort((a, b) => a - b), [0, 1, 2, 3], 'every chart goes to one member');
+    assert.ok(shares.every((s) => s.length > 0), `${members} members all have charts: ${JSON.stringify(shares)}`);
+    // A copy is not a view: it stays as it is after the pool is freed.
+    const last = pool.level();
+    pool.free();
+    assert.equal(sha256(last.indices), charted.levels[batches.length].indices);
+  }
+});
+
+test('charts are shared out largest first, each to the least loaded member', () => {
+  // 10 and 9 open the two shares; the ones go to whichever is lighter (the first on a tie).
+  const shares = shareCharts([10, 1, 1, 1, 9], 2);
+  assert.deepEqual(shares, [[0, 2], [1, 3, 4]]);
+  // Five equal charts on four members: one member gets two, the first.
+  assert.deepEqual(shareCharts([5, 5, 5, 5, 5], 4), [[0, 4], [1], [2], [3]]);
+  // More members than charts: the last go without.
+  assert.deepEqual(shareCharts([3, 7], 3), [[1], [0], []]);
+});
+
+test('damage in a chart a helper refines fails the batch with a decode error', async () => {
+  const { base, batches } = splitStream(charted.stream);
+  // The second parted batch: the first is applied whole by every member.
+  const k = batches.findIndex((b, i) => b[0] === PARTED_TAG && batches[i - 1][0] === PARTED_TAG);
+  let refused = 0;
+  // Flip bytes across the whole first parted batch: each one is an error
+  // (from this member, a helper, or the merge) or, where the coder happens
+  // to read a valid level, a level of the right counts; never a hang.
+  const batch = batches[k];
+  for (let at = 12; at < batch.length; at += Math.ceil(batch.length / 23)) {
+    const pool = new PooledDecoder(await VitrineCodec.instantiate(wasm), base, await helpers(2));
+    for (const b of batches.slice(0, k)) await pool.apply(b);
+    const bad = batch.slice();
+    bad[at] ^= 0x5a;
+    try {
+      await pool.apply(bad);
+      assert.equal(pool.view().vertices, charted.levels[k + 1].vertices);
+    } catch (error) {
+      assert.ok(error instanceof DecodeError, `byte ${at}: ${error}`);
+      refused++;
+    }
+    pool.free();
+  }
+  assert.ok(refused > 0, 'some damage is refused');
+});
