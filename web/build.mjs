@@ -1,10 +1,11 @@
 // Builds web/dist from web/src and the WebAssembly decoder:
 //   node build.mjs            (expects the wasm to be built, see README)
 //   VITRINE_WASM=path node build.mjs
-// esbuild bundles five entries: app.js (the pages), vitrine.js (the
-// <vitrine-viewer> element for other sites), worker.js (the decoder) and
-// render-worker.js (WebGL on an OffscreenCanvas), splat-worker.js (point
-// streams and splat preprocessing) — classic workers, so
+// esbuild bundles six entries: app.js (the pages), vitrine.js (the
+// <vitrine-viewer> element for other sites), worker.js (the decoder),
+// chart-worker.js (its helpers for a charted stream), render-worker.js
+// (WebGL on an OffscreenCanvas), splat-worker.js (point streams and splat
+// preprocessing) — the last four classic workers, so
 // another origin can start them from blob URLs.
 import { build } from 'esbuild';
 import { copyFileSync, existsSync, mkdirSync, rmSync, statSync } from 'node:fs';
@@ -29,13 +30,18 @@ const common = { bundle: true, minify: true, sourcemap: true, target: ['chrome11
 await build({ ...common, entryPoints: { app: join(src, 'app.js'), vitrine: join(src, 'element.js') }, format: 'esm', outdir: dist });
 await build({
   ...common,
-  entryPoints: { worker: join(src, 'worker.js'), 'render-worker': join(src, 'render-worker.js'), 'splat-worker': join(src, 'splats', 'splat-worker.js') },
+  entryPoints: {
+    worker: join(src, 'worker.js'),
+    'chart-worker': join(src, 'chart-worker.js'),
+    'render-worker': join(src, 'render-worker.js'),
+    'splat-worker': join(src, 'splats', 'splat-worker.js'),
+  },
   format: 'iife',
   outdir: dist,
 });
 for (const file of ['index.html', 'style.css']) copyFileSync(join(src, file), join(dist, file));
 copyFileSync(wasm, join(dist, 'vitrine_wasm.wasm'));
 
-for (const file of ['app.js', 'vitrine.js', 'worker.js', 'render-worker.js', 'splat-worker.js', 'vitrine_wasm.wasm']) {
+for (const file of ['app.js', 'vitrine.js', 'worker.js', 'chart-worker.js', 'render-worker.js', 'splat-worker.js', 'vitrine_wasm.wasm']) {
   console.log(`dist/${file.padEnd(18)} ${(statSync(join(dist, file)).size / 1024).toFixed(1)} KB`);
 }

@@ -1,17 +1,21 @@
 // @ts-check
-// Mesh decode speed in Node, one core, against Google's draco3d: every level
-// of a plain stream (format 4) and of a charted one (format 5, its charts
-// decoded in turn, as a viewer without workers does), by the viewer's .wasm,
-// and the same mesh as a single-rate Draco mesh (Edgebreaker, positions
-// only, 12 bits) decoded by draco3d's WebAssembly decoder, positions and
-// indices read out. Median of --runs, one process. The files come from
-// scripts/bench-charts.sh (STEM.vtr, STEM.v5.vtr, STEM.drc):
-//   node bench/mesh-decode.mjs --draco3d /tmp/draco3d/node_modules/draco3d DIR/igea …
+// Mesh decode speed in Node against Google's draco3d: every level of a
+// plain stream (format 4) and of a charted one (format 5) by the viewer's
+// .wasm — its charts decoded in turn as a viewer without workers does, and
+// by the viewer's decode pool (src/decode-pool.js) of 2 and 4 workers, the
+// helpers on worker threads — and the same mesh as a single-rate Draco mesh
+// (Edgebreaker, positions only, 12 bits) decoded by draco3d's WebAssembly
+// decoder on one thread, positions and indices read out. Median of --runs,
+// one process. The files come from scripts/bench-charts.sh (STEM.vtr,
+// STEM.v5.vtr, STEM.drc):
+//   node bench/mesh-decode.mjs --draco3d /tmp/draco3d/node_modules/draco3d [--workers 2,4] DIR/igea …
 import { existsSync, readFileSync } from 'node:fs';
 import { createRequire } from 'node:module';
 import { basename, join } from 'node:path';
 import { parseArgs } from 'node:util';
+import { Worker } from 'node:worker_threads';
 import { VitrineCodec, splitStream } from '../src/codec.js';
+import { PooledDecoder } from '../src/decode-pool.js';
 import { wasmPath } from '../test/support/fixtures.mjs';
 
 const { values, positionals } = parseArgs({
@@ -19,6 +23,7 @@ const { values, positionals } = parseArgs({
   options: {
     draco3d: { type: 'string' },
     runs: { type: 'string', default: '5' },
+    workers: { type: 'string', default: '2,4' },
   },
 });
 if (!values.draco3d || positionals.length === 0) {
@@ -30,6 +35,55 @@ const require = createRequire(import.meta.url);
 const draco3d = require(join(values.draco3d, 'draco3d.js'));
 const dracoModule = await draco3d.createDecoderModule({});
 const codec = await VitrineCodec.instantiate(readFileSync(wasmPath));
+const pools = values.workers
+  .split(',')
+  .filter(Boolean)
+  .map(Number)
+  .filter((n) => n >= 2);
+/** Helper threads, started once: the most any pool needs. */
+const threads = Array.from(
+  { length: Math.max(1, ...pools) - 1 },
+  () => new Worker(new URL('./chart-worker-node.mjs', import.meta.url), { workerData: { wasm: wasmPath } }),
+);
+/** @type {import('../src/decode-pool.js').HelperPort[]} */
+const ports = threads.map((thread) => {
+  /** @type {import('../src/decode-pool.js').HelperPort} */
+  const port = {
+    onmessage: null,
+    postMessage: (message, transfer) => thread.postMessage(message, /** @type {any} */ (transfer)),
+  };
+  thread.on('message', (data) => port.onmessage?.(new MessageEvent('message', { data })));
+  return port;
+});
+
+/** @param {() => Promise<number>} f @returns {Promise<{ ms: number, n: number }>} */
+async function medianAsync(f) {
+  await f();
+  let n = 0;
+  const times = [];
+  for (let r = 0; r < runs; r++) {
+    const t0 = performance.now();
+    n = await f();
+    times.push(performance.now() - t0);
+  }
+  times.sort((a, b) => a - b);
+  return { ms: times[times.length >> 1], n };
+}
+
+/**
+ * Every level of a charted stream by a pool of `members` (this thread and
+ * helper threads); the final vertex count.
+ * @param {Uint8Array} bytes
+ * @param {number} members
+ */
+async function decodePooled(bytes, members) {
+  const { base, batches } = splitStream(bytes);
+  const pool = new PooledDecoder(codec, base, ports.slice(0, members - 1));
+  for (const batch of batches) await pool.apply(batch);
+  const n = pool.view().vertices;
+  pool.free();
+  return n;
+}
 
 /** @param {() => number} f @returns {{ ms: number, n: number }} */
 function median(f) {
@@ -84,16 +138,28 @@ function decodeDraco(bytes) {
   return n;
 }
 
-console.log('| mesh | vertices | format 4, wasm | format 5, wasm, 1 worker | draco3d | format 4 / draco3d | format 5 (1 worker) / format 4 |');
-console.log('|---|---:|---:|---:|---:|---:|---:|');
+const poolHeads = pools.map((w) => `format 5, ${w} workers`);
+console.log(
+  `| mesh | vertices | format 4, wasm | format 5, wasm, 1 worker | ${poolHeads.join(' | ')} | draco3d | format 4 / draco3d | ${pools.map((w) => `${w} workers / draco3d`).join(' | ')} | format 4 / format 5 (1 worker) | ${pools.map((w) => `format 4 / ${w} workers`).join(' | ')} |`,
+);
+console.log(`|---|---:|---:|---:|${pools.map(() => '---:|').join('')}---:|---:|${pools.map(() => '---:|').join('')}---:|${pools.map(() => '---:|').join('')}`);
 for (const stem of positionals) {
   const [vtr, drc] = [readFileSync(`${stem}.vtr`), readFileSync(`${stem}.drc`)];
   const v5 = existsSync(`${stem}.v5.vtr`) ? readFileSync(`${stem}.v5.vtr`) : null;
   const plain = median(() => decodeVtr(vtr));
   const charted = v5 ? median(() => decodeVtr(v5)) : null;
+  /** @type {Array<{ ms: number, n: number } | null>} */
+  const pooled = [];
+  for (const w of pools) {
+    const result = v5 ? await medianAsync(() => decodePooled(v5, w)) : null;
+    if (result && charted && result.n !== charted.n) throw new Error(`${w} workers decoded ${result.n} vertices, one ${charted.n}`);
+    pooled.push(result);
+  }
   const draco = median(() => decodeDraco(drc));
   const ms = (/** @type {number} */ x) => `${x.toFixed(1)} ms`;
+  const cells = (/** @type {(r: { ms: number }) => string} */ f) => pooled.map((r) => (r ? f(r) : '–')).join(' | ');
   console.log(
-    `| ${basename(stem)} | ${plain.n} | ${ms(plain.ms)} | ${charted ? ms(charted.ms) : '–'} | ${ms(draco.ms)} | ${(plain.ms / draco.ms).toFixed(2)} | ${charted ? (charted.ms / plain.ms).toFixed(2) : '–'} |`,
+    `| ${basename(stem)} | ${plain.n} | ${ms(plain.ms)} | ${charted ? ms(charted.ms) : '–'} | ${cells((r) => ms(r.ms))} | ${ms(draco.ms)} | ${(plain.ms / draco.ms).toFixed(2)} | ${cells((r) => (r.ms / draco.ms).toFixed(2))} | ${charted ? (plain.ms / charted.ms).toFixed(2) : '–'} | ${cells((r) => (plain.ms / r.ms).toFixed(2))} |`,
   );
 }
+for (const thread of threads) await thread.terminate();

@@ -40,6 +40,15 @@ before(async () => {
         colour: true,
         policy: 'open',
       },
+      {
+        slug: 'charted',
+        title: 'Charted torus',
+        kind: 'torus',
+        kiloVertices: 30,
+        colour: true,
+        policy: 'open',
+        ingestArgs: ['--charts', '4'],
+      },
     ],
     serveArgs: ['--phone-max-vertices', String(PHONE_MAX_VERTICES)],
   });
@@ -226,6 +235,38 @@ test('refines to level n of n; the image matches a direct load and a CPU referen
   assert.deepEqual(problems, []);
   await page.close();
   await direct.page.close();
+});
+
+test('a charted stream is refined by the decode worker and a helper; the picture is one decoder\'s', async () => {
+  const charted = await (await fetch(`${service.url}/api/models/charted`)).json();
+  assert.equal(charted.stream_format, 5);
+  const n = charted.last_level;
+  /** @type {Record<number, { width: number, height: number, rgba: Uint8Array }>} */
+  const images = {};
+  for (const decoders of [1, 2, 4]) {
+    const { page, problems } = await open(`/embed/charted?decoders=${decoders}`);
+    /** @type {string[]} */
+    const helpers = [];
+    page.on('request', (r) => r.url().endsWith('/chart-worker.js') && helpers.push(r.url()));
+    const s = await until(page, `s.status === 'complete'`);
+    assert.equal(s.shownLevel, n);
+    assert.equal(s.vertices, charted.levels[n].vertices);
+    assert.equal(s.decoders, decoders, `${decoders} workers decode`);
+    // The helper script is fetched once (the browser's cache serves the others).
+    assert.equal(helpers.length > 0, decoders > 1, `helpers started: ${helpers.length}`);
+    assert.deepEqual(problems, []);
+    images[decoders] = await capture(page);
+    await page.close();
+  }
+  for (const decoders of [2, 4]) {
+    const same = compareImages(images[1].rgba, images[decoders].rgba);
+    assert.ok(same.iou > 0.999 && same.meanDiff < 0.5, `${decoders} workers against one: ${JSON.stringify(same)}`);
+  }
+  // A plain stream never starts helpers.
+  const plain = await open('/embed/torus?decoders=4');
+  const s = await until(plain.page, `s.status === 'complete'`);
+  assert.equal(s.decoders, 1);
+  await plain.page.close();
 });
 
 test('a phone stops at its cap, says so, and fetches nothing above it', async () => {

@@ -23,8 +23,8 @@ import { chartUpdates } from './chart-helper.js';
  * A helper's end of a channel: a MessagePort (browser), or the Node bench's
  * adapter of a worker thread, or an in-process one in the tests.
  * @typedef {object} HelperPort
- * @property {(message: import('./chart-helper.js').HelperCommand, transfer?: Transferable[]) => void} postMessage
- * @property {((event: { data: import('./chart-helper.js').HelperReply }) => void) | null} onmessage
+ * @property {(message: import('./chart-helper.js').HelperCommand, transfer: Transferable[]) => void} postMessage
+ * @property {((event: MessageEvent<import('./chart-helper.js').HelperReply>) => void) | null} onmessage
  */
 
 /**
@@ -59,8 +59,14 @@ function finalVertices(base) {
   return at + 4 <= base.byteLength ? view.getUint32(at, true) : 0;
 }
 
-/** A Uint32Array with room for at least `n`, keeping the first `used` entries. */
-function grown(/** @type {Uint32Array} */ array, /** @type {number} */ used, /** @type {number} */ n) {
+/**
+ * A Uint32Array with room for at least `n`, keeping the first `used` entries.
+ * @param {Uint32Array} array
+ * @param {number} used
+ * @param {number} n
+ * @returns {Uint32Array}
+ */
+function grown(array, used, n) {
   if (array.length >= n) return array;
   const bigger = new Uint32Array(Math.max(n, 2 * array.length, 64));
   bigger.set(array.subarray(0, used));
@@ -81,7 +87,7 @@ class ChartMerge {
     this.positions.set(cut.positions.subarray(0, 3 * cut.vertices));
     this.colours = cut.colours ? new Uint8Array(room) : null;
     if (this.colours && cut.colours) this.colours.set(cut.colours.subarray(0, 3 * cut.vertices));
-    /** Level id of each chart vertex known so far. */
+    /** Level id of each chart vertex known so far. @type {Uint32Array[]} */
     this.ids = Array.from({ length: charts }, () => new Uint32Array(0));
     this.known = new Array(charts).fill(0);
     this.indices = new Uint32Array(0);

@@ -11,7 +11,8 @@
  * comparisons and tests of the fallback), `hold` (show and decode up to this
  * level until `element.viewer.prefetch()` / `display()` say otherwise: the
  * quality study), `background` (`#rrggbb`: the canvas's colour; the study's
- * black). `chrome="none"` draws the model and nothing else. The
+ * black), `decoders` (workers that decode a charted stream together, 1–4;
+ * default: the device's cores, at most 4). `chrome="none"` draws the model and nothing else. The
  * worker and the decoder are loaded from beside this script, so the element
  * works on another origin (the service answers CORS).
  */
@@ -75,6 +76,7 @@ export class VitrineViewerElement extends HTMLElement {
       offscreen: this.getAttribute('offscreen') !== 'off',
       hold: hold === null || hold === '' ? null : Number(hold),
       background: parseColour(this.getAttribute('background')),
+      decoders: positiveInteger(this.getAttribute('decoders')),
     });
     void this.viewer.start();
   }
@@ -87,3 +89,9 @@ export class VitrineViewerElement extends HTMLElement {
 }
 
 if (!customElements.get('vitrine-viewer')) customElements.define('vitrine-viewer', VitrineViewerElement);
+
+/** @param {string | null} value @returns {number | null} */
+function positiveInteger(value) {
+  const n = Number(value);
+  return value !== null && Number.isInteger(n) && n >= 1 ? n : null;
+}

@@ -8,6 +8,7 @@
  */
 
 import { DecodeError } from './codec.js';
+import { PooledDecoder } from './decode-pool.js';
 import { bounds, edgeIndices, vertexNormals } from './geometry.js';
 import { normalDeviation, reliefTop } from './relief.js';
 import { NetworkError, fetchPayload } from './payload.js';
@@ -60,6 +61,7 @@ import { NetworkError, fetchPayload } from './payload.js';
  * @property {number} received payload bytes received so far
  * @property {number} decodeMs time in the WASM decoder so far (apply + copy out)
  * @property {number} deriveMs time computing normals, edges and θ so far
+ * @property {number} decoders members decoding the stream (1, or a pool's size: decode-pool.js)
  */
 
 /**
@@ -79,7 +81,7 @@ import { NetworkError, fetchPayload } from './payload.js';
 /**
  * What the page's main thread gets for a level when the buffers went to a
  * render worker: a few numbers, nothing to copy.
- * @typedef {Pick<LevelMessage, 'type' | 'level' | 'vertices' | 'faces' | 'baseBounds' | 'received' | 'decodeMs' | 'deriveMs'>} LevelNotice
+ * @typedef {Pick<LevelMessage, 'type' | 'level' | 'vertices' | 'faces' | 'baseBounds' | 'received' | 'decodeMs' | 'deriveMs' | 'decoders'>} LevelNotice
  */
 
 /** @typedef {LevelNotice | StatusMessage} PageMessage */
@@ -88,12 +90,21 @@ import { NetworkError, fetchPayload } from './payload.js';
 
 /** @typedef {import('./payload.js').Fetched} Fetched */
 
+/**
+ * What decodes the levels: the codec's decoder, or for a charted stream
+ * with helpers a pool of them (decode-pool.js), whose `apply` is async.
+ * @typedef {import('./codec.js').StreamDecoder | PooledDecoder} LevelDecoder
+ */
+
+/** The stream format whose charts a pool can refine in parallel (codec/core/FORMAT.md). */
+const CHARTED_FORMAT = 5;
+
 export { NetworkError };
 
 const PROGRESS_EVERY_MS = 100;
 
 export class Reconstruction {
-  /** @type {import('./codec.js').StreamDecoder | null} */
+  /** @type {LevelDecoder | null} */
   #decoder = null;
   /** @type {Map<number, Promise<Fetched>>} */
   #inFlight = new Map();
@@ -120,12 +131,20 @@ export class Reconstruction {
    * @param {LoadRequest} request
    * @param {Post} post
    * @param {typeof fetch} [fetchImpl]
+   * @param {import('./decode-pool.js').HelperPort[]} [helpers] decode helpers (chart-worker.js):
+   *   a charted stream's charts are refined by them and this worker together
    */
-  constructor(codec, request, post, fetchImpl = (input, init) => fetch(input, init)) {
+  constructor(codec, request, post, fetchImpl = (input, init) => fetch(input, init), helpers = []) {
     this.codec = codec;
     this.request = { ...request };
     this.post = post;
     this.fetchImpl = fetchImpl;
+    this.helpers = helpers;
+  }
+
+  /** Members decoding the stream: 1, or the pool's size once a charted stream started one. */
+  get decoders() {
+    return this.#decoder instanceof PooledDecoder ? this.#decoder.members : 1;
   }
 
   /**
@@ -231,7 +250,10 @@ export class Reconstruction {
     if (this.#cancelled) return;
     if (!('bytes' in base)) throw new NetworkError('the server refused the base mesh');
     const t0 = performance.now();
-    this.#decoder = this.codec.decoder(base.bytes);
+    this.#decoder =
+      this.helpers.length > 0 && base.bytes[4] === CHARTED_FORMAT
+        ? new PooledDecoder(this.codec, base.bytes, this.helpers)
+        : this.codec.decoder(base.bytes);
     this.#decodeMs += performance.now() - t0;
     this.#baseBounds = bounds(this.#decoder.view().positions);
     this.level = 0;
@@ -263,9 +285,10 @@ export class Reconstruction {
       return;
     }
     if (k + 1 <= this.request.upTo) void this.#batch(k + 1);
-    const decoder = /** @type {import('./codec.js').StreamDecoder} */ (this.#decoder);
+    const decoder = /** @type {LevelDecoder} */ (this.#decoder);
     const t0 = performance.now();
-    decoder.apply(fetched.bytes);
+    await decoder.apply(fetched.bytes);
+    if (this.#cancelled) return;
     this.#decodeMs += performance.now() - t0;
     this.#inFlight.delete(k);
     this.level = k;
@@ -300,7 +323,7 @@ export class Reconstruction {
    * except what is sent.
    */
   #postLevel() {
-    const decoder = /** @type {import('./codec.js').StreamDecoder} */ (this.#decoder);
+    const decoder = /** @type {LevelDecoder} */ (this.#decoder);
     const t0 = performance.now();
     const view = decoder.view();
     const t1 = performance.now();
@@ -344,6 +367,7 @@ export class Reconstruction {
         received: this.#received,
         decodeMs: this.#decodeMs,
         deriveMs: this.#deriveMs,
+        decoders: this.decoders,
       },
       transfer,
     );

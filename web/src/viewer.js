@@ -32,6 +32,9 @@ import { PointModel } from './splats/point-model.js';
  * @property {number | null} [hold] show and decode up to this level only, until
  *   {@link Viewer#prefetch} and {@link Viewer#display} say otherwise (the quality study)
  * @property {[number, number, number]} [background] the canvas's clear colour (0–1 components)
+ * @property {number | null} [decoders] workers that decode a charted stream together
+ *   (decode-pool.js): the decode worker and helpers; null or absent: as many as the
+ *   device has cores, at most {@link MAX_DECODERS}; 1: no helpers
  */
 
 /**
@@ -51,6 +54,7 @@ import { PointModel } from './splats/point-model.js';
  * @property {'mm' | 'cm' | 'm' | 'in' | null} [unit] the model's unit
  * @property {import('./geometry.js').Bounds} [bounds] every level's extent, model coordinates
  * @property {'mesh' | 'points'} [kind] a point cloud's levels are prefixes of a point stream (splats/point-model.js)
+ * @property {number} [stream_format] 5: a charted stream, whose charts a pool of workers refines
  */
 
 /**
@@ -70,7 +74,8 @@ import { PointModel } from './splats/point-model.js';
  * @property {number} lastLevel
  * @property {number} vertices of the level on screen
  * @property {number} received payload bytes
- * @property {number} decodeMs time inside the WASM decoder
+ * @property {number} decodeMs time inside the WASM decoder (with a pool: the wall time of its batches)
+ * @property {number} decoders workers decoding the stream (1, or a pool's size)
  * @property {number} deriveMs time computing normals, edges and θ in the decode worker
  * @property {number} normalsMs time the renderer spent deriving normals (levels sent without them)
  * @property {number | null} firstFrameMs performance.now() of the first frame with a mesh
@@ -108,6 +113,16 @@ export function compileDecoder(url) {
   return module;
 }
 
+/**
+ * The most workers decoding one charted stream: past four, a tablet's
+ * cores are wanted by the render worker and the page, and the charts
+ * (at most five with `--charts auto`) run out.
+ */
+export const MAX_DECODERS = 4;
+
+/** The charted stream format (codec/core/FORMAT.md). */
+const CHARTED_FORMAT = 5;
+
 /** Toolbar buttons for a mesh only: hidden on a point cloud. */
 const MESH_TOOLS = ['wireframe', 'relief', 'splats', 'measure'];
 
@@ -133,6 +148,7 @@ export class Viewer {
     vertices: 0,
     received: 0,
     decodeMs: 0,
+    decoders: 1,
     deriveMs: 0,
     normalsMs: 0,
     firstFrameMs: null,
@@ -167,6 +183,8 @@ export class Viewer {
   #levels = null;
   /** @type {Worker | null} */
   #worker = null;
+  /** Decode helpers of a charted stream (chart-worker.js). @type {Worker[]} */
+  #helpers = [];
   /** @type {ReturnType<typeof setTimeout> | null} */
   #retry = null;
   #wireframe = false;
@@ -364,6 +382,8 @@ export class Viewer {
     this.#attempt++;
     this.#worker?.terminate();
     this.#worker = null;
+    for (const helper of this.#helpers) helper.terminate();
+    this.#helpers = [];
     this.points?.stop();
     if (this.#retry) clearTimeout(this.#retry);
     this.#retry = null;
@@ -560,8 +580,52 @@ export class Viewer {
     // directly, or this page in the fallback); the page gets each level as
     // a notice without its buffers.
     const channel = new MessageChannel();
-    worker.postMessage({ type: 'load', module, request, port: channel.port2 }, [channel.port2]);
+    const helpers = manifest.stream_format === CHARTED_FORMAT ? this.#startHelpers(module) : [];
+    worker.postMessage({ type: 'load', module, request, port: channel.port2, helpers }, [channel.port2, ...helpers]);
     return channel.port1;
+  }
+
+  /** Workers to decode a charted stream with: the decode worker and this many helpers. */
+  #decoders() {
+    const wanted = this.options.decoders ?? Math.min(navigator.hardwareConcurrency || 1, MAX_DECODERS);
+    return Math.max(1, Math.min(wanted, MAX_DECODERS));
+  }
+
+  /**
+   * Starts the decode worker's helpers (chart-worker.js), each with the
+   * compiled codec and one end of a channel; returns the other ends, for
+   * the decode worker. Commands wait in a channel until its helper is
+   * ready; a helper that cannot start answers every command with an error
+   * (the load fails and can be retried, as after any decode error).
+   * @param {WebAssembly.Module} module
+   * @returns {MessagePort[]}
+   */
+  #startHelpers(module) {
+    const attempt = this.#attempt;
+    const url = new URL('./chart-worker.js', this.options.workerUrl).href;
+    /** @type {MessagePort[]} */
+    const ports = [];
+    for (let i = 1; i < this.#decoders(); i++) {
+      const channel = new MessageChannel();
+      ports.push(channel.port2);
+      const port = channel.port1;
+      const refuse = (/** @type {string} */ why) => {
+        port.onmessage = () => port.postMessage({ type: 'error', message: `a decode helper failed: ${why}` });
+      };
+      this.#createWorker(url).then(
+        (helper) => {
+          if (attempt !== this.#attempt) {
+            helper.terminate();
+            return;
+          }
+          this.#helpers.push(helper);
+          helper.onerror = (event) => this.#fail(`a decode helper failed: ${event.message}`);
+          helper.postMessage({ type: 'init', module, port }, [port]);
+        },
+        (error) => refuse(error instanceof Error ? error.message : String(error)),
+      );
+    }
+    return ports;
   }
 
   /**
@@ -683,6 +747,7 @@ export class Viewer {
           decodedLevel: message.level,
           received: message.received,
           decodeMs: message.decodeMs,
+          decoders: message.decoders,
           deriveMs: message.deriveMs,
         });
         break;

@@ -5,14 +5,16 @@
  * reconstruction at a time. Levels leave as transferred buffers, so the page
  * never copies or decodes anything. With a render worker (render-worker.js)
  * the 'load' command brings a MessagePort to it: levels, edges and θ go there,
- * and the page gets each level as a notice without its buffers.
+ * and the page gets each level as a notice without its buffers. `helpers`
+ * are channels to decode helpers (chart-worker.js) that the page started:
+ * a charted stream's charts are refined by them and this worker together.
  */
 
 import { VitrineCodec } from './codec.js';
 import { Reconstruction } from './reconstruction.js';
 
 /**
- * @typedef {{ type: 'load', module: WebAssembly.Module, request: import('./reconstruction.js').LoadRequest, port?: MessagePort | null }
+ * @typedef {{ type: 'load', module: WebAssembly.Module, request: import('./reconstruction.js').LoadRequest, port?: MessagePort | null, helpers?: MessagePort[] }
  *   | { type: 'extend', upTo: number }
  *   | { type: 'wireframe', on: boolean }
  *   | { type: 'relief', on: boolean }
@@ -44,9 +46,9 @@ function post(message, transfer) {
   }
   renderPort.postMessage(message, transfer);
   if (message.type === 'level') {
-    const { type, level, vertices, faces, baseBounds, received, decodeMs, deriveMs } = message;
+    const { type, level, vertices, faces, baseBounds, received, decodeMs, deriveMs, decoders } = message;
     /** @type {import('./reconstruction.js').LevelNotice} */
-    const notice = { type, level, vertices, faces, baseBounds, received, decodeMs, deriveMs };
+    const notice = { type, level, vertices, faces, baseBounds, received, decodeMs, deriveMs, decoders };
     scope.postMessage(notice);
   }
 }
@@ -64,7 +66,7 @@ scope.onmessage = async (/** @type {MessageEvent<WorkerCommand>} */ event) => {
       post({ type: 'error', kind: 'decode', level: -1, message: `the decoder did not start: ${error}` }, []);
       return;
     }
-    job = new Reconstruction(instance, command.request, post);
+    job = new Reconstruction(instance, command.request, post, undefined, command.helpers ?? []);
     if (normals !== null) job.setNormals(normals);
     if (relief !== null) job.setRelief(relief);
     void job.run();

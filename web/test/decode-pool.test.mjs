@@ -10,6 +10,7 @@ import test from 'node:test';
 import { ChartHelper } from '../src/chart-helper.js';
 import { DecodeError, PARTED_TAG, VitrineCodec, splitStream } from '../src/codec.js';
 import { PooledDecoder, shareCharts } from '../src/decode-pool.js';
+import { Reconstruction } from '../src/reconstruction.js';
 import { fixture, sha256, wasmPath } from './support/fixtures.mjs';
 
 const wasm = readFileSync(wasmPath);
@@ -32,7 +33,7 @@ async function helpers(n) {
         const copy = structuredClone(command);
         setImmediate(() => {
           const { reply } = helper.handle(copy);
-          port.onmessage?.({ data: structuredClone(reply) });
+          port.onmessage?.(new MessageEvent('message', { data: structuredClone(reply) }));
         });
       },
     };
@@ -111,4 +112,52 @@ test('damage in a chart a helper refines fails the batch with a decode error', a
     pool.free();
   }
   assert.ok(refused > 0, 'some damage is refused');
+});
+
+test('the decode worker refines a charted stream with its helpers: every level posted is the native one', async () => {
+  const { base, batches } = splitStream(charted.stream);
+  /** @type {typeof fetch} */
+  const fetchImpl = async (input) => {
+    const url = String(input);
+    return new Response(/** @type {BodyInit} */ (url.endsWith('/base') ? base : batches[Number(url.split('/').pop()) - 1]));
+  };
+  /** @type {import('../src/reconstruction.js').LevelMessage[]} */
+  const posted = [];
+  /** @type {{ resolve: (value: unknown) => void, reject: (error: Error) => void }} */
+  const done = { resolve: () => {}, reject: () => {} };
+  const finished = new Promise((resolve, reject) => Object.assign(done, { resolve, reject }));
+  const job = new Reconstruction(
+    await VitrineCodec.instantiate(wasm),
+    {
+      baseUrl: 'http://test/base',
+      batchUrls: batches.map((_, k) => `http://test/batches/${k + 1}`),
+      upTo: batches.length,
+      show: 'each',
+      wireframe: true,
+    },
+    (message) => {
+      if (message.type === 'level') posted.push(message);
+      if (message.type === 'done') done.resolve(undefined);
+      if (message.type === 'error') done.reject(new Error(message.message));
+    },
+    fetchImpl,
+    await helpers(2),
+  );
+  void job.run();
+  await finished;
+  assert.deepEqual(posted.map((l) => l.level), [...Array(batches.length + 1).keys()]);
+  // Positions and colours arrive once (from firstVertex on): put them together.
+  let positions = new Float32Array(0);
+  let colours = new Uint8Array(0);
+  for (const level of posted) {
+    positions = Float32Array.of(...positions, ...level.positions);
+    colours = Uint8Array.of(...colours, ...(level.colours ?? []));
+    const want = charted.levels[level.level];
+    assert.equal(sha256(positions), want.positions, `level ${level.level}`);
+    assert.equal(sha256(level.indices), want.indices, `level ${level.level}`);
+    assert.equal(want.colours && sha256(colours), want.colours);
+    assert.ok(level.edges && level.edges.length > 0, 'the wireframe reads the merged level');
+  }
+  assert.equal(posted[posted.length - 1].decoders, 3);
+  job.cancel();
 });
