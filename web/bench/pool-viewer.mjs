@@ -1,0 +1,99 @@
+// @ts-check
+// Time to the first level and to the last in headless Chromium for one scan,
+// ingested twice into the real `vitrine serve`: as a plain stream (format 4,
+// one decode worker) and charted (format 5, `--charts auto`), loaded with
+// 1, 2 and 4 decode workers (`?decoders=`; src/decode-pool.js). Each load is
+// cold (a fresh page, no HTTP cache) on loopback; times are from navigation
+// start to the frame that first drew the level (ViewerState.shownAtMs), and
+// `decode` is the decode worker's wall time in its batches (with a pool,
+// waiting for the helpers included). WebGL2 runs on SwiftShader, a CPU
+// renderer that shares the machine's cores with the decoders. Median of --runs.
+//   node bench/pool-viewer.mjs --mesh /work/scans/igea-2m.ply [--runs 3] [--workers 1,2,4]
+import { loadavg, cpus } from 'node:os';
+import { parseArgs } from 'node:util';
+import { launch } from '../test/support/browser.mjs';
+import { startService } from '../test/support/service.mjs';
+
+const { values } = parseArgs({
+  options: {
+    mesh: { type: 'string' },
+    runs: { type: 'string', default: '3' },
+    workers: { type: 'string', default: '1,2,4' },
+  },
+});
+if (!values.mesh) {
+  console.error('usage: node bench/pool-viewer.mjs --mesh MESH [--runs 3] [--workers 1,2,4]');
+  process.exit(2);
+}
+const runs = Number(values.runs);
+const workers = values.workers.split(',').map(Number);
+
+const t0 = performance.now();
+const service = await startService({
+  models: [
+    { slug: 'plain', title: 'Plain', kind: 'file', file: values.mesh, policy: 'open' },
+    { slug: 'charted', title: 'Charted', kind: 'file', file: values.mesh, policy: 'open', ingestArgs: ['--charts', 'auto'] },
+  ],
+});
+console.error(`ingested ${values.mesh} twice in ${((performance.now() - t0) / 1000).toFixed(0)} s`);
+/** @param {string} slug */
+const manifest = async (slug) => (await fetch(`${service.url}/api/models/${slug}`)).json();
+const plain = await manifest('plain');
+const charted = await manifest('charted');
+if (charted.stream_format !== 5) throw new Error(`--charts auto left ${values.mesh} plain (format ${charted.stream_format})`);
+const browser = await launch({ width: 800, height: 600 });
+
+/**
+ * One cold load up to the last level.
+ * @param {string} slug
+ * @param {number} decoders
+ * @param {number} last
+ */
+async function load(slug, decoders, last) {
+  const page = await browser.context.newPage();
+  await page.goto(`${service.url}/embed/${slug}?decoders=${decoders}`);
+  await page.waitForFunction(
+    (n) => /** @type {any} */ (document.querySelector('vitrine-viewer'))?.viewer?.state?.shownLevel === n,
+    last,
+    { timeout: 300_000, polling: 50 },
+  );
+  const s = await page.evaluate(() => /** @type {any} */ (document.querySelector('vitrine-viewer')).viewer.state);
+  await page.close();
+  if (s.decoders !== (slug === 'plain' ? 1 : decoders)) throw new Error(`${slug}: ${s.decoders} decoders, asked for ${decoders}`);
+  return { first: s.shownAtMs[0], last: s.shownAtMs[last], decode: s.decodeMs, vertices: s.vertices };
+}
+
+/** @param {number[]} xs */
+const median = (xs) => [...xs].sort((a, b) => a - b)[xs.length >> 1];
+
+/**
+ * @param {string} slug
+ * @param {number} decoders
+ * @param {any} m the manifest
+ */
+async function measure(slug, decoders, m) {
+  await load(slug, decoders, m.last_level); // warm-up: the service's caches, Chromium's compile cache
+  const results = [];
+  for (let r = 0; r < runs; r++) results.push(await load(slug, decoders, m.last_level));
+  return {
+    first: median(results.map((x) => x.first)),
+    last: median(results.map((x) => x.last)),
+    decode: median(results.map((x) => x.decode)),
+    vertices: results[0].vertices,
+  };
+}
+
+console.log(`# ${new Date().toISOString()}, ${cpus().length} cores, load ${loadavg().map((x) => x.toFixed(2)).join(' ')}; median of ${runs} cold loads`);
+console.log(`# plain: ${plain.last_level} batches, ${plain.levels.at(-1).vertices} vertices; charted: ${charted.last_level} batches`);
+console.log('| stream | decode workers | first level | last level | decode (wall) | last level / plain |');
+console.log('|---|---:|---:|---:|---:|---:|');
+const base = await measure('plain', 1, plain);
+const ms = (/** @type {number} */ x) => `${x.toFixed(0)} ms`;
+console.log(`| format 4 | 1 | ${ms(base.first)} | ${ms(base.last)} | ${ms(base.decode)} | 1.00 |`);
+for (const w of workers) {
+  const r = await measure('charted', w, charted);
+  if (r.vertices !== base.vertices) throw new Error(`charted: ${r.vertices} vertices, plain ${base.vertices}`);
+  console.log(`| format 5 | ${w} | ${ms(r.first)} | ${ms(r.last)} | ${ms(r.decode)} | ${(r.last / base.last).toFixed(2)} |`);
+}
+await browser.close();
+await service.stop();
