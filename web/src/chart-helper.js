@@ -3,17 +3,16 @@
  * A member of the decode pool (decode-pool.js) on a thread of its own: it
  * decodes the base mesh and the global batches like every member, then
  * refines only the charts it was given and sends back what each of them
- * gained. No DOM or worker dependency: chart-worker.js runs it in a Web
+ * gained: its new vertices, and its triangles already in the level's ids. No DOM or worker dependency: chart-worker.js runs it in a Web
  * Worker, the Node bench in a worker thread, the tests in-process.
  *
  * Every message gets exactly one reply, in order, so the pool matches them
  * first in, first out:
  * - `{ type: 'base', bytes }` → `{ type: 'ok' }` (a fresh decoder);
- * - `{ type: 'batch', bytes }` → `{ type: 'ok' }`, or once it has charts
- *   and the batch is parted, a ChartsReply;
- * - `{ type: 'charts', charts }` → `{ type: 'ok' }`: the charts it refines
- *   from the next parted batch on (after the first, which every member
- *   applies whole);
+ * - `{ type: 'batch', bytes, share? }` → `{ type: 'ok' }` for a global
+ *   batch, a ChartsReply for a parted one; `share` comes with the first
+ *   parted batch: the helper reads the charts' sizes from it and takes its
+ *   share by {@link shareCharts}, as every member does;
  * any failure → `{ type: 'error', message }`.
  */
 
@@ -23,48 +22,70 @@ import { DecodeError } from './codec.js';
  * What one chart gained in a parted batch.
  * @typedef {object} ChartUpdate
  * @property {number} chart
- * @property {Uint32Array | null} levelIds the level's id of each chart vertex when the
- *   members stopped merging (the chart's first update only)
- * @property {Float32Array} positions x, y, z of the chart vertices after those sent before
+ * @property {Float32Array} positions x, y, z of the chart's vertices the batch inserted
  * @property {Uint8Array | null} colours r, g, b of the same vertices
- * @property {Uint32Array} indices every triangle of the chart, in chart vertex ids
+ * @property {Uint32Array} indices every triangle of the chart, in the level's vertex ids
  */
 
 /** @typedef {{ type: 'charts', charts: ChartUpdate[] }} ChartsReply */
 /** @typedef {{ type: 'ok' } | ChartsReply | { type: 'error', message: string }} HelperReply */
-/** @typedef {{ type: 'base', bytes: Uint8Array } | { type: 'charts', charts: number[] } | { type: 'batch', bytes: Uint8Array }} HelperCommand */
+/**
+ * `share`, with a charted stream's first parted batch: the pool's size and
+ * this helper's place in it (1…), to share the charts out as every member does.
+ * @typedef {{ type: 'base', bytes: Uint8Array } | { type: 'batch', bytes: Uint8Array, share?: { members: number, member: number } }} HelperCommand
+ */
 
 /**
- * Copies out what `charts` gained since `sent` (vertices already sent, per
- * chart; updated), with the buffers to transfer.
+ * Copies out what `charts` gained in the last batch, with the buffers to
+ * transfer.
  * @param {import('./codec.js').StreamDecoder} decoder
  * @param {number[]} charts
- * @param {Map<number, number>} sent
  * @returns {{ updates: ChartUpdate[], transfer: ArrayBuffer[] }}
  */
-export function chartUpdates(decoder, charts, sent) {
+export function chartUpdates(decoder, charts) {
   /** @type {ChartUpdate[]} */
   const updates = [];
   /** @type {ArrayBuffer[]} */
   const transfer = [];
   for (const chart of charts) {
     const view = decoder.chartView(chart);
-    const before = sent.get(chart);
-    const from = before ?? view.levelIds.length;
     const update = {
       chart,
-      levelIds: before === undefined ? view.levelIds.slice() : null,
-      positions: view.positions.slice(3 * from),
-      colours: view.colours ? view.colours.slice(3 * from) : null,
-      indices: view.indices.slice(),
+      positions: view.positions.slice(3 * view.newFrom),
+      colours: view.colours ? view.colours.slice(3 * view.newFrom) : null,
+      indices: view.levelIndices.slice(),
     };
-    sent.set(chart, view.positions.length / 3);
     updates.push(update);
     transfer.push(update.positions.buffer, update.indices.buffer);
-    if (update.levelIds) transfer.push(update.levelIds.buffer);
     if (update.colours) transfer.push(update.colours.buffer);
   }
   return { updates, transfer };
+}
+
+/**
+ * Shares charts out among `members` by the longest-processing-time rule:
+ * largest first, each to the member with the least so far, so every
+ * member's share is within one chart of the fairest. On a tie the helpers
+ * come first and member 0 (the decode worker, which also merges and posts
+ * the levels) last.
+ * @param {number[]} sizes work per chart (its faces)
+ * @param {number} members
+ * @returns {number[][]} the charts of each member, ascending
+ */
+export function shareCharts(sizes, members) {
+  const load = new Array(members).fill(0);
+  /** @type {number[][]} */
+  const shares = Array.from({ length: members }, () => []);
+  const order = sizes.map((_, c) => c).sort((a, b) => sizes[b] - sizes[a] || a - b);
+  const preference = [...Array(members).keys()].slice(1).concat(0);
+  for (const chart of order) {
+    let best = preference[0];
+    for (const m of preference) if (load[m] < load[best]) best = m;
+    load[best] += Math.max(sizes[chart], 1);
+    shares[best].push(chart);
+  }
+  for (const share of shares) share.sort((a, b) => a - b);
+  return shares;
 }
 
 export class ChartHelper {
@@ -72,8 +93,6 @@ export class ChartHelper {
   #decoder = null;
   /** @type {number[]} */
   #charts = [];
-  /** @type {Map<number, number>} */
-  #sent = new Map();
 
   /** @param {import('./codec.js').VitrineCodec} codec */
   constructor(codec) {
@@ -101,20 +120,19 @@ export class ChartHelper {
       this.#decoder?.free();
       this.#decoder = null;
       this.#charts = [];
-      this.#sent = new Map();
       this.#decoder = this.codec.decoder(command.bytes);
       return ok;
     }
     const decoder = this.#decoder;
     if (!decoder) throw new DecodeError('no base mesh yet');
-    if (command.type === 'charts') {
-      decoder.refineOnly(command.charts);
-      this.#charts = command.charts;
-      return ok;
+    if (command.share) {
+      const { members, member } = command.share;
+      this.#charts = shareCharts(decoder.chartSizes(command.bytes), members)[member] ?? [];
+      decoder.refineOnly(this.#charts);
     }
     decoder.apply(command.bytes);
-    if (decoder.chartCount() === 0 || this.#charts.length === 0) return ok;
-    const { updates, transfer } = chartUpdates(decoder, this.#charts, this.#sent);
+    if (decoder.chartCount() === 0) return ok;
+    const { updates, transfer } = chartUpdates(decoder, this.#charts);
     return { reply: { type: 'charts', charts: updates }, transfer };
   }
 }

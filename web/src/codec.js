@@ -10,7 +10,7 @@
 const POSITIONS = 0;
 const COLOURS = 1;
 const INDICES = 2;
-const LEVEL_IDS = 3;
+const LEVEL_INDICES = 3;
 
 /**
  * @typedef {object} Level
@@ -22,14 +22,14 @@ const LEVEL_IDS = 3;
  */
 
 /**
- * One chart of a charted level (format 5), in the chart's own vertex ids.
+ * One chart of a charted level (format 5).
  * @typedef {object} ChartView
  * @property {Float32Array} positions x, y, z per chart vertex
  * @property {Uint8Array | null} colours r, g, b per chart vertex
- * @property {Uint32Array} indices the chart's triangles
- * @property {Uint32Array} levelIds the level's id of each of the chart's first vertices:
- *   all of them while the decoder merges its charts; once it refines only some, those
- *   it had then, and the vertices after them are the ones its parts inserted since
+ * @property {Uint32Array} levelIndices the chart's triangles in the level's vertex ids
+ *   (empty for a chart the decoder leaves to others)
+ * @property {number} newFrom the chart's vertices before the last batch: those after
+ *   are its insertions, whose level ids follow each other
  */
 
 export class DecodeError extends Error {}
@@ -60,6 +60,11 @@ export class VitrineCodec {
   #write(bytes) {
     const ptr = this.exports.input_reserve(bytes.length);
     this.memory().set(bytes, ptr);
+  }
+
+  /** Copies bytes into the decoder's input buffer, for a call that reads them. @param {Uint8Array} bytes */
+  input(bytes) {
+    this.#write(bytes);
   }
 
   #error() {
@@ -224,14 +229,27 @@ export class StreamDecoder {
     const span = (kind) => ({ ptr: e.chart_buffer_ptr(this.handle, chart, kind), len: e.chart_buffer_len(this.handle, chart, kind) });
     const p = span(POSITIONS);
     const c = span(COLOURS);
-    const i = span(INDICES);
-    const g = span(LEVEL_IDS);
+    const i = span(LEVEL_INDICES);
     return {
       positions: new Float32Array(buffer, p.ptr, p.len),
       colours: c.ptr === 0 ? null : new Uint8Array(buffer, c.ptr, c.len),
-      indices: new Uint32Array(buffer, i.ptr, i.len),
-      levelIds: new Uint32Array(buffer, g.ptr, g.len),
+      levelIndices: new Uint32Array(buffer, i.ptr, i.len),
+      newFrom: e.chart_new_from(this.handle, chart),
     };
+  }
+
+  /**
+   * The faces of each chart that a charted stream's first parted batch, not
+   * applied yet, will cut the level into: how a pool shares the charts out.
+   * @param {Uint8Array} batch
+   * @returns {number[]}
+   */
+  chartSizes(batch) {
+    const e = this.codec.exports;
+    this.codec.input(batch);
+    const charts = e.decoder_chart_sizes(this.handle, batch.length);
+    if (charts < 0) throw this.codec.lastError();
+    return Array.from(new Uint32Array(e.memory.buffer, e.sizes_ptr(), charts));
   }
 
   free() {

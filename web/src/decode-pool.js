@@ -3,21 +3,24 @@
  * A charted stream (format 5, codec/core/FORMAT.md) decoded by a pool of
  * workers. The decode worker is the pool's first member; every helper
  * (chart-helper.js) is another, on a thread of its own. Every member
- * decodes the base mesh, the global batches and the first parted batch
- * whole (the coarsest of the charts' batches: together about a tenth of
- * the work), so no chart mesh ever travels between threads; then the
- * charts are shared out by their size, and from the next parted batch on
- * each member refines only its own charts and sends what they gained. This
- * member merges the charts as the native decoder does (each chart's new
- * vertices appended in chart order, then every chart's triangles in level
- * ids: `Charted::merge` in codec/core/src/decoder/charted.rs), so the levels
- * are the same bytes as one decoder's, and hands them on as one level.
+ * decodes the base mesh and the global batches (about a tenth of the work)
+ * so that no chart mesh ever travels between threads. Before the first
+ * parted batch, this member reads from it how big each chart will be and
+ * shares the charts out; from then on each member refines only its own and
+ * sends what they gained: the new vertices, and the chart's triangles
+ * already in the level's vertex ids (each member numbers its charts' new
+ * vertices as one decoder would, counting the other charts' insertions
+ * from the batch). This member lays them end to end in chart order, as the
+ * native decoder merges (`Charted::merge` in codec/core/src/decoder/
+ * charted.rs), so the levels are the same bytes as one decoder's.
  *
  * It behaves like a StreamDecoder, except that `apply` returns a promise.
  */
 
 import { DecodeError, PARTED_TAG } from './codec.js';
-import { chartUpdates } from './chart-helper.js';
+import { chartUpdates, shareCharts } from './chart-helper.js';
+
+export { shareCharts };
 
 /**
  * A helper's end of a channel: a MessagePort (browser), or the Node bench's
@@ -28,114 +31,55 @@ import { chartUpdates } from './chart-helper.js';
  */
 
 /**
- * Shares charts out among `members` by the longest-processing-time rule:
- * largest first, each to the member with the least so far (the lowest on a
- * tie), so every member's share is within one chart of the fairest.
- * @param {number[]} sizes work per chart (its faces)
- * @param {number} members
- * @returns {number[][]} the charts of each member, ascending
+ * Every level's vertex count from a stream's level table (FORMAT.md; the
+ * decoder has checked the header already).
+ * @param {Uint8Array} base
+ * @returns {number[]}
  */
-export function shareCharts(sizes, members) {
-  const load = new Array(members).fill(0);
-  /** @type {number[][]} */
-  const shares = Array.from({ length: members }, () => []);
-  const order = sizes.map((_, c) => c).sort((a, b) => sizes[b] - sizes[a] || a - b);
-  for (const chart of order) {
-    let best = 0;
-    for (let m = 1; m < members; m++) if (load[m] < load[best]) best = m;
-    load[best] += Math.max(sizes[chart], 1);
-    shares[best].push(chart);
-  }
-  for (const share of shares) share.sort((a, b) => a - b);
-  return shares;
-}
-
-/** The final level's vertex count from a stream's header (FORMAT.md). @param {Uint8Array} base */
-function finalVertices(base) {
+function levelVertices(base) {
   const view = new DataView(base.buffer, base.byteOffset, base.byteLength);
-  if (base.byteLength < 40) return 0;
   const batches = view.getUint32(24, true);
-  const at = 28 + 12 * batches;
-  return at + 4 <= base.byteLength ? view.getUint32(at, true) : 0;
-}
-
-/**
- * A Uint32Array with room for at least `n`, keeping the first `used` entries.
- * @param {Uint32Array} array
- * @param {number} used
- * @param {number} n
- * @returns {Uint32Array}
- */
-function grown(array, used, n) {
-  if (array.length >= n) return array;
-  const bigger = new Uint32Array(Math.max(n, 2 * array.length, 64));
-  bigger.set(array.subarray(0, used));
-  return bigger;
+  return Array.from({ length: batches + 1 }, (_, k) => view.getUint32(28 + 12 * k, true));
 }
 
 /** The merged level of a charted stream, grown by every member's chart updates. */
 class ChartMerge {
   /**
-   * @param {import('./codec.js').Level} cut the level when the members stopped merging
+   * @param {import('./codec.js').Level} start the level when the members stopped merging
    * @param {number} capacity vertices to make room for (the final level's)
-   * @param {number} charts
    */
-  constructor(cut, capacity, charts) {
-    const room = 3 * Math.max(capacity, cut.vertices);
-    this.vertices = cut.vertices;
+  constructor(start, capacity) {
+    const room = 3 * Math.max(capacity, start.vertices);
+    this.vertices = start.vertices;
     this.positions = new Float32Array(room);
-    this.positions.set(cut.positions.subarray(0, 3 * cut.vertices));
-    this.colours = cut.colours ? new Uint8Array(room) : null;
-    if (this.colours && cut.colours) this.colours.set(cut.colours.subarray(0, 3 * cut.vertices));
-    /** Level id of each chart vertex known so far. @type {Uint32Array[]} */
-    this.ids = Array.from({ length: charts }, () => new Uint32Array(0));
-    this.known = new Array(charts).fill(0);
+    this.positions.set(start.positions.subarray(0, 3 * start.vertices));
+    this.colours = start.colours ? new Uint8Array(room) : null;
+    if (this.colours && start.colours) this.colours.set(start.colours.subarray(0, 3 * start.vertices));
     this.indices = new Uint32Array(0);
   }
 
-  /** @param {number} vertices */
-  #room(vertices) {
-    if (3 * vertices <= this.positions.length) return;
-    const positions = new Float32Array(6 * vertices);
-    positions.set(this.positions);
-    this.positions = positions;
-    if (this.colours) {
-      const colours = new Uint8Array(6 * vertices);
-      colours.set(this.colours);
-      this.colours = colours;
+  /**
+   * @param {import('./chart-helper.js').ChartUpdate[]} updates every chart's, in chart order
+   * @param {number} vertices the level's vertex count after them (the level table's)
+   */
+  add(updates, vertices) {
+    let total = 0;
+    for (const u of updates) total += u.positions.length / 3;
+    if (this.vertices + total !== vertices || 3 * vertices > this.positions.length) {
+      throw new DecodeError(`the charts bring ${this.vertices + total} vertices, the level has ${vertices}`);
     }
-  }
-
-  /** @param {import('./chart-helper.js').ChartUpdate[]} updates every chart's, in chart order */
-  add(updates) {
+    let faces = 0;
     for (const u of updates) {
-      const c = u.chart;
-      if (u.levelIds) {
-        this.ids[c] = u.levelIds.slice();
-        this.known[c] = u.levelIds.length;
-      }
-      const n = u.positions.length / 3;
-      this.#room(this.vertices + n);
       this.positions.set(u.positions, 3 * this.vertices);
       if (this.colours && u.colours) this.colours.set(u.colours, 3 * this.vertices);
-      const ids = (this.ids[c] = grown(this.ids[c], this.known[c], this.known[c] + n));
-      for (let j = 0; j < n; j++) ids[this.known[c] + j] = this.vertices + j;
-      this.known[c] += n;
-      this.vertices += n;
+      this.vertices += u.positions.length / 3;
+      faces += u.indices.length;
     }
-    let total = 0;
-    for (const u of updates) total += u.indices.length;
-    const indices = new Uint32Array(total);
+    const indices = new Uint32Array(faces);
     let at = 0;
     for (const u of updates) {
-      const ids = this.ids[u.chart];
-      const known = this.known[u.chart];
-      const chart = u.indices;
-      for (let k = 0; k < chart.length; k++) {
-        const v = chart[k];
-        if (v >= known) throw new DecodeError(`chart ${u.chart} names vertex ${v} of ${known}`);
-        indices[at++] = ids[v];
-      }
+      indices.set(u.indices, at);
+      at += u.indices.length;
     }
     this.indices = indices;
   }
@@ -153,14 +97,17 @@ export class PooledDecoder {
   #active;
   /** This member's charts, once shared. @type {number[] | null} */
   #mine = null;
-  /** @type {Map<number, number>} */
-  #sent = new Map();
+  /** Helpers left without charts, to leave out after this batch. @type {number[]} */
+  #leaveOut = [];
   /** @type {ChartMerge | null} */
   #merge = null;
-  #capacity;
+  /** @type {number[]} */
+  #levels;
   #level = 0;
   /** The charts each member refines (index 0: this one), once shared. @type {number[][] | null} */
   shares = null;
+  /** The faces of each chart they were shared by. @type {number[] | null} */
+  sizes = null;
 
   /**
    * @param {import('./codec.js').VitrineCodec} codec
@@ -172,11 +119,11 @@ export class PooledDecoder {
     this.#ports = ports;
     this.#waiting = ports.map(() => []);
     this.#active = ports.map((_, i) => i);
-    this.#capacity = finalVertices(base);
+    this.#levels = levelVertices(base);
     ports.forEach((port, i) => {
       port.onmessage = (event) => this.#reply(i, event.data);
     });
-    for (const i of this.#active) this.#hold(this.#send(i, { type: 'base', bytes: base.slice() }));
+    for (const i of this.#active) this.#hold(this.#send(i, { type: 'base', bytes: new Uint8Array(base) }));
   }
 
   /** @param {number} helper @param {import('./chart-helper.js').HelperReply} reply */
@@ -212,57 +159,60 @@ export class PooledDecoder {
   }
 
   /**
-   * Applies the next batch: a global one and the first parted one here and
-   * in every helper, then the charts are shared out; a later parted one
-   * each member refines its own charts of, at once.
+   * Applies the next batch: a global one here and in every helper; a
+   * parted one (its charts shared out first, if it is the first) by every
+   * member at once, each refining its own charts.
    * @param {Uint8Array} batch
    */
   async apply(batch) {
-    if (batch[0] !== PARTED_TAG || !this.#mine) {
+    if (batch[0] !== PARTED_TAG) {
       for (const i of this.#active) {
-        const copy = batch.slice();
+        const copy = new Uint8Array(batch); // a copy (a Node Buffer's slice() is a view)
         this.#hold(this.#send(i, { type: 'batch', bytes: copy }, [copy.buffer]));
       }
       this.#inner.apply(batch);
       this.#level++;
-      if (batch[0] === PARTED_TAG) this.#share();
       return;
     }
+    // The first parted batch: every member shares the charts out by the
+    // same rule from the same sizes, at once, and keeps its own share.
+    const first = !this.#mine;
     const replies = this.#active.map((i) => {
-      const copy = batch.slice();
-      return this.#send(i, { type: 'batch', bytes: copy }, [copy.buffer]);
+      const copy = new Uint8Array(batch); // a copy (a Node Buffer's slice() is a view)
+      /** @type {import('./chart-helper.js').HelperCommand} */
+      const command = first ? { type: 'batch', bytes: copy, share: { members: this.members, member: i + 1 } } : { type: 'batch', bytes: copy };
+      return this.#send(i, command, [copy.buffer]);
     });
     // Awaited below unless this member fails first.
     for (const reply of replies) reply.catch(() => {});
+    if (first) this.#share(batch);
     // This member's charts while the helpers do theirs.
     this.#inner.apply(batch);
-    const mine = chartUpdates(this.#inner, /** @type {number[]} */ (this.#mine), this.#sent).updates;
+    const mine = chartUpdates(this.#inner, /** @type {number[]} */ (this.#mine)).updates;
     await Promise.all(this.#pending.splice(0));
     const theirs = await Promise.all(replies);
+    if (this.#leaveOut.length > 0) {
+      this.#active = this.#active.filter((i) => !this.#leaveOut.includes(i));
+      this.#leaveOut = [];
+    }
     const updates = mine.concat(...theirs.map((r) => (r.type === 'charts' ? r.charts : [])));
     updates.sort((a, b) => a.chart - b.chart);
     const charts = this.#inner.chartCount();
     if (updates.length !== charts) throw new DecodeError(`${updates.length} of ${charts} charts came back`);
-    this.#merge ??= new ChartMerge(this.#inner.view(), this.#capacity, charts);
-    this.#merge.add(updates);
+    this.#merge ??= new ChartMerge(this.#inner.view(), this.#levels[this.#levels.length - 1]);
+    this.#merge.add(updates, this.#levels[this.#level + 1]);
     this.#level++;
   }
 
-  /** Shares the charts out by their faces now, the first parted batch applied. */
-  #share() {
-    const sizes = [];
-    for (let c = 0; c < this.#inner.chartCount(); c++) sizes.push(this.#inner.chartView(c).indices.length);
-    const shares = shareCharts(sizes, this.members);
+  /** Shares the charts out by their faces, read from the first parted batch. @param {Uint8Array} batch */
+  #share(batch) {
+    this.sizes = this.#inner.chartSizes(batch);
+    const shares = shareCharts(this.sizes, this.members);
     this.shares = shares;
     this.#mine = shares[0];
     this.#inner.refineOnly(shares[0]);
-    const active = [];
-    for (const i of this.#active) {
-      if (shares[i + 1].length === 0) continue;
-      active.push(i);
-      this.#hold(this.#send(i, { type: 'charts', charts: shares[i + 1] }));
-    }
-    this.#active = active;
+    // A helper without charts sends empty updates from now on: leave it out.
+    this.#leaveOut = this.#active.filter((i) => shares[i + 1].length === 0);
   }
 
   /** @returns {import('./codec.js').Level} views, valid until the next apply */

@@ -192,12 +192,10 @@ fn hostile_parted_batches_are_refused_without_panic() {
 
 /// Merges pool members' charts as `web/src/decode-pool.js` does: each
 /// chart's new vertices appended in chart order (positions and colours),
-/// then every chart's triangles mapped to level ids.
+/// then every chart's triangles, which each member gives in level ids.
 struct PoolMerge {
     positions: Vec<f32>,
     colours: Option<Vec<u8>>,
-    /// Level id of each chart vertex known so far.
-    ids: Vec<Vec<u32>>,
     indices: Vec<u32>,
 }
 
@@ -206,32 +204,21 @@ impl PoolMerge {
         PoolMerge {
             positions: cut.positions().to_vec(),
             colours: cut.colours().map(<[u8]>::to_vec),
-            ids: vec![Vec::new(); cut.chart_count()],
             indices: Vec::new(),
         }
     }
 
     fn add(&mut self, owner: &[&Decoder]) {
-        for (c, member) in owner.iter().enumerate() {
-            let chart = member.chart(c).expect("the chart exists");
-            let ids = &mut self.ids[c];
-            if ids.is_empty() {
-                ids.extend_from_slice(chart.level_ids);
-            }
-            for v in ids.len()..chart.positions.len() / 3 {
-                ids.push((self.positions.len() / 3) as u32);
-                self.positions
-                    .extend_from_slice(&chart.positions[3 * v..3 * v + 3]);
-                if let (Some(out), Some(colours)) = (&mut self.colours, chart.colours) {
-                    out.extend_from_slice(&colours[3 * v..3 * v + 3]);
-                }
-            }
-        }
         self.indices.clear();
         for (c, member) in owner.iter().enumerate() {
-            let chart = member.chart(c).unwrap();
-            self.indices
-                .extend(chart.indices.iter().map(|&v| self.ids[c][v as usize]));
+            let chart = member.chart(c).expect("the chart exists");
+            let new = 3 * chart.new_from..;
+            self.positions
+                .extend_from_slice(&chart.positions[new.clone()]);
+            if let (Some(out), Some(colours)) = (&mut self.colours, chart.colours) {
+                out.extend_from_slice(&colours[new]);
+            }
+            self.indices.extend_from_slice(chart.level_indices);
         }
     }
 }
@@ -273,6 +260,20 @@ fn pool_members_that_refine_some_charts_each_merge_into_the_same_levels() {
         let mut parted = 0;
         for range in &index.batches {
             let batch = &bytes[range.clone()];
+            if batch[0] == b'P' && full.chart_count() == 0 {
+                let sizes = full.chart_sizes(batch).unwrap();
+                assert_eq!(sizes.len(), 5);
+                assert_eq!(sizes.iter().sum::<usize>(), full.face_count());
+                assert!(
+                    sizes.iter().all(|&s| s > full.face_count() / 20),
+                    "{sizes:?}"
+                );
+            } else {
+                assert!(
+                    full.chart_sizes(batch).is_err(),
+                    "only a first parted batch"
+                );
+            }
             full.apply_batch(batch).unwrap();
             for d in &mut pool {
                 d.apply_batch(batch).unwrap();
@@ -280,6 +281,10 @@ fn pool_members_that_refine_some_charts_each_merge_into_the_same_levels() {
             if pool[0].chart_count() == 0 {
                 assert_eq!(pool[0].positions(), full.positions());
                 continue;
+            }
+            if parted == 0 {
+                // What the pool reads before the cut to share the charts out.
+                assert!(pool[0].chart_sizes(batch).is_err(), "the charts are cut");
             }
             parted += 1;
             if after_first && parted == 1 {

@@ -13,10 +13,12 @@
 //! 4. On error `error_ptr()` / `error_len()` give a UTF-8 message.
 //!
 //! A charted stream (format 5) can be decoded by a pool of workers, each
-//! with its own instance: `decoder_refine_only(handle, lo, hi)` before the
-//! next parted batch makes a decoder refine only the charts in the 64-bit
-//! mask; `decoder_charts`, `chart_buffer_ptr` and `chart_buffer_len` read
-//! one chart (`web/src/decode-pool.js` merges them).
+//! with its own instance: `decoder_chart_sizes(handle, len)` reads how big
+//! each chart of a first parted batch will be (then `sizes_ptr()`, u32s);
+//! `decoder_refine_only(handle, lo, hi)` before the next parted batch makes
+//! a decoder refine only the charts in the 64-bit mask; `decoder_charts`,
+//! `chart_new_from`, `chart_buffer_ptr` and `chart_buffer_len` read one
+//! chart (`web/src/decode-pool.js` merges them).
 //!
 //! [`geodesic`] adds distance along the surface of a decoded level, for
 //! the viewer's measurement tool; [`points`] decodes point streams and
@@ -36,14 +38,16 @@ thread_local! {
     pub(crate) static INPUT: RefCell<Vec<u8>> = const { RefCell::new(Vec::new()) };
     static ERROR: RefCell<String> = const { RefCell::new(String::new()) };
     static DECODERS: RefCell<Vec<Option<Decoder>>> = const { RefCell::new(Vec::new()) };
+    static SIZES: RefCell<Vec<u32>> = const { RefCell::new(Vec::new()) };
 }
 
 /// Buffer kinds for [`buffer_ptr`] and [`buffer_len`].
 pub const POSITIONS: u32 = 0;
 pub const COLOURS: u32 = 1;
 pub const INDICES: u32 = 2;
-/// A chart's level ids (u32, `ChartLevel::level_ids`), for [`chart_buffer_ptr`] only.
-pub const LEVEL_IDS: u32 = 3;
+/// A chart's triangles in level ids (u32, `ChartLevel::level_indices`),
+/// for [`chart_buffer_ptr`] only.
+pub const LEVEL_INDICES: u32 = 3;
 
 fn fail(message: String) -> i32 {
     ERROR.with(|e| *e.borrow_mut() = message);
@@ -159,6 +163,45 @@ pub extern "C" fn decoder_refine_only(handle: u32, lo: u32, hi: u32) -> i32 {
     }
 }
 
+/// The faces of each chart that the first parted batch in the input buffer
+/// will cut the level into (`Decoder::chart_sizes`): returns the number of
+/// charts, the sizes at [`sizes_ptr`]; −1 on error.
+#[allow(unsafe_code)]
+#[no_mangle]
+pub extern "C" fn decoder_chart_sizes(handle: u32, len: u32) -> i32 {
+    let result = INPUT.with(|i| {
+        let i = i.borrow();
+        with_decoder(handle, |d| d.chart_sizes(&i[..(len as usize).min(i.len())]))
+    });
+    match result {
+        Some(Ok(sizes)) => SIZES.with(|s| {
+            let mut s = s.borrow_mut();
+            s.clear();
+            s.extend(sizes.iter().map(|&n| n as u32));
+            s.len() as i32
+        }),
+        Some(Err(e)) => fail(e.to_string()),
+        None => fail(format!("no decoder with handle {handle}")),
+    }
+}
+
+/// Where the last [`decoder_chart_sizes`] left its u32s.
+#[allow(unsafe_code)]
+#[no_mangle]
+pub extern "C" fn sizes_ptr() -> u32 {
+    SIZES.with(|s| s.borrow().as_ptr() as usize as u32)
+}
+
+/// The chart's vertices before the last batch (`ChartLevel::new_from`).
+#[allow(unsafe_code)]
+#[no_mangle]
+pub extern "C" fn chart_new_from(handle: u32, chart: u32) -> u32 {
+    with_decoder(handle, |d| {
+        d.chart(chart as usize).map_or(0, |c| c.new_from as u32)
+    })
+    .unwrap_or(0)
+}
+
 /// Charts of the stream once its first parted batch is applied (else 0).
 #[allow(unsafe_code)]
 #[no_mangle]
@@ -174,11 +217,11 @@ fn chart_buffer(d: &Decoder, chart: u32, kind: u32) -> (usize, usize) {
         POSITIONS => (c.positions.as_ptr() as usize, c.positions.len()),
         COLOURS => c.colours.map_or((0, 0), |c| (c.as_ptr() as usize, c.len())),
         INDICES => (c.indices.as_ptr() as usize, c.indices.len()),
-        _ => (c.level_ids.as_ptr() as usize, c.level_ids.len()),
+        _ => (c.level_indices.as_ptr() as usize, c.level_indices.len()),
     }
 }
 
-/// Address of one chart's buffer (kinds as above, and [`LEVEL_IDS`]); 0 when absent.
+/// Address of one chart's buffer (kinds as above, and [`LEVEL_INDICES`]); 0 when absent.
 #[allow(unsafe_code)]
 #[no_mangle]
 pub extern "C" fn chart_buffer_ptr(handle: u32, chart: u32, kind: u32) -> u32 {

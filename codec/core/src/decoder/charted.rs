@@ -2,6 +2,8 @@
 //! each refined by its part of every parted batch, on its own thread where
 //! threads exist, then merged into the level the caller sees.
 
+use std::ops::Range;
+
 use super::conquest::{PassInput, Scratch};
 use super::{read_pass, Level};
 use crate::charts::{canonical_faces, cut, decode_labels};
@@ -12,16 +14,27 @@ use crate::{Error, Result};
 
 pub(super) struct Charted {
     charts: Vec<Chart>,
-    /// The merged level's triangle list, in the level's vertex ids.
+    /// The merged level's triangle list, in the level's vertex ids (as
+    /// when the decoder stopped merging, once it refines only some charts).
     pub indices: Vec<u32>,
+    /// The triangles of the charts this decoder refines, in level ids,
+    /// once it refines only some.
+    owned: Vec<u32>,
+    /// Where each chart's triangles are in `indices`, or in `owned` once
+    /// the decoder refines only some (empty for the others).
+    ranges: Vec<Range<usize>>,
+    /// The decoder refines only some charts: `owned` and `ranges` hold theirs.
+    some: bool,
 }
 
 struct Chart {
     level: Level,
     scratch: Scratch,
-    /// The merged level's id of each chart vertex (of those merged: a
-    /// decoder that refines only some charts stops merging).
+    /// The level's id of each chart vertex.
     global: Vec<u32>,
+    /// Chart vertices before the last batch applied: those after it are
+    /// the batch's insertions.
+    before_last: usize,
 }
 
 /// One chart of a charted level, in the chart's own vertex ids (see
@@ -34,11 +47,13 @@ pub struct ChartLevel<'a> {
     pub colours: Option<&'a [u8]>,
     /// The chart's triangles, three chart vertex ids each.
     pub indices: &'a [u32],
-    /// The level's id of each of the chart's first vertices: all of them
-    /// while the decoder merges its charts into its level; once it refines
-    /// only some charts, those it had when it stopped merging, and the
-    /// vertices after them are the ones its parts inserted since, in order.
-    pub level_ids: &'a [u32],
+    /// The same triangles in the level's vertex ids (empty for a chart the
+    /// decoder leaves to others).
+    pub level_indices: &'a [u32],
+    /// The chart's vertices before the last batch: the ones from here on
+    /// are that batch's insertions, in order, and their level ids follow
+    /// each other (those of earlier charts' insertions before them).
+    pub new_from: usize,
 }
 
 /// One chart's part of a parted batch: its cleaning and decimating passes
@@ -48,16 +63,19 @@ pub(super) type Part<'a> = Option<(PassInput<'a>, PassInput<'a>, usize)>;
 impl Charted {
     /// Cuts `level` (where the global batches left it) into `charts` charts
     /// by the labels coded in `labels`; `level` is not changed.
-    pub(super) fn cut(level: &Level, labels: &[u8], charts: usize) -> Result<Charted> {
-        let (faces, _) = canonical_faces(
-            level
-                .conn
-                .origin
-                .chunks_exact(3)
-                .map(|t| [t[0], t[1], t[2]]),
-            std::iter::repeat(0),
-        );
-        let labels = decode_labels(labels, &faces, level.vertex_count(), charts)?;
+    /// `labelled`: what [`Charted::labelled`] made of the same labels, if
+    /// it was asked before.
+    pub(super) fn cut(
+        level: &Level,
+        labels: &[u8],
+        charts: usize,
+        labelled: Option<Labelled>,
+    ) -> Result<Charted> {
+        let (faces, labels) = match labelled {
+            Some(l) if l.bytes == labels && l.charts == charts => (l.faces, l.labels),
+            _ => labelled_faces(level, labels, charts)?,
+        };
+        let count = charts;
         let charts = cut(&faces, &labels, charts, level.vertex_count())
             .into_iter()
             .map(|c| {
@@ -80,6 +98,7 @@ impl Charted {
                             .map(|colours| c.global.iter().map(|v| colours[pick(v)]).collect()),
                     },
                     scratch: Scratch::default(),
+                    before_last: c.global.len(),
                     global: c.global,
                 })
             })
@@ -87,6 +106,21 @@ impl Charted {
         Ok(Charted {
             charts,
             indices: level.conn.origin.clone(),
+            owned: Vec::new(),
+            ranges: vec![0..0; count],
+            some: false,
+        })
+    }
+
+    /// The faces of `level` labelled by a first parted batch's labels,
+    /// without cutting anything (see [`Labelled::sizes`]); kept for the cut.
+    pub(super) fn labelled(level: &Level, labels: &[u8], charts: usize) -> Result<Labelled> {
+        let (faces, l) = labelled_faces(level, labels, charts)?;
+        Ok(Labelled {
+            bytes: labels.to_vec(),
+            charts,
+            faces,
+            labels: l,
         })
     }
 
@@ -96,11 +130,17 @@ impl Charted {
 
     pub(super) fn chart(&self, chart: usize) -> Option<ChartLevel<'_>> {
         let c = self.charts.get(chart)?;
+        let range = self.ranges[chart].clone();
         Some(ChartLevel {
             positions: c.level.positions.as_flattened(),
             colours: c.level.colours.as_ref().map(|c| c.as_flattened()),
             indices: &c.level.conn.origin,
-            level_ids: &c.global,
+            level_indices: if self.some {
+                &self.owned[range]
+            } else {
+                &self.indices[range]
+            },
+            new_from: c.before_last,
         })
     }
 
@@ -156,7 +196,8 @@ impl Charted {
             }
         }
         self.indices.clear();
-        for chart in &self.charts {
+        for (chart, range) in self.charts.iter().zip(&mut self.ranges) {
+            let start = self.indices.len();
             self.indices.extend(
                 chart
                     .level
@@ -165,12 +206,85 @@ impl Charted {
                     .iter()
                     .map(|&v| chart.global[v as usize]),
             );
+            *range = start..self.indices.len();
+        }
+    }
+
+    /// For a decoder that refines only the charts in `refined`: numbers its
+    /// charts' new vertices as [`Charted::merge`] would in the level (from
+    /// `first`, the level's vertex count before the batch, chart by chart,
+    /// counting each other chart's insertions as `inserted` declares them)
+    /// and maps their triangles to level ids; the level is left alone.
+    pub(super) fn number_owned(&mut self, first: usize, inserted: &[u64], refined: u64) {
+        self.some = true;
+        self.owned.clear();
+        let mut next = first as u32;
+        for (k, (chart, range)) in self.charts.iter_mut().zip(&mut self.ranges).enumerate() {
+            if refined & (1 << k) == 0 {
+                next = next.wrapping_add(inserted[k] as u32);
+                *range = 0..0;
+                continue;
+            }
+            for _ in chart.global.len()..chart.level.vertex_count() {
+                chart.global.push(next);
+                next = next.wrapping_add(1);
+            }
+            let start = self.owned.len();
+            self.owned.extend(
+                chart
+                    .level
+                    .conn
+                    .origin
+                    .iter()
+                    .map(|&v| chart.global[v as usize]),
+            );
+            *range = start..self.owned.len();
         }
     }
 }
 
+/// A level's faces and their charts, decoded before the cut (to tell the
+/// charts' sizes) and kept so the cut need not decode them again.
+pub(super) struct Labelled {
+    bytes: Vec<u8>,
+    charts: usize,
+    faces: Vec<[u32; 3]>,
+    labels: Vec<u32>,
+}
+
+impl Labelled {
+    /// Faces of each chart: how much work each chart will be.
+    pub(super) fn sizes(&self) -> Vec<usize> {
+        let mut sizes = vec![0; self.charts];
+        for &label in &self.labels {
+            sizes[label as usize] += 1;
+        }
+        sizes
+    }
+}
+
+/// The faces of `level` in canonical order and each one's chart, from the
+/// labels section of a first parted batch.
+fn labelled_faces(
+    level: &Level,
+    labels: &[u8],
+    charts: usize,
+) -> Result<(Vec<[u32; 3]>, Vec<u32>)> {
+    let (faces, _) = canonical_faces(
+        level
+            .conn
+            .origin
+            .chunks_exact(3)
+            .map(|t| [t[0], t[1], t[2]]),
+        std::iter::repeat(0),
+    );
+    let labels = decode_labels(labels, &faces, level.vertex_count(), charts)?;
+    Ok((faces, labels))
+}
+
 impl Chart {
     fn apply(&mut self, part: Part<'_>) -> Result<()> {
+        self.before_last = self.level.vertex_count();
         let Some((cleaning, decimating, bytes)) = part else {
             return Ok(());
         };

@@ -13,7 +13,7 @@ use crate::halfedge::Connectivity;
 use crate::quantize::Quantization;
 use crate::{Error, IndexedMesh, Result};
 pub use charted::ChartLevel;
-use charted::{read_part, Charted};
+use charted::{read_part, Charted, Labelled};
 use conquest::{PassInput, Scratch};
 
 /// Budget a decoder enforces before it allocates or grows anything.
@@ -89,6 +89,8 @@ pub struct Decoder {
     threads: usize,
     /// The charts this decoder refines, bit c for chart c (all by default).
     refined: u64,
+    /// The first parted batch's labels, decoded by `chart_sizes` for the cut.
+    labelled: Option<Labelled>,
 }
 
 impl Decoder {
@@ -145,6 +147,7 @@ impl Decoder {
             charted: None,
             threads: 1,
             refined: u64::MAX,
+            labelled: None,
         })
     }
 
@@ -294,7 +297,12 @@ impl Decoder {
                 return Err(Error::stream("a parted batch changes the number of charts"))
             }
             Some(_) => None,
-            None => Some(Charted::cut(&self.level, r.section()?, charts)?),
+            None => Some(Charted::cut(
+                &self.level,
+                r.section()?,
+                charts,
+                self.labelled.take(),
+            )?),
         };
         let mut parts = Vec::with_capacity(charts);
         for _ in 0..charts {
@@ -328,6 +336,13 @@ impl Decoder {
             };
         }
         let some = self.refines_some();
+        let inserted: Vec<u64> = parts
+            .iter()
+            .map(|p| {
+                p.as_ref()
+                    .map_or(0, |(c, d, _)| c.inserted as u64 + d.inserted as u64)
+            })
+            .collect();
         if some {
             for (k, part) in parts.iter_mut().enumerate() {
                 if self.refined & (1 << k) == 0 {
@@ -340,11 +355,38 @@ impl Decoder {
             self.broken = true;
             return Err(e);
         }
-        if !some {
+        if some {
+            charted.number_owned(now.0, &inserted, self.refined);
+        } else {
             charted.merge(&mut self.level);
         }
         self.applied = expected;
         Ok(())
+    }
+
+    /// The faces of each chart that a charted stream's first parted batch
+    /// (`chunk_bytes`, not applied yet) will cut this level into: how a
+    /// pool shares the charts out before any member applies it. The level
+    /// is not changed; the labels decoded are kept for the cut.
+    pub fn chart_sizes(&mut self, chunk_bytes: &[u8]) -> Result<Vec<usize>> {
+        if self.charted.is_some() {
+            return Err(Error::stream("the charts are cut already"));
+        }
+        let (chunk, payload) = ChunkHeader::parse(chunk_bytes, &[PARTED_TAG])?;
+        if chunk.version != self.header.version || chunk.level as usize != self.applied + 1 {
+            return Err(Error::stream(
+                "not the next batch of this stream, or not parted",
+            ));
+        }
+        let mut r = Reader::new(payload);
+        let charts = r.varint()? as usize;
+        if !(2..=MAX_CHARTS).contains(&charts) {
+            return Err(Error::stream(format!("{charts} charts is out of range")));
+        }
+        let labelled = Charted::labelled(&self.level, r.section()?, charts)?;
+        let sizes = labelled.sizes();
+        self.labelled = Some(labelled);
+        Ok(sizes)
     }
 
     /// Makes this decoder one member of a pool that decodes a charted
@@ -355,8 +397,10 @@ impl Decoder {
     /// changing); read its charts with [`Decoder::chart`] and merge them
     /// with the other members' as the full decoder does: each chart's new
     /// vertices appended in chart order, then every chart's triangles
-    /// (`web/src/decode-pool.js`). Once it refines only some charts, the
-    /// choice is final.
+    /// (`web/src/decode-pool.js`): [`ChartLevel::level_indices`] gives its
+    /// charts' triangles in the level's ids already. [`Decoder::chart_sizes`]
+    /// tells how big each chart will be before the first parted batch. Once
+    /// it refines only some charts, the choice is final.
     pub fn refine_only(&mut self, charts: u64) -> Result<()> {
         if self.refines_some() {
             return Err(Error::stream(
