@@ -116,7 +116,7 @@ export function compileDecoder(url) {
 /**
  * The most workers decoding one charted stream: past four, a tablet's
  * cores are wanted by the render worker and the page, and the charts
- * (at most five with `--charts auto`) run out.
+ * (at most four with `--charts auto`) run out.
  */
 export const MAX_DECODERS = 4;
 

@@ -322,3 +322,18 @@ fn pool_members_that_refine_some_charts_each_merge_into_the_same_levels() {
         assert!(full.is_complete());
     }
 }
+
+#[test]
+fn auto_makes_two_charts_from_100k_vertices_and_four_from_200k() {
+    let auto = |v| Charts::Auto.count(v);
+    assert!(auto(99_999) < 2, "plain below 100,000");
+    assert_eq!(auto(100_000), 2);
+    assert_eq!(
+        auto(199_999),
+        2,
+        "three would split 2 : 1 between two decoders"
+    );
+    assert_eq!(auto(200_000), 4);
+    assert_eq!(auto(2_149_490), 4);
+    assert_eq!(auto(50_000_000), Charts::AUTO_MAX);
+}

@@ -49,7 +49,7 @@ pub struct EncodeArgs {
     #[command(flatten)]
     pub guard: GuardArgs,
     /// Cut the stream into charts that decode on several cores (format 5):
-    /// `off` (the default: format 4), `auto` (one per 50,000 vertices, at most 5;
+    /// `off` (the default: format 4), `auto` (2 charts from 100,000 vertices, 4 from 200,000;
     /// plain below 100,000) or a number of charts, 2–64.
     #[arg(long, default_value = "off")]
     pub charts: ChartsArg,

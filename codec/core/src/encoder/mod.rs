@@ -56,8 +56,9 @@ pub enum Charts {
     /// A plain stream (format 4): every batch refines the whole mesh.
     #[default]
     Off,
-    /// One chart per [`Charts::AUTO_VERTICES`] input vertices, at most
-    /// [`Charts::AUTO_MAX`]: a plain stream below 100,000 vertices.
+    /// One chart per [`Charts::AUTO_VERTICES`] input vertices, rounded
+    /// down to a power of two, at most [`Charts::AUTO_MAX`]: a plain stream
+    /// below 100,000 vertices, 2 charts below 200,000, else 4.
     Auto,
     /// One chart per this many input vertices, at most 64; a plain stream
     /// when that makes fewer than two.
@@ -72,14 +73,23 @@ impl Charts {
     /// The most charts [`Charts::Auto`] makes: every chart costs bytes (its
     /// parts restart their coders' models, its cut stays out of the fine
     /// layers). igea upsampled to 2.1 M vertices: +1.3 % over format 4 at
-    /// 4 charts, +1.4 % at 5, +2.0 % at 8 (BENCHMARKS.md, "Charts").
-    pub const AUTO_MAX: usize = 5;
+    /// 4 charts, +1.4 % at 5, +2.0 % at 8 (BENCHMARKS.md, "Charts"). A
+    /// power of two, so that pools of 2 and 4 decoders (web/src/decode-pool.js)
+    /// share the charts evenly: at 5 charts two decoders split 3 : 2.
+    pub const AUTO_MAX: usize = 4;
 
     /// How many charts a mesh of `vertices` vertices gets (below 2: none).
     pub fn count(self, vertices: usize) -> usize {
         match self {
             Charts::Off => 1,
-            Charts::Auto => (vertices / Self::AUTO_VERTICES as usize).min(Self::AUTO_MAX),
+            Charts::Auto => {
+                let k = (vertices / Self::AUTO_VERTICES as usize).min(Self::AUTO_MAX);
+                if k < 2 {
+                    k
+                } else {
+                    1 << k.ilog2()
+                }
+            }
             Charts::PerVertices(per) => {
                 (vertices / per.max(1) as usize).min(crate::charts::MAX_CHARTS)
             }
