@@ -2,8 +2,11 @@
 # Issue 23's measurements of the charted stream (format 5), in one run:
 # native size and decode time on 1, 2 and 4 threads against format 4
 # (`charts_bench`, every charted stream checked lossless), DracoPy on the
-# same meshes (size, native decode), then WebAssembly decode in Node, one
-# core: format 4, format 5 decoded serially, and draco3d.
+# same meshes (size, native decode), then WebAssembly decode in Node:
+# format 4, format 5 decoded serially and by the viewer's decode pool of 2
+# and 4 workers, and draco3d; last, the viewer in headless Chromium on the
+# last mesh (time to the first and the last level, format 4 and format 5 on
+# 1, 2 and 4 decode workers; VIEWER=0 skips it).
 #
 #   bash scripts/bench-charts.sh MESH…     (RUNS=7, OUT=target/bench-charts,
 #                                           PEER_DRACO=../shared/tools/peer_draco.py)
@@ -45,5 +48,10 @@ with open(sys.argv[3], "wb") as out:
 PY
     stems+=("$PWD/$stem")
 done
-echo "## WebAssembly in Node, one core (median of $runs)"
-(cd web && node bench/mesh-decode.mjs --draco3d /tmp/draco3d/node_modules/draco3d --runs "$runs" "${stems[@]}")
+echo "## WebAssembly in Node: one thread, and pools whose helpers run on worker threads (median of $runs)"
+(cd web && node bench/mesh-decode.mjs --draco3d /tmp/draco3d/node_modules/draco3d --runs "$runs" --workers 2,4 "${stems[@]}")
+if [ "${VIEWER:-1}" != 0 ]; then
+    echo
+    echo "## The viewer in headless Chromium (SwiftShader), ${*: -1}"
+    (cd web && node build.mjs >/dev/null && node bench/pool-viewer.mjs --mesh "$(realpath "${*: -1}")" --runs 3 --workers 1,2,4)
+fi
