@@ -33,7 +33,7 @@ const workers = values.workers.split(',').map(Number);
 const t0 = performance.now();
 const service = await startService({
   models: [
-    { slug: 'plain', title: 'Plain', kind: 'file', file: values.mesh, policy: 'open' },
+    { slug: 'plain', title: 'Plain', kind: 'file', file: values.mesh, policy: 'open', ingestArgs: ['--charts', 'off'] },
     { slug: 'charted', title: 'Charted', kind: 'file', file: values.mesh, policy: 'open', ingestArgs: ['--charts', 'auto'] },
   ],
 });

@@ -180,6 +180,27 @@ fn hostile_parted_batches_are_refused_without_panic() {
         }
     }
     assert!(refused > 0);
+    // Chart sizes read from a damaged first parted batch: an error or some
+    // sizes of the level's faces, never a panic; then the batch itself is
+    // refused or decodes as before (the labels kept are only a cache).
+    let mut d = fresh(first_parted);
+    let faces = d.face_count();
+    for cut in [1, 2, 5, chunk.len() / 3, chunk.len() / 2] {
+        assert!(d.chart_sizes(&chunk[..cut]).is_err(), "cut at {cut}");
+    }
+    for at in (2..chunk.len()).step_by(chunk.len() / 31 + 1) {
+        let mut bad = chunk.to_vec();
+        bad[at] ^= 0x5a;
+        let mut d = fresh(first_parted);
+        if let Ok(sizes) = d.chart_sizes(&bad) {
+            assert_eq!(sizes.iter().sum::<usize>(), faces, "byte {at}");
+            // The intact batch after sizes of a damaged one: the same level.
+            d.apply_batch(chunk).unwrap();
+            let mut plain = fresh(first_parted);
+            plain.apply_batch(chunk).unwrap();
+            assert_eq!(d.indices(), plain.indices(), "byte {at}");
+        }
+    }
     // A whole-mesh batch after a parted one, and batches out of order.
     let mut d = fresh(first_parted + 1);
     let plain_batch = index.batches[0].clone();

@@ -57,10 +57,12 @@ pub struct IngestArgs {
     /// a point cloud (default 14).
     #[arg(long)]
     pub quantization_bits: Option<u8>,
-    /// A mesh's stream cut into charts that decode on several cores (format
-    /// 5): `off` (the default), `auto` (one per 50,000 vertices, at most
-    /// 5) or 2–64.
-    #[arg(long, default_value = "off")]
+    /// A mesh's stream cut into charts that the viewer decodes on several
+    /// cores at once (format 5): `auto` (the default: 2 charts from 100,000
+    /// vertices, 4 from 200,000, a plain stream below; about 1–1.5 % more
+    /// bytes, 1.3–1.5× faster to the last level with two decode workers:
+    /// BENCHMARKS.md, "Charts"), `off` (format 4) or 2–64.
+    #[arg(long, default_value = "auto")]
     pub charts: ChartsArg,
     /// How colour travels: `ccc` (a cubic cell complex: a cell texture and
     /// a colour texture shared by every level, sampled from the file's
