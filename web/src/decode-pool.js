@@ -198,7 +198,9 @@ export class PooledDecoder {
     const updates = mine.concat(...theirs.map((r) => (r.type === 'charts' ? r.charts : [])));
     updates.sort((a, b) => a.chart - b.chart);
     const charts = this.#inner.chartCount();
-    if (updates.length !== charts) throw new DecodeError(`${updates.length} of ${charts} charts came back`);
+    if (updates.length !== charts || updates.some((u, c) => u.chart !== c)) {
+      throw new DecodeError(`charts ${updates.map((u) => u.chart)} came back, of ${charts}`);
+    }
     this.#merge ??= new ChartMerge(this.#inner.view(), this.#levels[this.#levels.length - 1]);
     this.#merge.add(updates, this.#levels[this.#level + 1]);
     this.#level++;

@@ -197,16 +197,7 @@ impl Charted {
         }
         self.indices.clear();
         for (chart, range) in self.charts.iter().zip(&mut self.ranges) {
-            let start = self.indices.len();
-            self.indices.extend(
-                chart
-                    .level
-                    .conn
-                    .origin
-                    .iter()
-                    .map(|&v| chart.global[v as usize]),
-            );
-            *range = start..self.indices.len();
+            *range = chart.append_level_triangles(&mut self.indices);
         }
     }
 
@@ -229,16 +220,7 @@ impl Charted {
                 chart.global.push(next);
                 next = next.wrapping_add(1);
             }
-            let start = self.owned.len();
-            self.owned.extend(
-                chart
-                    .level
-                    .conn
-                    .origin
-                    .iter()
-                    .map(|&v| chart.global[v as usize]),
-            );
-            *range = start..self.owned.len();
+            *range = chart.append_level_triangles(&mut self.owned);
         }
     }
 }
@@ -283,6 +265,19 @@ fn labelled_faces(
 }
 
 impl Chart {
+    /// Appends the chart's triangles in level ids to `out`; where they are.
+    fn append_level_triangles(&self, out: &mut Vec<u32>) -> Range<usize> {
+        let start = out.len();
+        out.extend(
+            self.level
+                .conn
+                .origin
+                .iter()
+                .map(|&v| self.global[v as usize]),
+        );
+        start..out.len()
+    }
+
     fn apply(&mut self, part: Part<'_>) -> Result<()> {
         self.before_last = self.level.vertex_count();
         let Some((cleaning, decimating, bytes)) = part else {
