@@ -288,10 +288,7 @@ impl Decoder {
         expected: usize,
     ) -> Result<()> {
         let mut r = Reader::new(payload);
-        let charts = r.varint()? as usize;
-        if !(2..=MAX_CHARTS).contains(&charts) {
-            return Err(Error::stream(format!("{charts} charts is out of range")));
-        }
+        let charts = read_chart_count(&mut r)?;
         let cut = match &self.charted {
             Some(c) if c.chart_count() != charts => {
                 return Err(Error::stream("a parted batch changes the number of charts"))
@@ -379,10 +376,7 @@ impl Decoder {
             ));
         }
         let mut r = Reader::new(payload);
-        let charts = r.varint()? as usize;
-        if !(2..=MAX_CHARTS).contains(&charts) {
-            return Err(Error::stream(format!("{charts} charts is out of range")));
-        }
+        let charts = read_chart_count(&mut r)?;
         let labelled = Charted::labelled(&self.level, r.section()?, charts)?;
         let sizes = labelled.sizes();
         self.labelled = Some(labelled);
@@ -479,6 +473,15 @@ fn version_mismatch(chunk: u8, stream: u8) -> Error {
     Error::stream(format!(
         "chunk version mismatch: a version {chunk} chunk in a version {stream} stream"
     ))
+}
+
+/// A parted batch's payload begins with its number of charts.
+fn read_chart_count(r: &mut Reader) -> Result<usize> {
+    let charts = r.varint()? as usize;
+    if !(2..=MAX_CHARTS).contains(&charts) {
+        return Err(Error::stream(format!("{charts} charts is out of range")));
+    }
+    Ok(charts)
 }
 
 fn read_pass<'a>(r: &mut Reader<'a>, kind: PassKind) -> Result<PassInput<'a>> {
