@@ -10,7 +10,7 @@
 #                                disconnects shutdown hostile)
 #
 # PostgreSQL cases run on a throw-away cluster of their own (initdb into a
-# temporary directory, port $FAULT_PG_PORT, default 55433) so that stopping
+# temporary directory, port $FAULT_PG_PORT, default 25433) so that stopping
 # it never disturbs the shared server on 5432; they SKIP when no PostgreSQL
 # binaries are installed (apt-get install postgresql). The read-only and
 # disk-full cases use a read-only bind mount and a tiny tmpfs, which need
@@ -44,7 +44,9 @@ work=$(mktemp -d /tmp/vitrine-faults.XXXXXX)
 chmod 755 "$work"
 port=${FAULT_PORT:-18191}
 url=http://127.0.0.1:$port
-pg_port=${FAULT_PG_PORT:-55433}
+# Below the kernel's ephemeral range (32768–60999): a client socket that
+# happened to take 55434 once kept the delay line from listening.
+pg_port=${FAULT_PG_PORT:-25433}
 proxy_port=$((pg_port + 1))
 pids=()
 mounts=()
