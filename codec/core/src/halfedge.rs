@@ -83,7 +83,7 @@ impl Connectivity {
     }
 
     /// Every vertex's faces must form one fan, or rotation would miss some.
-    fn check_vertex_fans(&self) -> Result<()> {
+    pub(crate) fn check_vertex_fans(&self) -> Result<()> {
         let mut seen = vec![0u32; self.out.len()];
         for v in 0..self.out.len() as u32 {
             if self.out[v as usize] == NONE {

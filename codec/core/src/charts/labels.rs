@@ -49,22 +49,22 @@ pub(crate) fn encode_labels(
     Ok(coder.finish())
 }
 
-/// The labels of `faces` (canonical order, a level the caller holds).
+/// The labels of the faces of `adjacency` (the level where charts begin,
+/// in canonical order: [`super::canonical_level`]).
 pub(crate) fn decode_labels(
     bytes: &[u8],
-    faces: &[[u32; 3]],
-    vertex_count: usize,
+    adjacency: &Connectivity,
     charts: usize,
 ) -> Result<Vec<u32>> {
     if !(2..=super::MAX_CHARTS).contains(&charts) {
         return Err(Error::stream(format!("{charts} charts is out of range")));
     }
-    let conn = adjacency(faces, vertex_count)?;
     let mut models = models(charts);
     let mut coder = RangeDecoder::new(bytes);
-    let mut labels = vec![NONE; faces.len()];
-    for f in 0..faces.len() {
-        let c = context(&conn, &labels, f);
+    let faces = adjacency.origin.len() / 3;
+    let mut labels = vec![NONE; faces];
+    for f in 0..faces {
+        let c = context(adjacency, &labels, f);
         labels[f] = coder.decode_symbol(&mut models[c]) as u32;
     }
     coder.check_overrun()?;
@@ -95,10 +95,11 @@ mod tests {
         let labels: Vec<u32> = faces.iter().map(|t| (t[0] * 7 / (n + 1)).min(6)).collect();
         let bytes = encode_labels(&faces, 2 * n as usize + 2, &labels, 7).unwrap();
         assert!(bytes.len() < 200, "{} bytes for 7 patches", bytes.len());
-        let decoded = decode_labels(&bytes, &faces, 2 * n as usize + 2, 7).unwrap();
+        let conn = adjacency(&faces, 2 * n as usize + 2).unwrap();
+        let decoded = decode_labels(&bytes, &conn, 7).unwrap();
         assert_eq!(decoded, labels);
         // Truncated: an overrun, never a panic.
-        assert!(decode_labels(&bytes[..bytes.len() / 2], &faces, 2 * n as usize + 2, 7).is_err());
-        assert!(decode_labels(&bytes, &faces, 2 * n as usize + 2, 65).is_err());
+        assert!(decode_labels(&bytes[..bytes.len() / 2], &conn, 7).is_err());
+        assert!(decode_labels(&bytes, &conn, 65).is_err());
     }
 }

@@ -20,20 +20,30 @@ mod partition;
 
 pub(crate) use labels::{decode_labels, encode_labels};
 
-use crate::halfedge::NONE;
+use crate::halfedge::{face, Connectivity, NONE};
+use crate::{Error, Result};
 
 /// At most this many charts: a label is one symbol of a 64-symbol model.
 pub const MAX_CHARTS: usize = 64;
 
-/// A face rotated so its smallest vertex id comes first (orientation kept).
-fn canonical(t: [u32; 3]) -> [u32; 3] {
-    let i = if t[0] <= t[1] && t[0] <= t[2] {
+/// The corner of a face with the smallest vertex id.
+fn smallest_corner(t: [u32; 3]) -> usize {
+    if t[0] <= t[1] && t[0] <= t[2] {
         0
     } else if t[1] <= t[2] {
         1
     } else {
         2
-    };
+    }
+}
+
+/// A face rotated so its smallest vertex id comes first (orientation kept).
+fn canonical(t: [u32; 3]) -> [u32; 3] {
+    rotated(t, smallest_corner(t))
+}
+
+/// Face `t` starting from corner `i`.
+fn rotated(t: [u32; 3], i: usize) -> [u32; 3] {
     [t[i], t[(i + 1) % 3], t[(i + 2) % 3]]
 }
 
@@ -49,6 +59,89 @@ pub(crate) fn canonical_faces(
     faces.into_iter().unzip()
 }
 
+/// The level where charts begin, as the decoder holds it, in the order
+/// both sides label it ([`canonical_faces`]): canonical face `i` is
+/// half-edges `3i..3i + 3` of `adjacency`.
+pub(crate) struct CanonicalLevel {
+    pub adjacency: Connectivity,
+}
+
+impl CanonicalLevel {
+    pub(crate) fn faces(&self) -> &[[u32; 3]] {
+        self.adjacency.origin.as_chunks().0
+    }
+}
+
+/// [`canonical_faces`] of a level, with the adjacency read off the level's
+/// own half-edges: faces bucketed by their smallest vertex (ids are dense,
+/// so no sort of the whole level) and no edge table built. The decoder's
+/// cut did both, and took about as long as decoding a level of its size.
+pub(crate) fn canonical_level(conn: &Connectivity) -> Result<CanonicalLevel> {
+    let vertex_count = conn.out.len();
+    if conn.origin.iter().any(|&v| v as usize >= vertex_count) {
+        return Err(Error::stream("a face names a vertex the level lacks"));
+    }
+    let triangles: &[[u32; 3]] = conn.origin.as_chunks().0;
+    let rotation: Vec<u8> = triangles
+        .iter()
+        .map(|&t| smallest_corner(t) as u8)
+        .collect();
+    let smallest = |f: usize| triangles[f][rotation[f] as usize] as usize;
+    let canonical_face = |f: u32| rotated(triangles[f as usize], rotation[f as usize] as usize);
+    // Faces by smallest vertex (a counting sort), then each bucket in order.
+    let mut starts = vec![0u32; vertex_count + 1];
+    for f in 0..triangles.len() {
+        starts[smallest(f) + 1] += 1;
+    }
+    for v in 0..vertex_count {
+        starts[v + 1] += starts[v];
+    }
+    let mut order = vec![0u32; triangles.len()];
+    let mut cursor = starts.clone();
+    for f in 0..triangles.len() {
+        let slot = &mut cursor[smallest(f)];
+        order[*slot as usize] = f as u32;
+        *slot += 1;
+    }
+    drop(cursor);
+    for bucket in starts.windows(2) {
+        let faces = &mut order[bucket[0] as usize..bucket[1] as usize];
+        if faces.len() > 1 {
+            faces.sort_unstable_by_key(|&f| canonical_face(f));
+        }
+    }
+    let mut position = vec![0u32; triangles.len()];
+    for (i, &f) in order.iter().enumerate() {
+        position[f as usize] = i as u32;
+    }
+    // Canonical half-edge 3i + k is the level's 3f + (k + rotation) mod 3.
+    let canonical_half_edge = |h: u32| {
+        if h == NONE {
+            return NONE;
+        }
+        let f = face(h) as usize;
+        3 * position[f] + (h % 3 + 3 - u32::from(rotation[f])) % 3
+    };
+    let mut origin = Vec::with_capacity(conn.origin.len());
+    let mut twin = Vec::with_capacity(conn.origin.len());
+    for &f in &order {
+        origin.extend(canonical_face(f));
+        let r = rotation[f as usize] as u32;
+        for k in 0..3 {
+            twin.push(canonical_half_edge(
+                conn.twin[(3 * f + (k + r) % 3) as usize],
+            ));
+        }
+    }
+    let mut out = vec![NONE; vertex_count];
+    for (h, &v) in origin.iter().enumerate() {
+        out[v as usize] = h as u32;
+    }
+    Ok(CanonicalLevel {
+        adjacency: Connectivity { origin, twin, out },
+    })
+}
+
 /// One chart cut out of the level where charts begin.
 #[derive(Debug, Default, PartialEq)]
 pub(crate) struct Cut {
@@ -56,6 +149,8 @@ pub(crate) struct Cut {
     pub global: Vec<u32>,
     /// The chart's faces in chart ids, in canonical order.
     pub triangles: Vec<[u32; 3]>,
+    /// Where each of them is in the level's canonical order.
+    pub faces: Vec<u32>,
 }
 
 /// Cuts `faces` (canonical order, ids below `vertex_count`) into `charts`
@@ -73,9 +168,9 @@ pub(crate) fn cut(
     for (f, &label) in labels.iter().enumerate() {
         by_chart[label as usize].push(f as u32);
     }
-    for (chart, faces_of) in cuts.iter_mut().zip(&by_chart) {
+    for (chart, faces_of) in cuts.iter_mut().zip(by_chart) {
         chart.triangles.reserve(faces_of.len());
-        for &f in faces_of {
+        for &f in &faces_of {
             let t = faces[f as usize].map(|v| {
                 let slot = &mut local[v as usize];
                 if *slot == NONE {
@@ -89,8 +184,53 @@ pub(crate) fn cut(
         for &v in &chart.global {
             local[v as usize] = NONE;
         }
+        chart.faces = faces_of;
     }
     cuts
+}
+
+/// Each chart's connectivity, read off the level's (`adjacency`, in
+/// canonical order, [`canonical_level`]): a chart's half-edges pair as the
+/// level's do inside it and are borders along its cut, which is what
+/// [`Connectivity::from_triangles`] makes of its faces, without an edge
+/// table. The same check of every vertex's fan follows.
+pub(crate) fn chart_connectivity(
+    cuts: &[Cut],
+    labels: &[u32],
+    adjacency: &Connectivity,
+) -> Result<Vec<Connectivity>> {
+    // Each level face's place in its chart.
+    let mut place = vec![0u32; labels.len()];
+    for chart in cuts {
+        for (j, &f) in chart.faces.iter().enumerate() {
+            place[f as usize] = j as u32;
+        }
+    }
+    cuts.iter()
+        .enumerate()
+        .map(|(c, chart)| {
+            let origin = chart.triangles.as_flattened().to_vec();
+            let mut twin = Vec::with_capacity(origin.len());
+            for &f in &chart.faces {
+                for k in 0..3 {
+                    let t = adjacency.twin[(3 * f + k) as usize];
+                    let inside = t != NONE && labels[face(t) as usize] as usize == c;
+                    twin.push(if inside {
+                        3 * place[face(t) as usize] + t % 3
+                    } else {
+                        NONE
+                    });
+                }
+            }
+            let mut out = vec![NONE; chart.global.len()];
+            for (h, &v) in origin.iter().enumerate() {
+                out[v as usize] = h as u32;
+            }
+            let conn = Connectivity { origin, twin, out };
+            conn.check_vertex_fans()?;
+            Ok(conn)
+        })
+        .collect()
 }
 
 #[cfg(test)]
@@ -102,6 +242,81 @@ mod tests {
         assert_eq!(canonical([5, 2, 9]), [2, 9, 5]);
         assert_eq!(canonical([9, 5, 2]), [2, 9, 5]);
         assert_eq!(canonical([2, 9, 5]), [2, 9, 5]);
+    }
+
+    /// A torus of `n × n` quads with scrambled vertex ids, faces in a
+    /// scrambled order, each starting from a scrambled corner; with each
+    /// face, its quad's row and column.
+    fn scrambled_torus(n: u32) -> Vec<([u32; 3], [u32; 2])> {
+        let mut state = 0x9e37_79b9_7f4a_7c15_u64;
+        let mut random = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            state
+        };
+        let mut ids: Vec<u32> = (0..n * n).collect();
+        for i in (1..ids.len()).rev() {
+            ids.swap(i, (random() % (i as u64 + 1)) as usize);
+        }
+        let v = |i: u32, j: u32| ids[((i % n) * n + j % n) as usize];
+        let mut faces = Vec::new();
+        for i in 0..n {
+            for j in 0..n {
+                faces.push(([v(i, j), v(i + 1, j), v(i + 1, j + 1)], [i, j]));
+                faces.push(([v(i, j), v(i + 1, j + 1), v(i, j + 1)], [i, j]));
+            }
+        }
+        for i in (1..faces.len()).rev() {
+            faces.swap(i, (random() % (i as u64 + 1)) as usize);
+        }
+        faces
+            .into_iter()
+            .map(|(t, quad)| (rotated(t, (random() % 3) as usize), quad))
+            .collect()
+    }
+
+    #[test]
+    fn a_level_read_off_its_half_edges_is_what_its_faces_would_build() {
+        let n = 24;
+        let torus = scrambled_torus(n);
+        let faces: Vec<[u32; 3]> = torus.iter().map(|&(t, _)| t).collect();
+        let vertices = (n * n) as usize;
+        let level = Connectivity::from_triangles(vertices, &faces).unwrap();
+        let canonical = canonical_level(&level).unwrap();
+        let (expected, quads) = canonical_faces(
+            faces.iter().copied(),
+            torus.iter().map(|&(_, [i, j])| i * n + j),
+        );
+        assert_eq!(canonical.faces(), &expected[..]);
+        let built = Connectivity::from_triangles(vertices, &expected).unwrap();
+        assert_eq!(canonical.adjacency.twin, built.twin);
+        assert_eq!(canonical.adjacency.out, built.out);
+        // Charts: the torus's four quarters (discs), then scattered faces
+        // whose charts touch themselves at single vertices (not manifolds).
+        let quarters: Vec<u32> = quads
+            .iter()
+            .map(|q| 2 * (q / n / (n / 2)) + q % n / (n / 2))
+            .collect();
+        let scattered: Vec<u32> = expected.iter().map(|t| t[0] % 3).collect();
+        for (labels, charts, manifold) in [(quarters, 4, true), (scattered, 3, false)] {
+            let cuts = cut(canonical.faces(), &labels, charts, vertices);
+            let read = chart_connectivity(&cuts, &labels, &canonical.adjacency);
+            let built: Vec<_> = cuts
+                .iter()
+                .map(|c| Connectivity::from_triangles(c.global.len(), &c.triangles))
+                .collect();
+            assert_eq!(read.is_ok(), manifold);
+            match read {
+                Ok(read) => {
+                    for (r, b) in read.iter().zip(built) {
+                        let b = b.expect("a chart both sides accept");
+                        assert_eq!((&r.origin, &r.twin, &r.out), (&b.origin, &b.twin, &b.out));
+                    }
+                }
+                Err(_) => assert!(built.iter().any(Result::is_err)),
+            }
+        }
     }
 
     #[test]

@@ -6,10 +6,9 @@ use std::ops::Range;
 
 use super::conquest::{PassInput, Scratch};
 use super::{read_pass, Level};
-use crate::charts::{canonical_faces, cut, decode_labels};
+use crate::charts::{canonical_level, chart_connectivity, cut, decode_labels, CanonicalLevel};
 use crate::format::Reader;
 use crate::gates::PassKind;
-use crate::halfedge::Connectivity;
 use crate::{Error, Result};
 
 pub(super) struct Charted {
@@ -71,38 +70,38 @@ impl Charted {
         charts: usize,
         labelled: Option<Labelled>,
     ) -> Result<Charted> {
-        let (faces, labels) = match labelled {
-            Some(l) if l.bytes == labels && l.charts == charts => (l.faces, l.labels),
+        let (level_faces, labels) = match labelled {
+            Some(l) if l.bytes == labels && l.charts == charts => (l.level, l.labels),
             _ => labelled_faces(level, labels, charts)?,
         };
         let count = charts;
-        let charts = cut(&faces, &labels, charts, level.vertex_count())
+        let cuts = cut(level_faces.faces(), &labels, charts, level.vertex_count());
+        let connectivity = chart_connectivity(&cuts, &labels, &level_faces.adjacency)
+            .map_err(|e| Error::stream(format!("a chart is not a manifold: {e}")))?;
+        let pick = |v: &u32| *v as usize;
+        let charts = cuts
             .into_iter()
-            .map(|c| {
-                let conn = Connectivity::from_triangles(c.global.len(), &c.triangles)
-                    .map_err(|e| Error::stream(format!("a chart is not a manifold: {e}")))?;
-                let pick = |v: &u32| *v as usize;
-                Ok(Chart {
-                    level: Level {
-                        conn,
-                        quantization: level.quantization,
-                        positions_q: c
-                            .global
-                            .iter()
-                            .map(|v| level.positions_q[pick(v)])
-                            .collect(),
-                        positions: c.global.iter().map(|v| level.positions[pick(v)]).collect(),
-                        colours: level
-                            .colours
-                            .as_ref()
-                            .map(|colours| c.global.iter().map(|v| colours[pick(v)]).collect()),
-                    },
-                    scratch: Scratch::default(),
-                    before_last: c.global.len(),
-                    global: c.global,
-                })
+            .zip(connectivity)
+            .map(|(c, conn)| Chart {
+                level: Level {
+                    conn,
+                    quantization: level.quantization,
+                    positions_q: c
+                        .global
+                        .iter()
+                        .map(|v| level.positions_q[pick(v)])
+                        .collect(),
+                    positions: c.global.iter().map(|v| level.positions[pick(v)]).collect(),
+                    colours: level
+                        .colours
+                        .as_ref()
+                        .map(|colours| c.global.iter().map(|v| colours[pick(v)]).collect()),
+                },
+                scratch: Scratch::default(),
+                before_last: c.global.len(),
+                global: c.global,
             })
-            .collect::<Result<Vec<_>>>()?;
+            .collect();
         Ok(Charted {
             charts,
             indices: level.conn.origin.clone(),
@@ -119,7 +118,7 @@ impl Charted {
         Ok(Labelled {
             bytes: labels.to_vec(),
             charts,
-            faces,
+            level: faces,
             labels: l,
         })
     }
@@ -186,13 +185,17 @@ impl Charted {
     /// insertion order, and rebuilds the merged triangle list.
     pub(super) fn merge(&mut self, level: &mut Level) {
         for chart in &mut self.charts {
-            for v in chart.global.len()..chart.level.vertex_count() {
-                chart.global.push(level.positions_q.len() as u32);
-                level.positions_q.push(chart.level.positions_q[v]);
-                level.positions.push(chart.level.positions[v]);
-                if let (Some(out), Some(colours)) = (&mut level.colours, &chart.level.colours) {
-                    out.push(colours[v]);
-                }
+            let new = chart.global.len()..chart.level.vertex_count();
+            let first = level.positions_q.len() as u32;
+            chart.global.extend(first..first + new.len() as u32);
+            level
+                .positions_q
+                .extend_from_slice(&chart.level.positions_q[new.clone()]);
+            level
+                .positions
+                .extend_from_slice(&chart.level.positions[new.clone()]);
+            if let (Some(out), Some(colours)) = (&mut level.colours, &chart.level.colours) {
+                out.extend_from_slice(&colours[new]);
             }
         }
         self.indices.clear();
@@ -230,7 +233,7 @@ impl Charted {
 pub(super) struct Labelled {
     bytes: Vec<u8>,
     charts: usize,
-    faces: Vec<[u32; 3]>,
+    level: CanonicalLevel,
     labels: Vec<u32>,
 }
 
@@ -251,17 +254,10 @@ fn labelled_faces(
     level: &Level,
     labels: &[u8],
     charts: usize,
-) -> Result<(Vec<[u32; 3]>, Vec<u32>)> {
-    let (faces, _) = canonical_faces(
-        level
-            .conn
-            .origin
-            .chunks_exact(3)
-            .map(|t| [t[0], t[1], t[2]]),
-        std::iter::repeat(0),
-    );
-    let labels = decode_labels(labels, &faces, level.vertex_count(), charts)?;
-    Ok((faces, labels))
+) -> Result<(CanonicalLevel, Vec<u32>)> {
+    let canonical = canonical_level(&level.conn)?;
+    let labels = decode_labels(labels, &canonical.adjacency, charts)?;
+    Ok((canonical, labels))
 }
 
 impl Chart {
