@@ -73,13 +73,21 @@ impl Connectivity {
                 edge[0],
             )),
         })?;
+        let conn = Connectivity::paired(vertex_count, origin, twin);
+        conn.check_vertex_fans()?;
+        Ok(conn)
+    }
+
+    /// Faces `origin` whose half-edges are paired by `twin` already, each
+    /// vertex leaving by the last half-edge that starts at it (as
+    /// [`Connectivity::from_triangles`] chooses). `origin` must index
+    /// `vertex_count` vertices (it panics otherwise).
+    pub(crate) fn paired(vertex_count: usize, origin: Vec<u32>, twin: Vec<u32>) -> Self {
         let mut out = vec![NONE; vertex_count];
         for (h, &v) in origin.iter().enumerate() {
             out[v as usize] = h as u32;
         }
-        let conn = Connectivity { origin, twin, out };
-        conn.check_vertex_fans()?;
-        Ok(conn)
+        Connectivity { origin, twin, out }
     }
 
     /// Every vertex's faces must form one fan, or rotation would miss some.

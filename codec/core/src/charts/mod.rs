@@ -133,12 +133,8 @@ pub(crate) fn canonical_level(conn: &Connectivity) -> Result<CanonicalLevel> {
             ));
         }
     }
-    let mut out = vec![NONE; vertex_count];
-    for (h, &v) in origin.iter().enumerate() {
-        out[v as usize] = h as u32;
-    }
     Ok(CanonicalLevel {
-        adjacency: Connectivity { origin, twin, out },
+        adjacency: Connectivity::paired(vertex_count, origin, twin),
     })
 }
 
@@ -222,11 +218,7 @@ pub(crate) fn chart_connectivity(
                     });
                 }
             }
-            let mut out = vec![NONE; chart.global.len()];
-            for (h, &v) in origin.iter().enumerate() {
-                out[v as usize] = h as u32;
-            }
-            let conn = Connectivity { origin, twin, out };
+            let conn = Connectivity::paired(chart.global.len(), origin, twin);
             conn.check_vertex_fans()?;
             Ok(conn)
         })
