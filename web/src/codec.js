@@ -314,16 +314,30 @@ export function splitStream(stream) {
   const view = new DataView(stream.buffer, stream.byteOffset, stream.byteLength);
   const magic = String.fromCharCode(...stream.subarray(0, 4));
   if (magic !== 'VTRN') throw new DecodeError('not a Vitrine stream');
-  const batches = view.getUint32(24, true);
-  const headerLen = 40 + 12 * batches;
-  let at = headerLen;
+  const levels = levelTable(stream);
+  let at = 40 + 12 * (levels.length - 1);
   const parts = [];
-  for (let k = 0; k <= batches; k++) {
-    const bytes = view.getUint32(28 + 12 * k + 8, true);
+  for (const [k, { bytes }] of levels.entries()) {
     parts.push(stream.subarray(k === 0 ? 0 : at, at + bytes));
     at += bytes;
   }
   return { base: parts[0], batches: parts.slice(1) };
+}
+
+/**
+ * A stream's level table (FORMAT.md), from its header: each level's vertex
+ * and face counts and its chunk's bytes (the base's includes the header).
+ * @param {Uint8Array} stream the stream, or any prefix holding its header
+ * @returns {{ vertices: number, faces: number, bytes: number }[]}
+ */
+export function levelTable(stream) {
+  const view = new DataView(stream.buffer, stream.byteOffset, stream.byteLength);
+  const batches = view.getUint32(24, true);
+  return Array.from({ length: batches + 1 }, (_, k) => ({
+    vertices: view.getUint32(28 + 12 * k, true),
+    faces: view.getUint32(28 + 12 * k + 4, true),
+    bytes: view.getUint32(28 + 12 * k + 8, true),
+  }));
 }
 
 /** The chunk tag of a parted batch (a charted stream's fine levels). */

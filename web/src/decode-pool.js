@@ -17,7 +17,7 @@
  * It behaves like a StreamDecoder, except that `apply` returns a promise.
  */
 
-import { DecodeError, PARTED_TAG } from './codec.js';
+import { DecodeError, PARTED_TAG, levelTable } from './codec.js';
 import { chartUpdates, shareCharts } from './chart-helper.js';
 
 export { shareCharts };
@@ -29,18 +29,6 @@ export { shareCharts };
  * @property {(message: import('./chart-helper.js').HelperCommand, transfer: Transferable[]) => void} postMessage
  * @property {((event: MessageEvent<import('./chart-helper.js').HelperReply>) => void) | null} onmessage
  */
-
-/**
- * Every level's vertex count from a stream's level table (FORMAT.md; the
- * decoder has checked the header already).
- * @param {Uint8Array} base
- * @returns {number[]}
- */
-function levelVertices(base) {
-  const view = new DataView(base.buffer, base.byteOffset, base.byteLength);
-  const batches = view.getUint32(24, true);
-  return Array.from({ length: batches + 1 }, (_, k) => view.getUint32(28 + 12 * k, true));
-}
 
 /** The merged level of a charted stream, grown by every member's chart updates. */
 class ChartMerge {
@@ -119,7 +107,7 @@ export class PooledDecoder {
     this.#ports = ports;
     this.#waiting = ports.map(() => []);
     this.#active = ports.map((_, i) => i);
-    this.#levels = levelVertices(base);
+    this.#levels = levelTable(base).map((level) => level.vertices);
     ports.forEach((port, i) => {
       port.onmessage = (event) => this.#reply(i, event.data);
     });

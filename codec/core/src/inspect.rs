@@ -1,6 +1,8 @@
 //! Per-level byte breakdown of a stream, read from section lengths only.
 
+use crate::decoder::read_pass;
 use crate::format::{ChunkHeader, Reader, BASE_TAG, BATCH_TAG, PARTED_TAG};
+use crate::gates::PassKind;
 use crate::{Result, StreamIndex};
 
 /// Where the bytes of one level went.
@@ -67,15 +69,11 @@ pub fn breakdown(stream: &[u8]) -> Result<Vec<LevelBreakdown>> {
 
 /// Adds a batch's (or a chart part's) two passes' section sizes to `b`.
 fn add_passes(r: &mut Reader<'_>, b: &mut LevelBreakdown) -> Result<()> {
-    for _pass in 0..2 {
-        let seeds = r.varint()?;
-        for _ in 0..2 * seeds {
-            r.varint()?;
-        }
-        r.varint()?;
-        b.connectivity += r.section()?.len() as u32;
-        b.geometry += r.section()?.len() as u32;
-        b.colour += r.section()?.len() as u32;
+    for kind in [PassKind::Cleaning, PassKind::Decimating] {
+        let pass = read_pass(r, kind)?;
+        b.connectivity += pass.connectivity.len() as u32;
+        b.geometry += pass.geometry.len() as u32;
+        b.colour += pass.colour.len() as u32;
     }
     Ok(())
 }

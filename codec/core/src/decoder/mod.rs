@@ -484,7 +484,9 @@ fn read_chart_count(r: &mut Reader) -> Result<usize> {
     Ok(charts)
 }
 
-fn read_pass<'a>(r: &mut Reader<'a>, kind: PassKind) -> Result<PassInput<'a>> {
+/// One pass of a batch or a chart's part: its seeds, its count and its
+/// three sections (FORMAT.md).
+pub(crate) fn read_pass<'a>(r: &mut Reader<'a>, kind: PassKind) -> Result<PassInput<'a>> {
     let count = r.varint()? as usize;
     // Each seed takes at least two bytes: never trust the count beyond that.
     if count > r.remaining() / 2 {
