@@ -70,13 +70,13 @@ impl Charted {
         charts: usize,
         labelled: Option<Labelled>,
     ) -> Result<Charted> {
-        let (level_faces, labels) = match labelled {
+        let (canonical, labels) = match labelled {
             Some(l) if l.bytes == labels && l.charts == charts => (l.level, l.labels),
             _ => labelled_faces(level, labels, charts)?,
         };
         let count = charts;
-        let cuts = cut(level_faces.faces(), &labels, charts, level.vertex_count());
-        let connectivity = chart_connectivity(&cuts, &labels, &level_faces.adjacency)
+        let cuts = cut(canonical.faces(), &labels, charts, level.vertex_count());
+        let connectivity = chart_connectivity(&cuts, &labels, &canonical.adjacency)
             .map_err(|e| Error::stream(format!("a chart is not a manifold: {e}")))?;
         let pick = |v: &u32| *v as usize;
         let charts = cuts
@@ -114,11 +114,11 @@ impl Charted {
     /// The faces of `level` labelled by a first parted batch's labels,
     /// without cutting anything (see [`Labelled::sizes`]); kept for the cut.
     pub(super) fn labelled(level: &Level, labels: &[u8], charts: usize) -> Result<Labelled> {
-        let (faces, l) = labelled_faces(level, labels, charts)?;
+        let (canonical, l) = labelled_faces(level, labels, charts)?;
         Ok(Labelled {
             bytes: labels.to_vec(),
             charts,
-            level: faces,
+            level: canonical,
             labels: l,
         })
     }
