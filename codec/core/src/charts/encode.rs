@@ -145,13 +145,13 @@ pub(crate) fn encode_charted(
     drop(global);
 
     // The level where charts begin, as the decoder will have it, and its cut.
-    let (faces, labels) = canonical_faces(
-        coarse_faces
-            .iter()
-            .map(|t| t.map(|v| plain.new_id[v as usize])),
-        coarse_labels.into_iter(),
-    );
     let level_vertices = coarse_vertices.len();
+    let level_faces: Vec<[u32; 3]> = coarse_faces
+        .iter()
+        .map(|t| t.map(|v| plain.new_id[v as usize]))
+        .collect();
+    let (faces, labels) = canonical_faces(&level_faces, level_vertices, &coarse_labels);
+    drop(level_faces);
     let cuts = cut(&faces, &labels, charts, level_vertices);
     let labels_bytes = encode_labels(&faces, level_vertices, &labels, charts)?;
 

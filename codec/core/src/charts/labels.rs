@@ -83,7 +83,8 @@ mod tests {
             faces.push([a, b, d]);
             faces.push([a, d, c]);
         }
-        let (faces, _) = super::super::canonical_faces(faces.into_iter(), std::iter::repeat(0));
+        let vertices = 2 * n as usize + 2;
+        let (faces, _) = super::super::canonical_faces(&faces, vertices, &vec![0; faces.len()]);
         faces
     }
 

@@ -37,58 +37,24 @@ fn smallest_corner(t: [u32; 3]) -> usize {
     }
 }
 
-/// A face rotated so its smallest vertex id comes first (orientation kept).
-fn canonical(t: [u32; 3]) -> [u32; 3] {
-    rotated(t, smallest_corner(t))
-}
-
 /// Face `t` starting from corner `i`.
 fn rotated(t: [u32; 3], i: usize) -> [u32; 3] {
     [t[i], t[(i + 1) % 3], t[(i + 2) % 3]]
 }
 
-/// The faces of the level where charts begin in the order both sides label
-/// them, with `tag` (a label, or the face's index elsewhere) carried along:
-/// each face rotated to its smallest vertex, then sorted.
-pub(crate) fn canonical_faces(
-    triangles: impl Iterator<Item = [u32; 3]>,
-    tags: impl Iterator<Item = u32>,
-) -> (Vec<[u32; 3]>, Vec<u32>) {
-    let mut faces: Vec<([u32; 3], u32)> = triangles.map(canonical).zip(tags).collect();
-    faces.sort_unstable();
-    faces.into_iter().unzip()
-}
-
-/// The level where charts begin, as the decoder holds it, in the order
-/// both sides label it ([`canonical_faces`]): canonical face `i` is
-/// half-edges `3i..3i + 3` of `adjacency`.
-pub(crate) struct CanonicalLevel {
-    pub adjacency: Connectivity,
-}
-
-impl CanonicalLevel {
-    pub(crate) fn faces(&self) -> &[[u32; 3]] {
-        self.adjacency.origin.as_chunks().0
-    }
-}
-
-/// [`canonical_faces`] of a level, with the adjacency read off the level's
-/// own half-edges: faces bucketed by their smallest vertex (ids are dense,
-/// so no sort of the whole level) and no edge table built. The decoder's
-/// cut did both, and took about as long as decoding a level of its size.
-pub(crate) fn canonical_level(conn: &Connectivity) -> Result<CanonicalLevel> {
-    let vertex_count = conn.out.len();
-    if conn.origin.iter().any(|&v| v as usize >= vertex_count) {
-        return Err(Error::stream("a face names a vertex the level lacks"));
-    }
-    let triangles: &[[u32; 3]] = conn.origin.as_chunks().0;
+/// The order both sides list the faces of the level where charts begin in
+/// (FORMAT.md, "canonical order"): each face rotated to its smallest vertex
+/// (orientation kept), then sorted. Faces are bucketed by their smallest
+/// vertex (ids are dense, so the level is never sorted whole), then each
+/// bucket is sorted. Returns each face's rotation (the corner it starts
+/// from) and the faces in that order. `triangles` index `vertex_count`
+/// vertices (it panics otherwise).
+fn canonical_order(triangles: &[[u32; 3]], vertex_count: usize) -> (Vec<u8>, Vec<u32>) {
     let rotation: Vec<u8> = triangles
         .iter()
         .map(|&t| smallest_corner(t) as u8)
         .collect();
     let smallest = |f: usize| triangles[f][rotation[f] as usize] as usize;
-    let canonical_face = |f: u32| rotated(triangles[f as usize], rotation[f as usize] as usize);
-    // Faces by smallest vertex (a counting sort), then each bucket in order.
     let mut starts = vec![0u32; vertex_count + 1];
     for f in 0..triangles.len() {
         starts[smallest(f) + 1] += 1;
@@ -107,9 +73,55 @@ pub(crate) fn canonical_level(conn: &Connectivity) -> Result<CanonicalLevel> {
     for bucket in starts.windows(2) {
         let faces = &mut order[bucket[0] as usize..bucket[1] as usize];
         if faces.len() > 1 {
-            faces.sort_unstable_by_key(|&f| canonical_face(f));
+            faces.sort_unstable_by_key(|&f| {
+                rotated(triangles[f as usize], rotation[f as usize] as usize)
+            });
         }
     }
+    (rotation, order)
+}
+
+/// The faces of the level where charts begin in canonical order
+/// ([`canonical_order`]), with each face's `tags` entry (its label) carried
+/// along. `triangles` index `vertex_count` vertices.
+pub(crate) fn canonical_faces(
+    triangles: &[[u32; 3]],
+    vertex_count: usize,
+    tags: &[u32],
+) -> (Vec<[u32; 3]>, Vec<u32>) {
+    let (rotation, order) = canonical_order(triangles, vertex_count);
+    order
+        .iter()
+        .map(|&f| {
+            let f = f as usize;
+            (rotated(triangles[f], rotation[f] as usize), tags[f])
+        })
+        .unzip()
+}
+
+/// The level where charts begin, as the decoder holds it, in canonical
+/// order: canonical face `i` is half-edges `3i..3i + 3` of `adjacency`.
+pub(crate) struct CanonicalLevel {
+    pub adjacency: Connectivity,
+}
+
+impl CanonicalLevel {
+    pub(crate) fn faces(&self) -> &[[u32; 3]] {
+        self.adjacency.origin.as_chunks().0
+    }
+}
+
+/// A level in canonical order, with the adjacency read off the level's own
+/// half-edges rather than built from an edge table: the decoder's cut built
+/// one for the labels and one per chart, and took about as long as
+/// decoding a level of its size.
+pub(crate) fn canonical_level(conn: &Connectivity) -> Result<CanonicalLevel> {
+    let vertex_count = conn.out.len();
+    if conn.origin.iter().any(|&v| v as usize >= vertex_count) {
+        return Err(Error::stream("a face names a vertex the level lacks"));
+    }
+    let triangles: &[[u32; 3]] = conn.origin.as_chunks().0;
+    let (rotation, order) = canonical_order(triangles, vertex_count);
     let mut position = vec![0u32; triangles.len()];
     for (i, &f) in order.iter().enumerate() {
         position[f as usize] = i as u32;
@@ -125,8 +137,8 @@ pub(crate) fn canonical_level(conn: &Connectivity) -> Result<CanonicalLevel> {
     let mut origin = Vec::with_capacity(conn.origin.len());
     let mut twin = Vec::with_capacity(conn.origin.len());
     for &f in &order {
-        origin.extend(canonical_face(f));
         let r = rotation[f as usize] as u32;
+        origin.extend(rotated(triangles[f as usize], r as usize));
         for k in 0..3 {
             twin.push(canonical_half_edge(
                 conn.twin[(3 * f + (k + r) % 3) as usize],
@@ -185,28 +197,28 @@ pub(crate) fn cut(
     cuts
 }
 
-/// Each chart's connectivity, read off the level's (`adjacency`, in
-/// canonical order, [`canonical_level`]): a chart's half-edges pair as the
-/// level's do inside it and are borders along its cut, which is what
-/// [`Connectivity::from_triangles`] makes of its faces, without an edge
-/// table. The same check of every vertex's fan follows.
+/// Each chart's vertices (its cut's `global`) and connectivity, read off
+/// the level's (`adjacency`, in canonical order, [`canonical_level`]): a
+/// chart's half-edges pair as the level's do inside it and are borders
+/// along its cut, which is what [`Connectivity::from_triangles`] makes of
+/// its faces, without an edge table. The same check of every vertex's fan
+/// follows. The cuts' faces become the charts' connectivity (not copied).
 pub(crate) fn chart_connectivity(
-    cuts: &[Cut],
+    cuts: Vec<Cut>,
     labels: &[u32],
     adjacency: &Connectivity,
-) -> Result<Vec<Connectivity>> {
+) -> Result<Vec<(Vec<u32>, Connectivity)>> {
     // Each level face's place in its chart.
     let mut place = vec![0u32; labels.len()];
-    for chart in cuts {
+    for chart in &cuts {
         for (j, &f) in chart.faces.iter().enumerate() {
             place[f as usize] = j as u32;
         }
     }
-    cuts.iter()
+    cuts.into_iter()
         .enumerate()
         .map(|(c, chart)| {
-            let origin = chart.triangles.as_flattened().to_vec();
-            let mut twin = Vec::with_capacity(origin.len());
+            let mut twin = Vec::with_capacity(3 * chart.faces.len());
             for &f in &chart.faces {
                 for k in 0..3 {
                     let t = adjacency.twin[(3 * f + k) as usize];
@@ -218,9 +230,10 @@ pub(crate) fn chart_connectivity(
                     });
                 }
             }
+            let origin = chart.triangles.into_flattened();
             let conn = Connectivity::paired(chart.global.len(), origin, twin);
             conn.check_vertex_fans()?;
-            Ok(conn)
+            Ok((chart.global, conn))
         })
         .collect()
 }
@@ -231,6 +244,7 @@ mod tests {
 
     #[test]
     fn canonical_keeps_orientation() {
+        let canonical = |t: [u32; 3]| canonical_faces(&[t], 10, &[0]).0[0];
         assert_eq!(canonical([5, 2, 9]), [2, 9, 5]);
         assert_eq!(canonical([9, 5, 2]), [2, 9, 5]);
         assert_eq!(canonical([2, 9, 5]), [2, 9, 5]);
@@ -276,11 +290,13 @@ mod tests {
         let vertices = (n * n) as usize;
         let level = Connectivity::from_triangles(vertices, &faces).unwrap();
         let canonical = canonical_level(&level).unwrap();
-        let (expected, quads) = canonical_faces(
-            faces.iter().copied(),
-            torus.iter().map(|&(_, [i, j])| i * n + j),
-        );
+        let quads: Vec<u32> = torus.iter().map(|&(_, [i, j])| i * n + j).collect();
+        let (expected, quads) = canonical_faces(&faces, vertices, &quads);
         assert_eq!(canonical.faces(), &expected[..]);
+        // Canonical order itself: each face from its smallest vertex, all
+        // sorted (and distinct).
+        assert!(expected.iter().all(|t| t[0] < t[1] && t[0] < t[2]));
+        assert!(expected.windows(2).all(|w| w[0] < w[1]));
         let built = Connectivity::from_triangles(vertices, &expected).unwrap();
         assert_eq!(canonical.adjacency.twin, built.twin);
         assert_eq!(canonical.adjacency.out, built.out);
@@ -293,15 +309,15 @@ mod tests {
         let scattered: Vec<u32> = expected.iter().map(|t| t[0] % 3).collect();
         for (labels, charts, manifold) in [(quarters, 4, true), (scattered, 3, false)] {
             let cuts = cut(canonical.faces(), &labels, charts, vertices);
-            let read = chart_connectivity(&cuts, &labels, &canonical.adjacency);
             let built: Vec<_> = cuts
                 .iter()
                 .map(|c| Connectivity::from_triangles(c.global.len(), &c.triangles))
                 .collect();
+            let read = chart_connectivity(cuts, &labels, &canonical.adjacency);
             assert_eq!(read.is_ok(), manifold);
             match read {
                 Ok(read) => {
-                    for (r, b) in read.iter().zip(built) {
+                    for ((_, r), b) in read.iter().zip(built) {
                         let b = b.expect("a chart both sides accept");
                         assert_eq!((&r.origin, &r.twin, &r.out), (&b.origin, &b.twin, &b.out));
                     }
@@ -315,7 +331,7 @@ mod tests {
     fn cut_numbers_each_chart_by_first_appearance() {
         // Two quads sharing the edge 1–4: chart 0 the left, chart 1 the right.
         let faces = [[0, 1, 4], [0, 4, 3], [1, 2, 5], [1, 5, 4]];
-        let (faces, labels) = canonical_faces(faces.into_iter(), [0, 0, 1, 1].into_iter());
+        let (faces, labels) = canonical_faces(&faces, 6, &[0, 0, 1, 1]);
         let cuts = cut(&faces, &labels, 2, 6);
         assert_eq!(cuts[0].global, vec![0, 1, 4, 3]);
         assert_eq!(cuts[0].triangles, vec![[0, 1, 2], [0, 2, 3]]);

@@ -76,30 +76,24 @@ impl Charted {
         };
         let count = charts;
         let cuts = cut(canonical.faces(), &labels, charts, level.vertex_count());
-        let connectivity = chart_connectivity(&cuts, &labels, &canonical.adjacency)
-            .map_err(|e| Error::stream(format!("a chart is not a manifold: {e}")))?;
         let pick = |v: &u32| *v as usize;
-        let charts = cuts
+        let charts = chart_connectivity(cuts, &labels, &canonical.adjacency)
+            .map_err(|e| Error::stream(format!("a chart is not a manifold: {e}")))?
             .into_iter()
-            .zip(connectivity)
-            .map(|(c, conn)| Chart {
+            .map(|(global, conn)| Chart {
                 level: Level {
                     conn,
                     quantization: level.quantization,
-                    positions_q: c
-                        .global
-                        .iter()
-                        .map(|v| level.positions_q[pick(v)])
-                        .collect(),
-                    positions: c.global.iter().map(|v| level.positions[pick(v)]).collect(),
+                    positions_q: global.iter().map(|v| level.positions_q[pick(v)]).collect(),
+                    positions: global.iter().map(|v| level.positions[pick(v)]).collect(),
                     colours: level
                         .colours
                         .as_ref()
-                        .map(|colours| c.global.iter().map(|v| colours[pick(v)]).collect()),
+                        .map(|colours| global.iter().map(|v| colours[pick(v)]).collect()),
                 },
                 scratch: Scratch::default(),
-                before_last: c.global.len(),
-                global: c.global,
+                before_last: global.len(),
+                global,
             })
             .collect();
         Ok(Charted {
