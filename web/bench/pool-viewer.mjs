@@ -79,7 +79,11 @@ const median = (xs) => [...xs].sort((a, b) => a - b)[xs.length >> 1];
 async function measure(slug, decoders, m) {
   await load(slug, decoders, m.last_level); // warm-up: the service's caches, Chromium's compile cache
   const results = [];
-  for (let r = 0; r < runs; r++) results.push(await load(slug, decoders, m.last_level));
+  for (let r = 0; r < runs; r++) {
+    const x = await load(slug, decoders, m.last_level);
+    console.error(`${slug}, ${decoders} decoders: first ${x.first.toFixed(0)} ms, last ${x.last.toFixed(0)} ms, decode ${x.decode.toFixed(0)} ms`);
+    results.push(x);
+  }
   return {
     first: median(results.map((x) => x.first)),
     last: median(results.map((x) => x.last)),
