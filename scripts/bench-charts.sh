@@ -4,7 +4,8 @@
 # (`charts_bench`, every charted stream checked lossless), DracoPy on the
 # same meshes (size, native decode), then WebAssembly decode in Node:
 # format 4, format 5 decoded serially and by the viewer's decode pool of 2
-# and 4 workers, and draco3d; last, the viewer in headless Chromium on the
+# and 4 workers, and draco3d, and each pool member's share decoded alone
+# (a pool's critical path with a core per member); last, the viewer in headless Chromium on the
 # last mesh (time to the first and the last level, format 4 and format 5 on
 # 1, 2 and 4 decode workers; VIEWER=0 skips it).
 #
@@ -49,7 +50,7 @@ PY
     stems+=("$PWD/$stem")
 done
 echo "## WebAssembly in Node: one thread, and pools whose helpers run on worker threads (median of $runs)"
-(cd web && node bench/mesh-decode.mjs --draco3d /tmp/draco3d/node_modules/draco3d --runs "$runs" --workers 2,4 "${stems[@]}")
+(cd web && node bench/mesh-decode.mjs --draco3d /tmp/draco3d/node_modules/draco3d --runs "$runs" --workers 2,4 --members 2,4 "${stems[@]}")
 if [ "${VIEWER:-1}" != 0 ]; then
     echo
     echo "## The viewer in headless Chromium (SwiftShader), ${*: -1}"

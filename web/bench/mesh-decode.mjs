@@ -9,13 +9,18 @@
 // one process. The files come from scripts/bench-charts.sh (STEM.vtr,
 // STEM.v5.vtr, STEM.drc):
 //   node bench/mesh-decode.mjs --draco3d /tmp/draco3d/node_modules/draco3d [--workers 2,4] DIR/igea …
+// `--members 2,4` also times, for each pool size, every member's share of
+// the charts decoded alone on this thread (the global layers, the cut and
+// its charts, as a pool member decodes them): the slowest is that pool's
+// critical path on a machine with a core per member, before merging and
+// messages (which the pool rows above include).
 import { existsSync, readFileSync } from 'node:fs';
 import { createRequire } from 'node:module';
 import { basename, join } from 'node:path';
 import { parseArgs } from 'node:util';
 import { Worker } from 'node:worker_threads';
-import { VitrineCodec, splitStream } from '../src/codec.js';
-import { PooledDecoder } from '../src/decode-pool.js';
+import { PARTED_TAG, VitrineCodec, splitStream } from '../src/codec.js';
+import { PooledDecoder, shareCharts } from '../src/decode-pool.js';
 import { wasmPath } from '../test/support/fixtures.mjs';
 
 const { values, positionals } = parseArgs({
@@ -24,6 +29,7 @@ const { values, positionals } = parseArgs({
     draco3d: { type: 'string' },
     runs: { type: 'string', default: '5' },
     workers: { type: 'string', default: '2,4' },
+    members: { type: 'string', default: '' },
   },
 });
 if (!values.draco3d || positionals.length === 0) {
@@ -83,6 +89,49 @@ async function decodePooled(bytes, members) {
   const n = pool.view().vertices;
   pool.free();
   return n;
+}
+
+/**
+ * Every level of a charted stream as one pool member decodes it: the charts
+ * in `share` only, from the first parted batch on.
+ * @param {Uint8Array} bytes
+ * @param {number[]} share
+ */
+function decodeMember(bytes, share) {
+  const { base, batches } = splitStream(bytes);
+  const decoder = codec.decoder(base);
+  let shared = false;
+  for (const batch of batches) {
+    if (!shared && batch[0] === PARTED_TAG) {
+      decoder.refineOnly(share);
+      shared = true;
+    }
+    decoder.apply(batch);
+  }
+  const n = decoder.chartCount();
+  decoder.free();
+  return n;
+}
+
+/**
+ * How `members` members share a charted stream's charts (decode-pool.js's
+ * rule, from the first parted batch's chart sizes).
+ * @param {Uint8Array} bytes
+ * @param {number} members
+ */
+function memberShares(bytes, members) {
+  const { base, batches } = splitStream(bytes);
+  const decoder = codec.decoder(base);
+  let sizes = [];
+  for (const batch of batches) {
+    if (batch[0] === PARTED_TAG) {
+      sizes = decoder.chartSizes(batch);
+      break;
+    }
+    decoder.apply(batch);
+  }
+  decoder.free();
+  return shareCharts(sizes, members);
 }
 
 /** @param {() => number} f @returns {{ ms: number, n: number }} */
@@ -161,5 +210,24 @@ for (const stem of positionals) {
   console.log(
     `| ${basename(stem)} | ${plain.n} | ${ms(plain.ms)} | ${charted ? ms(charted.ms) : '–'} | ${cells((r) => ms(r.ms))} | ${ms(draco.ms)} | ${(plain.ms / draco.ms).toFixed(2)} | ${cells((r) => (r.ms / draco.ms).toFixed(2))} | ${charted ? (plain.ms / charted.ms).toFixed(2) : '–'} | ${cells((r) => (plain.ms / r.ms).toFixed(2))} |`,
   );
+}
+const memberCounts = values.members.split(',').filter(Boolean).map(Number);
+if (memberCounts.length > 0) {
+  console.log();
+  console.log('| mesh | members | charts per member | each member alone | slowest (critical path) | draco3d | critical path / draco3d |');
+  console.log('|---|---:|---|---|---:|---:|---:|');
+  for (const stem of positionals) {
+    if (!existsSync(`${stem}.v5.vtr`)) continue;
+    const v5 = readFileSync(`${stem}.v5.vtr`);
+    const draco = median(() => decodeDraco(readFileSync(`${stem}.drc`)));
+    for (const members of memberCounts) {
+      const shares = memberShares(v5, members).filter((share) => share.length > 0);
+      const alone = shares.map((share) => median(() => decodeMember(v5, share)).ms);
+      const slowest = Math.max(...alone);
+      console.log(
+        `| ${basename(stem)} | ${members} | ${shares.map((share) => share.join('+')).join(', ')} | ${alone.map((ms) => ms.toFixed(1)).join(', ')} ms | ${slowest.toFixed(1)} ms | ${draco.ms.toFixed(1)} ms | ${(slowest / draco.ms).toFixed(2)} |`,
+      );
+    }
+  }
 }
 for (const thread of threads) await thread.terminate();
