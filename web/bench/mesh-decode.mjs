@@ -122,6 +122,7 @@ function decodeMember(bytes, share) {
 function memberShares(bytes, members) {
   const { base, batches } = splitStream(bytes);
   const decoder = codec.decoder(base);
+  /** @type {number[]} */
   let sizes = [];
   for (const batch of batches) {
     if (batch[0] === PARTED_TAG) {
