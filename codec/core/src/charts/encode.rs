@@ -13,13 +13,28 @@ use crate::halfedge::{Connectivity, NONE};
 use crate::quantize::Quantization;
 use crate::{Error, Result};
 
-/// A chart's fine layers stop once it has this fraction of its vertices
-/// left (or a layer removes too little): what remains, cut vertices and
-/// coarse interiors, goes to the global layers. (1/3 to 1/16 change igea's
-/// size by under 4 ‰ and its 2 M upsample's at 42 charts by 1.8 %, earlier
-/// stops smaller; 1/8 leaves about 10 % of the vertices to the serial
-/// global layers. docs/bench-log/2026-12-04-session-17-charts.md)
-const CHART_REDUCTION: usize = 8;
+/// A chart's fine layers stop once it has 1/`chart_reduction` of its
+/// vertices left (or a layer removes too little): what remains, cut
+/// vertices and coarse interiors, goes to the global layers, which every
+/// member of a decoding pool runs in full before its charts. A large
+/// chart's cut is a small part of it, so it can go further for little
+/// size, and the pool saves far more time: at `--charts auto` (charts of
+/// 50 k vertices or more), 1/8 → 1/16 took igea +1.05 → +1.42 % over the
+/// plain stream and its 2 M upsample +1.32 → +1.52 %, and the slowest
+/// member's decode 55.9 → 48.8 ms and 564 → 477 ms (1/32: +1.67 % and
+/// +1.80 %, 46.9 and 464 ms). Charts of 9–34 k vertices paid +0.2 to
+/// +1.8 points at 1/16, so they stop at 1/8.
+/// docs/bench-log/2026-12-04-session-20-bounds.md
+fn chart_reduction(vertices: usize) -> usize {
+    if vertices >= LARGE_CHART {
+        16
+    } else {
+        8
+    }
+}
+
+/// Vertices from which a chart counts as large ([`chart_reduction`]).
+const LARGE_CHART: usize = 50_000;
 
 /// A chart after its fine layers.
 struct ChartLayers {
@@ -299,7 +314,7 @@ fn chart_layers(
         },
         vertices.iter().map(|&v| shared[v as usize]).collect(),
         options,
-        vertices.len() / CHART_REDUCTION,
+        vertices.len() / chart_reduction(vertices.len()),
         guard,
         |e| e,
         |_| {},
