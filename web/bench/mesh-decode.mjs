@@ -220,7 +220,8 @@ if (memberCounts.length > 0) {
   for (const stem of positionals) {
     if (!existsSync(`${stem}.v5.vtr`)) continue;
     const v5 = readFileSync(`${stem}.v5.vtr`);
-    const draco = median(() => decodeDraco(readFileSync(`${stem}.drc`)));
+    const drc = readFileSync(`${stem}.drc`);
+    const draco = median(() => decodeDraco(drc));
     for (const members of memberCounts) {
       const shares = memberShares(v5, members).filter((share) => share.length > 0);
       const alone = shares.map((share) => median(() => decodeMember(v5, share)).ms);
