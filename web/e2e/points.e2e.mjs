@@ -8,7 +8,7 @@
 // as for a mesh; the mesh-only tools are hidden; the gallery lists it.
 import { after, before, test } from 'node:test';
 import assert from 'node:assert/strict';
-import { launch } from '../test/support/browser.mjs';
+import { launch, noticeMatching } from '../test/support/browser.mjs';
 import { startService } from '../test/support/service.mjs';
 import { foreground } from '../test/support/raster.mjs';
 
@@ -170,9 +170,13 @@ test('a batch answered 503 with Retry-After is waited for and fetched again', as
 
 test('a batch refused by a load cap holds the cloud at the level before, says so, and resumes', async () => {
   const page = await browser.context.newPage();
+  // The cap holds until the notice has been read: a retry every second
+  // must not lift it while a loaded machine is still polling.
+  let lifted = false;
   let refused = 0;
   await page.route('**/batches/2*', async (route) => {
-    if (++refused === 1) {
+    if (!lifted) {
+      refused++;
       await route.fulfill({
         status: 429,
         headers: { 'retry-after': '1' },
@@ -183,10 +187,13 @@ test('a batch refused by a load cap holds the cloud at the level before, says so
   await page.goto(`${service.url}/m/cube`);
   const capped = await until(page, "s.status === 'capped'");
   assert.equal(capped.shownLevel, 1);
-  assert.match(String((await shadow(page, '.notice'))?.text), /^Refinement limited to level 1 of \d+: the server is busy; trying again every 1 s\.$/);
+  const expected = /^Refinement limited to level 1 of \d+: the server is busy; trying again every 1 s\.$/;
+  await noticeMatching(page, expected);
+  lifted = true;
   const done = await until(page, "s.status === 'complete'", 30_000);
   assert.equal(done.shownLevel, manifest.last_level);
   assert.equal((await shadow(page, '.notice'))?.hidden, true);
+  assert.ok(refused >= 1);
   await page.close();
 });
 

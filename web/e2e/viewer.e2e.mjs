@@ -5,7 +5,7 @@ import { after, before, test } from 'node:test';
 import assert from 'node:assert/strict';
 import { readFileSync } from 'node:fs';
 import { createServer } from 'node:http';
-import { launch } from '../test/support/browser.mjs';
+import { launch, noticeMatching } from '../test/support/browser.mjs';
 import { startService } from '../test/support/service.mjs';
 import { wasmPath } from '../test/support/fixtures.mjs';
 import { compareImages, foreground, rasterize } from '../test/support/raster.mjs';
@@ -294,11 +294,14 @@ test('a phone stops at its cap, says so, and fetches nothing above it', async ()
 test('a load cap is retried and refinement resumes when it rises', async () => {
   const page = await browser.context.newPage();
   let manifests = 0;
+  // The cap holds until the notice has been read: a retry every second
+  // must not lift it while a loaded machine is still polling.
+  let lifted = false;
   await page.route('**/api/models/torus*', async (route) => {
     manifests++;
     const response = await route.fetch();
     const body = await response.json();
-    if (manifests === 1) {
+    if (!lifted) {
       body.cap = { ...body.cap, level: 2, reason: 'load', retry_after_s: 1 };
     }
     await route.fulfill({ response, json: body });
@@ -306,7 +309,8 @@ test('a load cap is retried and refinement resumes when it rises', async () => {
   await page.goto(`${service.url}/m/torus`);
   const capped = await until(page, `s.status === 'capped'`);
   assert.equal(capped.shownLevel, 2);
-  assert.match(await shadowText(page, '.notice'), /^Refinement limited to level 2 of \d+: the server is busy; trying again every 1 s\.$/);
+  await noticeMatching(page, /^Refinement limited to level 2 of \d+: the server is busy; trying again every 1 s\.$/);
+  lifted = true;
   const done = await until(page, `s.status === 'complete'`, 15_000);
   assert.equal(done.shownLevel, manifest.last_level);
   assert.equal(await shadowHidden(page, '.notice'), true);

@@ -49,3 +49,21 @@ export async function launch(options = {}) {
   };
   return { context, close };
 }
+
+/**
+ * Waits until the `<vitrine-viewer>` notice reads `pattern` (fails after
+ * 10 s). The viewer's state and its notice are not updated in one step, so
+ * a single read right after a state change can fall between them.
+ * @param {import('playwright-core').Page} page
+ * @param {RegExp} pattern
+ */
+export function noticeMatching(page, pattern) {
+  return page.waitForFunction(
+    ([source, flags]) => {
+      const e = /** @type {HTMLElement | null} */ (document.querySelector('vitrine-viewer')?.shadowRoot?.querySelector('.notice') ?? null);
+      return e !== null && new RegExp(source, flags).test(e.innerText);
+    },
+    [pattern.source, pattern.flags],
+    { timeout: 10_000, polling: 50 },
+  );
+}
