@@ -77,21 +77,32 @@ pub(crate) fn umbrellas(
 ) {
     out.clear();
     out.resize(positions.len(), [0; 4]);
+    // Σ (neighbour − vertex) = Σ neighbour − count × vertex: the sweep adds
+    // only the neighbours (one position load per half-edge, not two; it is
+    // bound by the random accesses to `out`), a sequential pass subtracts.
+    // Wrapping, so the result is the exact sum modulo 2³² either way.
     for t in conn.origin.chunks_exact(3) {
         if t[0] == crate::halfedge::NONE {
             continue;
         }
+        let corners = [t[0], t[1], t[2]].map(|v| positions[v as usize]);
         for k in 0..3 {
-            let (a, b) = (t[k] as usize, t[(k + 1) % 3] as usize);
-            let u = &mut out[a];
+            let b = corners[(k + 1) % 3];
+            let u = &mut out[t[k] as usize];
             for c in 0..3 {
-                u[c] += positions[b][c] - positions[a][c];
+                u[c] = u[c].wrapping_add(b[c]);
             }
             u[3] += 1;
         }
     }
     valences.clear();
-    valences.extend(out.iter().map(|u| u[3].clamp(0, 255) as u8));
+    valences.reserve(out.len());
+    for (u, p) in out.iter_mut().zip(positions) {
+        for c in 0..3 {
+            u[c] = u[c].wrapping_sub(u[3].wrapping_mul(p[c]));
+        }
+        valences.push(u[3].clamp(0, 255) as u8);
+    }
 }
 
 /// How far the fine surface bulges out of the border polygon, from the
