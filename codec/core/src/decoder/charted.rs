@@ -285,8 +285,7 @@ impl Chart {
         }
         level.conn.origin.reserve(6 * grow);
         level.conn.twin.reserve(6 * grow);
-        level.undo_pass(&cleaning, &mut self.scratch)?;
-        level.undo_pass(&decimating, &mut self.scratch)
+        level.undo_batch(&cleaning, &decimating, &mut self.scratch)
     }
 }
 

@@ -247,8 +247,7 @@ impl Decoder {
         self.level.conn.twin.reserve(6 * grow);
         let undone = self
             .level
-            .undo_pass(&cleaning, &mut self.scratch)
-            .and_then(|()| self.level.undo_pass(&decimating, &mut self.scratch));
+            .undo_batch(&cleaning, &decimating, &mut self.scratch);
         if undone.is_err() {
             // Fans may be in without their vertices' positions: refuse
             // whatever comes next rather than walk a half-built level.
