@@ -47,7 +47,10 @@ v, f, _, _ = load(sys.argv[2])
 with open(sys.argv[3], "wb") as out:
     out.write(DracoPy.encode(v.astype(np.float32), f.astype(np.uint32), quantization_bits=12, compression_level=10))
 PY
-    stems+=("$PWD/$stem")
+    case $stem in
+        /*) stems+=("$stem") ;;
+        *) stems+=("$PWD/$stem") ;;
+    esac
 done
 echo "## WebAssembly in Node: one thread, and pools whose helpers run on worker threads (median of $runs)"
 (cd web && node bench/mesh-decode.mjs --draco3d /tmp/draco3d/node_modules/draco3d --runs "$runs" --workers 2,4 --members 2,4 "${stems[@]}")
