@@ -2,6 +2,7 @@
 
 mod charted;
 mod conquest;
+mod umbrellas;
 
 use crate::base_mesh;
 use crate::charts::MAX_CHARTS;
