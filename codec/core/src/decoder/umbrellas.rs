@@ -103,26 +103,13 @@ impl Umbrellas {
     /// The pass is over: its gains join the umbrellas, and its vertices'
     /// umbrellas follow in insertion order.
     pub(super) fn end_pass(&mut self) {
-        let fold = |u: &Umbrella| Umbrella {
-            start: std::array::from_fn(|c| u.start[c].wrapping_add(u.gained[c])),
-            gained: [0; 4],
-        };
-        let needed = self.records.len() + self.inserted.len();
-        if needed > self.records.capacity() {
-            // Folded into a larger block rather than grown first: growing
-            // copies every record, and WebAssembly's allocator cannot remap.
-            let mut grown = Vec::with_capacity(needed.max(2 * self.records.capacity()));
-            grown.extend(self.records.iter().map(fold));
-            self.records = grown;
-        } else {
-            for u in &mut self.records {
-                *u = fold(u);
+        for (u, valence) in self.records.iter_mut().zip(&mut self.valences) {
+            for c in 0..4 {
+                u.start[c] = u.start[c].wrapping_add(u.gained[c]);
             }
-        }
-        for (u, valence) in self.records.iter().zip(&mut self.valences) {
+            u.gained = [0; 4];
             *valence = u.start[3].clamp(0, 255) as u8;
         }
-        self.valences.reserve(self.inserted.len());
         for &start in &self.inserted {
             self.records.push(Umbrella {
                 start,
