@@ -94,8 +94,6 @@ pub(crate) struct Region {
 pub(crate) struct Border {
     pub valence: usize,
     pub polygon: [u32; MAX_VALENCE],
-    /// The patch's `valence − 3` diagonals, as indices into `polygon`.
-    pub diagonals: [[u8; 2]; MAX_VALENCE - 3],
 }
 
 /// Adaptive models of the connectivity codes of one pass, each starting
@@ -322,12 +320,10 @@ impl Traversal {
                 "pass inserts more vertices than its header says",
             ));
         }
-        let pat = pattern(region.valence, g0, g1);
-        self.claim_patch(&region, pat);
+        self.claim_patch(&region, pattern(region.valence, g0, g1));
         self.borders.push(Border {
             valence: region.valence,
             polygon: region.polygon,
-            diagonals: diagonals(pat),
         });
         Ok(Some(region))
     }
@@ -457,16 +453,6 @@ impl Traversal {
             *t = tag;
         }
     }
-}
-
-/// A pattern's diagonals: each step of its walk crosses one.
-fn diagonals(pat: &Pattern) -> [[u8; 2]; MAX_VALENCE - 3] {
-    let mut out = [[0; 2]; MAX_VALENCE - 3];
-    for (d, &[from, k, _, _]) in out.iter_mut().zip(&pat.walk[..pat.valence - 3]) {
-        let t = &pat.triangles[from as usize];
-        *d = [t[k as usize], t[(k as usize + 1) % 3]];
-    }
-    out
 }
 
 /// The half-edges a patch's faces are entered by: the gate, then one per

@@ -121,18 +121,18 @@ pub(crate) const PREDICTION_BLOCK: usize = 32;
 
 impl PatchPrediction {
     /// The prediction for a removed vertex whose border polygon is `border`
-    /// (ids into the coarse mesh's `positions`, and `umbrella` of each).
+    /// (ids into the coarse mesh's `positions` and `umbrellas`).
     pub(crate) fn for_border(
         border: &[u32],
         positions: &[[i32; 3]],
-        umbrella: impl Fn(u32) -> [i32; 4],
+        umbrellas: &[[i32; 4]],
     ) -> Self {
         let d = border.len();
         let mut polygon = [[0i32; 3]; MAX_VALENCE];
         let mut around = [[0i32; 4]; MAX_VALENCE];
         for i in 0..d {
             polygon[i] = positions[border[i] as usize];
-            around[i] = umbrella(border[i]);
+            around[i] = umbrellas[border[i] as usize];
         }
         Self::with_curvature(&polygon[..d], &around[..d])
     }

@@ -2,7 +2,6 @@
 //! coarser mesh ([`crate::gates`]) with codes read from the stream, then the
 //! removed vertices' positions and colours, then their re-insertion.
 
-use super::umbrellas::Umbrellas;
 use super::Level;
 use crate::contexts::DECIMATION_SYMBOLS;
 use crate::entropy::{BitModel, FrequencyModel, RangeDecoder};
@@ -10,7 +9,7 @@ use crate::gates::{Border, GateCodes, PassKind, PatchSink, Region, Traversal};
 use crate::halfedge::{face, Connectivity, NONE};
 use crate::patch::MAX_VALENCE;
 use crate::predict::{
-    decode_colour, predict_colour, PassModels, PatchPrediction, PREDICTION_BLOCK,
+    decode_colour, predict_colour, umbrellas, PassModels, PatchPrediction, PREDICTION_BLOCK,
 };
 use crate::{Error, Result};
 
@@ -19,7 +18,8 @@ use crate::{Error, Result};
 pub(crate) struct Scratch {
     pub traversal: Traversal,
     decoded: Vec<([i32; 3], Option<[u8; 3]>)>,
-    umbrellas: Umbrellas,
+    umbrellas: Vec<[i32; 4]>,
+    valences: Vec<u8>,
     predictions: Vec<PatchPrediction>,
 }
 
@@ -56,23 +56,67 @@ struct Streams<'a> {
 }
 
 impl Level {
-    /// Undoes one batch: its cleaning pass, then its decimating pass,
-    /// each predicting from the umbrellas of the mesh it starts on (swept
-    /// once for a level, then kept up to date: [`Umbrellas`]).
+    /// Undoes one batch: its cleaning pass, then its decimating pass.
+    ///
+    /// Both passes predict from the umbrellas of the mesh they start on.
+    /// The decimating pass's mesh is the cleaning pass's plus a fan of
+    /// three faces in place of one face for every vertex cleaning put back,
+    /// so its umbrellas are the cleaning pass's updated at those vertices
+    /// rather than swept again over every face (the sweep is bound by
+    /// random accesses: a fifth of a WebAssembly decode, swept twice).
     pub(crate) fn undo_batch(
         &mut self,
         cleaning: &PassInput,
         decimating: &PassInput,
         scratch: &mut Scratch,
     ) -> Result<()> {
-        scratch.umbrellas.ensure(&self.conn, &self.positions_q);
-        let undone = self
-            .undo_pass(cleaning, scratch)
-            .and_then(|()| self.undo_pass(decimating, scratch));
-        if undone.is_err() {
-            scratch.umbrellas.invalidate();
+        umbrellas(
+            &self.conn,
+            &self.positions_q,
+            &mut scratch.umbrellas,
+            &mut scratch.valences,
+        );
+        let before = self.vertex_count();
+        self.undo_pass(cleaning, scratch)?;
+        self.add_cleaned_umbrellas(before, scratch);
+        self.undo_pass(decimating, scratch)
+    }
+
+    /// Brings the umbrellas up to date with the vertices from `first` on,
+    /// each put back by the cleaning pass into a face `a b c`: it becomes
+    /// the fans `v a b`, `v b c`, `v c a`, so every corner gains one
+    /// outgoing half-edge (to `v`) and keeps the others, and `v` has three.
+    /// Wrapping, as the sweep: the same sums modulo 2³².
+    fn add_cleaned_umbrellas(&self, first: usize, scratch: &mut Scratch) {
+        let inserted = self.vertex_count() - first;
+        if inserted == 0 {
+            // A skipped pass leaves the last traversal's borders behind.
+            return;
         }
-        undone
+        let Scratch {
+            traversal,
+            umbrellas,
+            valences,
+            ..
+        } = scratch;
+        for (i, border) in traversal.borders[..inserted].iter().enumerate() {
+            debug_assert_eq!(border.valence, 3, "cleaning puts back valence-3 vertices");
+            let v = self.positions_q[first + i];
+            let mut own = [0i32, 0, 0, 3];
+            for &p in &border.polygon[..3] {
+                let p = p as usize;
+                let q = self.positions_q[p];
+                let u = &mut umbrellas[p];
+                for c in 0..3 {
+                    u[c] = u[c].wrapping_add(v[c].wrapping_sub(q[c]));
+                    own[c] = own[c].wrapping_add(q[c].wrapping_sub(v[c]));
+                }
+                u[3] += 1;
+                valences[p] = u[3].clamp(0, 255) as u8;
+            }
+            umbrellas.push(own);
+            valences.push(3);
+        }
     }
 
     /// Undoes one pass, predicting from `scratch`'s umbrellas and valences
@@ -86,13 +130,14 @@ impl Level {
                 _ => Err(Error::stream("pass without seeds claims inserted vertices")),
             };
         }
+        debug_assert_eq!(scratch.umbrellas.len(), n, "umbrellas of this mesh");
         // Phase 1: the traversal finds every patch and re-inserts its
         // vertex's fan (the vertex gets its position in phase 2).
         let mut codes = StreamCodes(RangeDecoder::new(pass.connectivity));
         let traversal = &mut scratch.traversal;
         traversal.run(
             &mut Fans(&mut self.conn),
-            &scratch.umbrellas.valences,
+            &scratch.valences,
             pass.kind,
             &pass.seeds,
             pass.inserted as usize,
@@ -114,18 +159,17 @@ impl Level {
         let mut decoded = std::mem::take(&mut scratch.decoded);
         decoded.clear();
         let predictions = &mut scratch.predictions;
-        let umbrellas = &mut scratch.umbrellas;
         for block in traversal.borders.chunks(PREDICTION_BLOCK) {
             predictions.clear();
             predictions.extend(block.iter().map(|r| {
-                PatchPrediction::for_border(&r.polygon[..r.valence], &self.positions_q, |v| {
-                    umbrellas.at_start(v)
-                })
+                PatchPrediction::for_border(
+                    &r.polygon[..r.valence],
+                    &self.positions_q,
+                    &scratch.umbrellas,
+                )
             }));
             for (r, prediction) in block.iter().zip(predictions.iter()) {
-                let vertex = self.decode_vertex(r, prediction, &mut s)?;
-                umbrellas.add_fan(r, &self.positions_q, vertex.0);
-                decoded.push(vertex);
+                decoded.push(self.decode_vertex(r, prediction, &mut s)?);
             }
         }
         debug_assert_eq!(n + decoded.len(), self.conn.out.len());
@@ -133,14 +177,6 @@ impl Level {
             self.push_vertex(position, colour);
         }
         scratch.decoded = decoded;
-        umbrellas.end_pass();
-        #[cfg(debug_assertions)]
-        if n < 50_000 {
-            debug_assert!(
-                umbrellas.agrees_with_sweep(&self.conn, &self.positions_q),
-                "umbrellas kept up to date differ from a sweep"
-            );
-        }
         s.geom.check_overrun()?;
         s.colour.check_overrun()
     }

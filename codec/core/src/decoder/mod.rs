@@ -2,7 +2,6 @@
 
 mod charted;
 mod conquest;
-mod umbrellas;
 
 use crate::base_mesh;
 use crate::charts::MAX_CHARTS;

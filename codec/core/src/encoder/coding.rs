@@ -181,9 +181,7 @@ impl PassCoder {
         for block in pass.patches.chunks(PREDICTION_BLOCK) {
             predictions.clear();
             predictions.extend(block.iter().map(|(_, valence, polygon)| {
-                PatchPrediction::for_border(&polygon[..*valence], mesh.positions, |v| {
-                    self.umbrellas[v as usize]
-                })
+                PatchPrediction::for_border(&polygon[..*valence], mesh.positions, &self.umbrellas)
             }));
             for (&(centre, valence, polygon), prediction) in block.iter().zip(predictions.iter()) {
                 prediction.encode(mesh.positions[centre as usize], &mut models, &mut geom);
