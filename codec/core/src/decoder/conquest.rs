@@ -63,7 +63,8 @@ impl Level {
     /// three faces in place of one face for every vertex cleaning put back,
     /// so its umbrellas are the cleaning pass's updated at those vertices
     /// rather than swept again over every face (the sweep is bound by
-    /// random accesses: a fifth of a WebAssembly decode, swept twice).
+    /// random accesses: a sixth of a WebAssembly decode when every pass
+    /// swept).
     pub(crate) fn undo_batch(
         &mut self,
         cleaning: &PassInput,
