@@ -80,7 +80,19 @@ impl Level {
         let before = self.vertex_count();
         self.undo_pass(cleaning, scratch)?;
         self.add_cleaned_umbrellas(before, scratch);
+        debug_assert!(
+            before > 50_000 || self.umbrellas_agree(scratch),
+            "umbrellas updated after cleaning differ from a sweep"
+        );
         self.undo_pass(decimating, scratch)
+    }
+
+    /// Whether `scratch`'s umbrellas and valences are what a sweep of the
+    /// level gives (debug builds check the update after cleaning with it).
+    fn umbrellas_agree(&self, scratch: &Scratch) -> bool {
+        let (mut swept, mut valences) = (Vec::new(), Vec::new());
+        umbrellas(&self.conn, &self.positions_q, &mut swept, &mut valences);
+        swept == scratch.umbrellas && valences == scratch.valences
     }
 
     /// Brings the umbrellas up to date with the vertices from `first` on,
