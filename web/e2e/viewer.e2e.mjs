@@ -398,6 +398,23 @@ test('the render worker draws the canvas where OffscreenCanvas has WebGL2; ?offs
   await until(main.page, `s.status === 'complete'`);
   assert.equal(await thread(main.page), 'main');
   assert.equal(await canvasOnMainThread(main.page), 'webgl2');
+  // Headless Chromium draws on SwiftShader, a CPU rasteriser: neither
+  // renderer multisamples there (src/rasteriser.js), which the main
+  // thread's own context confirms.
+  const rasteriser = await main.page.evaluate(() => {
+    const gl = /** @type {WebGL2RenderingContext} */ (document.createElement('canvas').getContext('webgl2'));
+    const info = gl.getExtension('WEBGL_debug_renderer_info');
+    return String(gl.getParameter(info ? info.UNMASKED_RENDERER_WEBGL : gl.RENDERER));
+  });
+  assert.match(rasteriser, /SwiftShader/);
+  for (const page of [worker.page, main.page]) {
+    assert.equal(await page.evaluate(() => /** @type {any} */ (document.querySelector('vitrine-viewer')).viewer.state.antialias), false);
+  }
+  const canvasAntialias = await main.page.evaluate(() => {
+    const canvas = /** @type {HTMLCanvasElement} */ (document.querySelector('vitrine-viewer')?.shadowRoot?.querySelector('canvas'));
+    return /** @type {WebGL2RenderingContext} */ (canvas.getContext('webgl2')).getContextAttributes()?.antialias;
+  });
+  assert.equal(canvasAntialias, false);
   const onMain = await capture(main.page);
   const score = compareImages(inWorker.rgba, onMain.rgba);
   assert.ok(score.iou > 0.999 && score.meanDiff < 0.5, `worker vs main thread: ${JSON.stringify(score)}`);

@@ -40,6 +40,7 @@ import { Renderer } from './renderer.js';
  * @property {boolean} edges the level on screen has its wire edges on the GPU
  * @property {AtlasResolution | null} colourResolution
  * @property {number} maxTextureSize
+ * @property {boolean} antialias whether the context multisamples (rasteriser.js)
  * @property {(on: boolean) => void} setWireframe
  * @property {(on: boolean) => void} setRelief colour by θ (relief.js) where the level has it
  * @property {(level: number | null) => void} setHold show levels up to this one only (null: all);
@@ -147,6 +148,10 @@ class MainRenderer {
     return this.renderer.maxTextureSize;
   }
 
+  get antialias() {
+    return this.renderer.antialias;
+  }
+
   /** @type {MessagePort | null} */
   #port = null;
 
@@ -250,6 +255,7 @@ class WorkerRenderer {
   /** @type {AtlasResolution | null} */
   colourResolution = null;
   maxTextureSize = 4096;
+  antialias = false;
   /** @type {Map<number, (value: any) => void>} */
   #captures = new Map();
   #nextCapture = 1;
@@ -285,6 +291,7 @@ class WorkerRenderer {
         if (message.type === 'started') {
           performance.mark('vitrine:render-worker-started');
           host.maxTextureSize = message.maxTextureSize;
+          host.antialias = message.antialias;
           resolve(host);
         } else if (message.type === 'failed') {
           worker.terminate();

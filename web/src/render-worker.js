@@ -20,6 +20,7 @@
 import { OrbitCamera } from './camera.js';
 import { frameBox } from './frame.js';
 import { occludedPoints, pickLevel } from './pick.js';
+import { isSoftwareRasteriser, probeRenderer } from './rasteriser.js';
 import { Renderer } from './renderer.js';
 
 /**
@@ -44,7 +45,7 @@ import { Renderer } from './renderer.js';
 /**
  * Reports to the page.
  * @typedef {{ type: 'ready', webgl2: boolean }
- *   | { type: 'started', maxTextureSize: number }
+ *   | { type: 'started', maxTextureSize: number, antialias: boolean }
  *   | { type: 'failed', message: string }
  *   | { type: 'swap', level: number, vertices: number, normalsMs: number }
  *   | { type: 'held', level: number }
@@ -154,7 +155,7 @@ function start(canvas, width, height, background) {
         },
         onTick: sendStatus,
       },
-      { ...WORKER_UPLOAD, background },
+      { ...WORKER_UPLOAD, background, antialias: rendererName !== null && !isSoftwareRasteriser(rendererName) },
     );
   } catch (error) {
     report({ type: 'failed', message: error instanceof Error ? error.message : String(error) });
@@ -162,7 +163,7 @@ function start(canvas, width, height, background) {
   }
   canvas.addEventListener('webglcontextlost', () => queueMicrotask(sendStatus));
   canvas.addEventListener('webglcontextrestored', () => queueMicrotask(sendStatus));
-  report({ type: 'started', maxTextureSize: renderer.maxTextureSize });
+  report({ type: 'started', maxTextureSize: renderer.maxTextureSize, antialias: renderer.antialias });
   sendStatus();
 }
 
@@ -245,20 +246,13 @@ scope.onmessage = (event) => {
   }
 };
 
-/** Whether this worker can draw WebGL2 at all, before the page gives up its canvas. */
-function probe() {
-  try {
-    if (typeof OffscreenCanvas !== 'function') return false;
-    const gl = /** @type {WebGL2RenderingContext | null} */ (new OffscreenCanvas(1, 1).getContext('webgl2'));
-    if (!gl) return false;
-    // Free it now rather than at garbage collection: the real context comes next.
-    gl.getExtension('WEBGL_lose_context')?.loseContext();
-    return true;
-  } catch {
-    return false;
-  }
-}
+/**
+ * Whether this worker can draw WebGL2 at all, before the page gives up its
+ * canvas: the renderer's name, or null (rasteriser.js; it also decides
+ * antialiasing).
+ */
+const rendererName = typeof OffscreenCanvas === 'function' ? probeRenderer() : null;
 
 // Names this thread in DevTools traces (the benchmark finds its tasks by it).
 performance.mark('vitrine:render-worker');
-report({ type: 'ready', webgl2: probe() });
+report({ type: 'ready', webgl2: rendererName !== null });

@@ -31,6 +31,7 @@
 import { multiply } from './camera.js';
 import { NormalsTask, deriveNormals } from './normals-task.js';
 import { DEFAULT_LOOK, bindCcc, bindLook, bindRelief, createAtlasTexture, createCellTexture, createProgram } from './program.js';
+import { isSoftwareRasteriser, probeRenderer } from './rasteriser.js';
 import { BACKGROUND, CLAY } from './shading.js';
 import {
   VertexStore,
@@ -63,6 +64,7 @@ const cancelFrame = typeof cancelAnimationFrame === 'function' ? (id) => cancelA
  * @typedef {object} RendererOptions
  * @property {number} [uploadBudgetMs] bufferSubData per frame (default 6 ms)
  * @property {number} [uploadChunkBytes] bytes per bufferSubData (default 256 KB)
+ * @property {boolean} [antialias] multisample (default: on a GPU, not on a CPU rasteriser; rasteriser.js)
  * @property {[number, number, number]} [background] clear colour, 0–1 components (default shading.js BACKGROUND)
  */
 
@@ -151,8 +153,9 @@ export class Renderer {
     this.uploadBudgetMs = options.uploadBudgetMs ?? UPLOAD_BUDGET_MS;
     this.uploadChunkBytes = options.uploadChunkBytes ?? UPLOAD_CHUNK_BYTES;
     this.background = options.background ?? BACKGROUND;
+    const antialias = options.antialias ?? !isSoftwareRasteriser(probeRenderer() ?? '');
     const gl = /** @type {WebGL2RenderingContext | null} */ (
-      canvas.getContext('webgl2', { antialias: true, powerPreference: 'high-performance' })
+      canvas.getContext('webgl2', { antialias, powerPreference: 'high-performance' })
     );
     if (!gl) throw new Error('this browser has no WebGL2');
     this.gl = gl;
@@ -321,6 +324,11 @@ export class Renderer {
   /** Which colour texture is drawn: null without a CCC mapping. */
   get colourResolution() {
     return this.#mapping && this.#atlas ? this.#atlas.resolution : null;
+  }
+
+  /** Whether the context multisamples (rasteriser.js: not on a CPU rasteriser). */
+  get antialias() {
+    return Boolean(this.gl.getContextAttributes()?.antialias);
   }
 
   /** The largest texture side this GPU takes. */

@@ -78,8 +78,12 @@ import { PointModel } from './splats/point-model.js';
  * @property {number} decoders workers decoding the stream (1, or a pool's size)
  * @property {number} deriveMs time computing normals, edges and θ in the decode worker
  * @property {number} normalsMs time the renderer spent deriving normals (levels sent without them)
+ * @property {boolean | null} antialias whether the picture is multisampled (null before the
+ *   renderer starts): not on a CPU rasteriser (rasteriser.js)
  * @property {number | null} firstFrameMs performance.now() of the first frame with a mesh
  * @property {Record<number, number>} shownAtMs performance.now() when each level was first drawn
+ * @property {Record<number, number>} decodedAtMs performance.now() when the decode worker's notice of
+ *   each level reached the page (decoded and posted; drawing it may take much longer on a CPU renderer)
  * @property {string | null} message cap or error text on screen
  * @property {'none' | 'vertex' | 'loading' | 'low' | 'full'} colour what colours the surface:
  *   nothing (clay), per-vertex colour, or the CCC texture (`loading` until the
@@ -151,8 +155,10 @@ export class Viewer {
     decoders: 1,
     deriveMs: 0,
     normalsMs: 0,
+    antialias: null,
     firstFrameMs: null,
     shownAtMs: {},
+    decodedAtMs: {},
     message: null,
     colour: 'none',
     colourAtMs: {},
@@ -365,6 +371,7 @@ export class Viewer {
       if (this.#levels !== levels) return;
       // The look first: the render worker frames its camera with it when the base mesh arrives.
       renderer.setLook(this.#look);
+      this.#set({ antialias: renderer.antialias });
       if (this.camera) renderer.camera = this.camera;
       // Normals are derived by the renderer when it has a thread of its own;
       // the main thread's fallback gets them from the decode worker.
@@ -743,6 +750,7 @@ export class Viewer {
             this.renderer.requestFrame();
           }
         }
+        this.state.decodedAtMs[message.level] ??= performance.now();
         this.#set({
           decodedLevel: message.level,
           received: message.received,
