@@ -280,7 +280,9 @@ test('ccc: the base mesh is drawn first; the cell and low-resolution colour text
     requested.push(url);
     held.set(new URL(url).pathname, () => void route.continue());
   });
-  await page.goto(`${service.url}/embed/painted`);
+  // Multisampled as on a GPU (SwiftShader otherwise goes without): the
+  // screenshots below are the documentation's.
+  await page.goto(`${service.url}/embed/painted?antialias=on`);
   let s = await until(page, '0 in s.shownAtMs');
   assert.equal(s.colour, 'loading', 'the base mesh is on screen before any colour texture arrives');
   const clay = await capture(page);
@@ -475,7 +477,7 @@ test('ccc: every level shows the painted colours: each matches a CPU rendering o
   let colour;
   for (let k = 0; k <= n; k++) {
     const page = await browser.context.newPage();
-    await page.goto(`${service.url}/embed/painted?level=${k}`);
+    await page.goto(`${service.url}/embed/painted?level=${k}&antialias=on`);
     await until(page, `s.status === 'complete' && s.colour === 'full' && s.shownLevel === ${k}`);
     const gpu = (await capture(page)).rgba;
     images.push(gpu);

@@ -415,6 +415,11 @@ test('the render worker draws the canvas where OffscreenCanvas has WebGL2; ?offs
     return /** @type {WebGL2RenderingContext} */ (canvas.getContext('webgl2')).getContextAttributes()?.antialias;
   });
   assert.equal(canvasAntialias, false);
+  // A page can still ask for it (the documentation's screenshots do).
+  const forced = await open('/embed/torus?antialias=on');
+  await until(forced.page, `s.status === 'complete'`);
+  assert.equal(await forced.page.evaluate(() => /** @type {any} */ (document.querySelector('vitrine-viewer')).viewer.state.antialias), true);
+  await forced.page.close();
   const onMain = await capture(main.page);
   const score = compareImages(inWorker.rgba, onMain.rgba);
   assert.ok(score.iou > 0.999 && score.meanDiff < 0.5, `worker vs main thread: ${JSON.stringify(score)}`);

@@ -32,7 +32,7 @@ try {
       if (batch <= level) return route.continue();
       // Never answered: the wanted level stays on screen.
     });
-    await page.goto(`${values.url}/m/${values.slug}`);
+    await page.goto(`${values.url}/m/${values.slug}?antialias=on`);
     await page.waitForFunction(
       (want) => {
         const v = /** @type {any} */ (document.querySelector('vitrine-viewer'))?.viewer;

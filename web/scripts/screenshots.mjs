@@ -49,7 +49,10 @@ const settled = (page, status) =>
 /** @param {string} path @param {string} file @param {(page: import('playwright-core').Page) => Promise<unknown>} ready */
 async function shot(path, file, ready) {
   const page = await browser.context.newPage();
-  await page.goto(`${service.url}${path}`);
+  // Multisampled as on a GPU: headless Chromium's SwiftShader goes without by default (src/rasteriser.js).
+  const url = new URL(path, service.url);
+  url.searchParams.set('antialias', 'on');
+  await page.goto(url.href);
   await ready(page);
   await page.waitForTimeout(300);
   await page.screenshot({ path: join(out, file) });

@@ -12,7 +12,8 @@
  * level until `element.viewer.prefetch()` / `display()` say otherwise: the
  * quality study), `background` (`#rrggbb`: the canvas's colour; the study's
  * black), `decoders` (workers that decode a charted stream together, 1–4;
- * default: the device's cores, at most 4). `chrome="none"` draws the model and nothing else. The
+ * default: the device's cores, at most 4), `antialias` (`on` or `off`;
+ * default: on a GPU, off on a CPU rasteriser: rasteriser.js). `chrome="none"` draws the model and nothing else. The
  * worker and the decoder are loaded from beside this script, so the element
  * works on another origin (the service answers CORS).
  */
@@ -77,6 +78,7 @@ export class VitrineViewerElement extends HTMLElement {
       hold: hold === null || hold === '' ? null : Number(hold),
       background: parseColour(this.getAttribute('background')),
       decoders: positiveInteger(this.getAttribute('decoders')),
+      antialias: onOff(this.getAttribute('antialias')),
     });
     void this.viewer.start();
   }
@@ -89,6 +91,11 @@ export class VitrineViewerElement extends HTMLElement {
 }
 
 if (!customElements.get('vitrine-viewer')) customElements.define('vitrine-viewer', VitrineViewerElement);
+
+/** @param {string | null} value @returns {boolean | null} `on`: true, `off`: false, else null */
+function onOff(value) {
+  return value === 'on' ? true : value === 'off' ? false : null;
+}
 
 /** @param {string | null} value @returns {number | null} */
 function positiveInteger(value) {

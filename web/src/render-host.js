@@ -76,7 +76,8 @@ export function canTransfer(canvas) {
  * worker reports WebGL2, else on the main thread.
  * @param {HTMLCanvasElement} canvas
  * @param {RenderHooks} hooks
- * @param {{ offscreen: boolean, createWorker: () => Promise<Worker>, background?: [number, number, number] }} options
+ * @param {{ offscreen: boolean, createWorker: () => Promise<Worker>, background?: [number, number, number], antialias?: boolean | null }} options
+ *   `antialias`: multisample (null or absent: on a GPU only; rasteriser.js)
  * @returns {Promise<RenderHost>}
  */
 export async function openRenderer(canvas, hooks, options) {
@@ -88,11 +89,11 @@ export async function openRenderer(canvas, hooks, options) {
         worker.onerror = () => resolve(false);
       });
       performance.mark(`vitrine:render-worker-${ready ? 'ready' : 'without-webgl2'}`);
-      if (ready) return WorkerRenderer.start(canvas, worker, hooks, options.background);
+      if (ready) return WorkerRenderer.start(canvas, worker, hooks, options.background, options.antialias);
       worker.terminate();
     }
   }
-  return new MainRenderer(canvas, hooks, options.background);
+  return new MainRenderer(canvas, hooks, options.background, options.antialias);
 }
 
 /** The fallback: the renderer on the page's own canvas. */
@@ -103,8 +104,9 @@ class MainRenderer {
    * @param {HTMLCanvasElement} canvas
    * @param {RenderHooks} hooks
    * @param {[number, number, number]} [background]
+   * @param {boolean | null} [antialias]
    */
-  constructor(canvas, hooks, background) {
+  constructor(canvas, hooks, background, antialias) {
     this.hooks = hooks;
     this.renderer = new Renderer(canvas, null, {
       onSwap: (level) => hooks.onSwap({ level: level.level, vertices: level.vertices, normalsMs: this.renderer.normalsMs }),
@@ -116,7 +118,7 @@ class MainRenderer {
           reliefTop: this.renderer.reliefTop,
           at: performance.now(),
         }),
-    }, { background });
+    }, { background, antialias: antialias ?? undefined });
   }
 
   get camera() {
@@ -278,9 +280,10 @@ class WorkerRenderer {
    * @param {Worker} worker
    * @param {RenderHooks} hooks
    * @param {[number, number, number]} [background]
+   * @param {boolean | null} [antialias]
    * @returns {Promise<RenderHost>}
    */
-  static start(canvas, worker, hooks, background) {
+  static start(canvas, worker, hooks, background, antialias) {
     const host = new WorkerRenderer(canvas, worker, hooks);
     const { width, height } = canvas;
     const offscreen = canvas.transferControlToOffscreen();
@@ -301,7 +304,7 @@ class WorkerRenderer {
         }
       };
       worker.onerror = (event) => reject(new Error(`the render worker failed: ${event.message}`));
-      worker.postMessage({ type: 'canvas', canvas: offscreen, width, height, background }, [offscreen]);
+      worker.postMessage({ type: 'canvas', canvas: offscreen, width, height, background, antialias }, [offscreen]);
     });
   }
 

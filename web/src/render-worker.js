@@ -25,7 +25,7 @@ import { Renderer } from './renderer.js';
 
 /**
  * Commands from the page.
- * @typedef {{ type: 'canvas', canvas: OffscreenCanvas, width: number, height: number, background?: [number, number, number] }
+ * @typedef {{ type: 'canvas', canvas: OffscreenCanvas, width: number, height: number, background?: [number, number, number], antialias?: boolean | null }
  *   | { type: 'source', port: MessagePort }
  *   | { type: 'size', width: number, height: number }
  *   | { type: 'camera', state: import('./camera.js').OrbitState | null, radius?: number | null }
@@ -130,8 +130,9 @@ function fromDecoder(message) {
 /**
  * @param {OffscreenCanvas} canvas @param {number} width @param {number} height
  * @param {[number, number, number] | undefined} background
+ * @param {boolean | null | undefined} antialias multisample (null or absent: on a GPU only; rasteriser.js)
  */
-function start(canvas, width, height, background) {
+function start(canvas, width, height, background, antialias) {
   canvas.width = width;
   canvas.height = height;
   try {
@@ -155,7 +156,7 @@ function start(canvas, width, height, background) {
         },
         onTick: sendStatus,
       },
-      { ...WORKER_UPLOAD, background, antialias: rendererName !== null && !isSoftwareRasteriser(rendererName) },
+      { ...WORKER_UPLOAD, background, antialias: antialias ?? (rendererName !== null && !isSoftwareRasteriser(rendererName)) },
     );
   } catch (error) {
     report({ type: 'failed', message: error instanceof Error ? error.message : String(error) });
@@ -171,7 +172,7 @@ scope.onmessage = (event) => {
   const command = event.data;
   switch (command.type) {
     case 'canvas':
-      start(command.canvas, command.width, command.height, command.background);
+      start(command.canvas, command.width, command.height, command.background, command.antialias);
       break;
     case 'source':
       // A new decode worker (a retry): the old one's port is closed, so nothing late arrives from it.

@@ -32,6 +32,8 @@ import { PointModel } from './splats/point-model.js';
  * @property {number | null} [hold] show and decode up to this level only, until
  *   {@link Viewer#prefetch} and {@link Viewer#display} say otherwise (the quality study)
  * @property {[number, number, number]} [background] the canvas's clear colour (0–1 components)
+ * @property {boolean | null} [antialias] multisample the picture (null or absent: on a GPU,
+ *   not on a CPU rasteriser, where it costs seconds a frame of a large scan; rasteriser.js)
  * @property {number | null} [decoders] workers that decode a charted stream together
  *   (decode-pool.js): the decode worker and helpers; null or absent: as many as the
  *   device has cores, at most {@link MAX_DECODERS}; 1: no helpers
@@ -698,6 +700,7 @@ export class Viewer {
         offscreen: this.options.offscreen,
         createWorker: () => this.#createWorker(this.options.renderWorkerUrl),
         background: this.options.background,
+        antialias: this.options.antialias,
       },
     ).then(
       (renderer) => (this.renderer = renderer),
