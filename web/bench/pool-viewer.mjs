@@ -15,8 +15,14 @@
 // waiting for the helpers included). The first level is the first frame with
 // a mesh (the base, or a later level if the base was superseded before it
 // was drawn). WebGL2 runs on SwiftShader, a CPU renderer that shares the
-// machine's cores with the decoders. Median of --runs.
-//   node bench/pool-viewer.mjs --mesh /work/scans/igea-2m.ply [--runs 3] [--workers 1,2,4]
+// machine's cores with the decoders. Median of --runs. `--antialias` runs the
+// whole table once per value (`auto`: the viewer's rule, no multisampling on
+// SwiftShader; `on`: multisampled as before 5 Dec 2026; src/rasteriser.js).
+// Each load starts on a quiet machine: a closed page's GPU process can
+// rasterise its last frame for seconds, which delayed the next page's
+// navigation by up to 15 s.
+//   node bench/pool-viewer.mjs --mesh /work/scans/igea-2m.ply [--runs 3] [--workers 1,2,4] [--antialias auto,on]
+import { readFileSync } from 'node:fs';
 import { loadavg, cpus } from 'node:os';
 import { parseArgs } from 'node:util';
 import { launch } from '../test/support/browser.mjs';
@@ -27,6 +33,7 @@ const { values } = parseArgs({
     mesh: { type: 'string' },
     runs: { type: 'string', default: '3' },
     workers: { type: 'string', default: '1,2,4' },
+    antialias: { type: 'string', default: 'auto' },
   },
 });
 if (!values.mesh) {
@@ -35,6 +42,8 @@ if (!values.mesh) {
 }
 const runs = Number(values.runs);
 const workers = values.workers.split(',').map(Number);
+const antialiasModes = values.antialias.split(',');
+for (const a of antialiasModes) if (!['auto', 'on', 'off'].includes(a)) throw new Error(`--antialias: auto, on or off, not ${a}`);
 
 const t0 = performance.now();
 const service = await startService({
@@ -59,10 +68,12 @@ const browser = await launch({ width: 800, height: 600, gpuCompositing: true });
  * @param {string} slug
  * @param {number} decoders
  * @param {number} last
+ * @param {string} antialias
  */
-async function load(slug, decoders, last) {
+async function load(slug, decoders, last, antialias) {
+  await quiet();
   const page = await browser.context.newPage();
-  await page.goto(`${service.url}/embed/${slug}?decoders=${decoders}`);
+  await page.goto(`${service.url}/embed/${slug}?decoders=${decoders}${antialias === 'auto' ? '' : `&antialias=${antialias}`}`);
   await page.waitForFunction(
     (n) => /** @type {any} */ (document.querySelector('vitrine-viewer'))?.viewer?.state?.shownLevel === n,
     last,
@@ -74,6 +85,26 @@ async function load(slug, decoders, last) {
   return { first: s.firstFrameMs, decoded: s.decodedAtMs[last], last: s.shownAtMs[last], decode: s.decodeMs, vertices: s.vertices };
 }
 
+/** Busy and total jiffies of every core since boot (/proc/stat). */
+function cpuTimes() {
+  const [, ...fields] = readFileSync('/proc/stat', 'utf8').split('\n')[0].trim().split(/\s+/);
+  const t = fields.map(Number);
+  const idle = t[3] + t[4];
+  const total = t.reduce((a, b) => a + b, 0);
+  return { busy: total - idle, total };
+}
+
+/** Waits until the machine's cores were less than 15 % busy over half a second (at most 60 s). */
+async function quiet() {
+  const until = performance.now() + 60_000;
+  while (performance.now() < until) {
+    const a = cpuTimes();
+    await new Promise((resolve) => setTimeout(resolve, 500));
+    const b = cpuTimes();
+    if ((b.busy - a.busy) / Math.max(1, b.total - a.total) < 0.15) return;
+  }
+}
+
 /** @param {number[]} xs */
 const median = (xs) => [...xs].sort((a, b) => a - b)[xs.length >> 1];
 
@@ -81,13 +112,14 @@ const median = (xs) => [...xs].sort((a, b) => a - b)[xs.length >> 1];
  * @param {string} slug
  * @param {number} decoders
  * @param {any} m the manifest
+ * @param {string} antialias
  */
-async function measure(slug, decoders, m) {
-  await load(slug, decoders, m.last_level); // warm-up: the service's caches, Chromium's compile cache
+async function measure(slug, decoders, m, antialias) {
+  await load(slug, decoders, m.last_level, antialias); // warm-up: the service's caches, Chromium's compile cache
   const results = [];
   for (let r = 0; r < runs; r++) {
-    const x = await load(slug, decoders, m.last_level);
-    console.error(`${slug}, ${decoders} decoders: first ${x.first.toFixed(0)} ms, last decoded ${x.decoded.toFixed(0)} ms, last ${x.last.toFixed(0)} ms, decode ${x.decode.toFixed(0)} ms`);
+    const x = await load(slug, decoders, m.last_level, antialias);
+    console.error(`${slug}, ${decoders} decoders, antialias ${antialias}: first ${x.first.toFixed(0)} ms, last decoded ${x.decoded.toFixed(0)} ms, last ${x.last.toFixed(0)} ms, decode ${x.decode.toFixed(0)} ms`);
     results.push(x);
   }
   return {
@@ -101,15 +133,17 @@ async function measure(slug, decoders, m) {
 
 console.log(`# ${new Date().toISOString()}, ${cpus().length} cores, load ${loadavg().map((x) => x.toFixed(2)).join(' ')}; median of ${runs} cold loads`);
 console.log(`# plain: ${plain.last_level} batches, ${plain.levels.at(-1).vertices} vertices; charted: ${charted.last_level} batches`);
-console.log('| stream | decode workers | first level | last level decoded | last level drawn | decode (wall) | decoded / plain | drawn / plain |');
-console.log('|---|---:|---:|---:|---:|---:|---:|---:|');
-const base = await measure('plain', 1, plain);
+console.log('| antialias | stream | decode workers | first level | last level decoded | last level drawn | decode (wall) | decoded / plain | drawn / plain |');
+console.log('|---|---|---:|---:|---:|---:|---:|---:|---:|');
 const ms = (/** @type {number} */ x) => `${x.toFixed(0)} ms`;
-console.log(`| format 4 | 1 | ${ms(base.first)} | ${ms(base.decoded)} | ${ms(base.last)} | ${ms(base.decode)} | 1.00 | 1.00 |`);
-for (const w of workers) {
-  const r = await measure('charted', w, charted);
-  if (r.vertices !== base.vertices) throw new Error(`charted: ${r.vertices} vertices, plain ${base.vertices}`);
-  console.log(`| format 5 | ${w} | ${ms(r.first)} | ${ms(r.decoded)} | ${ms(r.last)} | ${ms(r.decode)} | ${(r.decoded / base.decoded).toFixed(2)} | ${(r.last / base.last).toFixed(2)} |`);
+for (const antialias of antialiasModes) {
+  const base = await measure('plain', 1, plain, antialias);
+  console.log(`| ${antialias} | format 4 | 1 | ${ms(base.first)} | ${ms(base.decoded)} | ${ms(base.last)} | ${ms(base.decode)} | 1.00 | 1.00 |`);
+  for (const w of workers) {
+    const r = await measure('charted', w, charted, antialias);
+    if (r.vertices !== base.vertices) throw new Error(`charted: ${r.vertices} vertices, plain ${base.vertices}`);
+    console.log(`| ${antialias} | format 5 | ${w} | ${ms(r.first)} | ${ms(r.decoded)} | ${ms(r.last)} | ${ms(r.decode)} | ${(r.decoded / base.decoded).toFixed(2)} | ${(r.last / base.last).toFixed(2)} |`);
+  }
 }
 await browser.close();
 await service.stop();
