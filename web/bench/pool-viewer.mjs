@@ -7,16 +7,16 @@
 // start to the frame that first drew the level (ViewerState.shownAtMs) and,
 // for the last level, also to when its decode worker's notice reached the
 // page (ViewerState.decodedAtMs: decoded, normals derived, posted). On
-// SwiftShader the two differ by seconds for a 2 M-vertex scan: the GPU
-// process rasterises the level before (millions of triangles on the CPU)
-// before the next frame can start, so "drawn" measures SwiftShader as much
+// SwiftShader the two differ by seconds for a 2 M-vertex scan: the next
+// frame waits until the GPU process has rasterised the previous level's
+// (millions of triangles on the CPU), so "drawn" measures SwiftShader as much
 // as decoding, and "decoded" is the pipeline a real GPU would wait for.
 // `decode` is the decode worker's wall time in its batches (with a pool,
 // waiting for the helpers included). The first level is the first frame with
 // a mesh (the base, or a later level if the base was superseded before it
 // was drawn). WebGL2 runs on SwiftShader, a CPU renderer that shares the
 // machine's cores with the decoders. Median of --runs. `--antialias` runs the
-// whole table once per value (`auto`: the viewer's rule, no multisampling on
+// table once per value, alternating them load by load (`auto`: the viewer's rule, no multisampling on
 // SwiftShader; `on`: multisampled as before 5 Dec 2026; src/rasteriser.js).
 // Each load starts on a quiet machine: a closed page's GPU process can
 // rasterise its last frame for seconds, which delayed the next page's
@@ -108,42 +108,60 @@ async function quiet() {
 /** @param {number[]} xs */
 const median = (xs) => [...xs].sort((a, b) => a - b)[xs.length >> 1];
 
+/** @typedef {{ first: number, decoded: number, last: number, decode: number, vertices: number }} Load */
+
 /**
+ * Medians of `runs` loads per antialias mode, the modes alternated load by
+ * load (the VM's speed drifts by tens of per cent within minutes).
  * @param {string} slug
  * @param {number} decoders
  * @param {any} m the manifest
- * @param {string} antialias
+ * @returns {Promise<Map<string, Load>>}
  */
-async function measure(slug, decoders, m, antialias) {
-  await load(slug, decoders, m.last_level, antialias); // warm-up: the service's caches, Chromium's compile cache
-  const results = [];
+async function measure(slug, decoders, m) {
+  await load(slug, decoders, m.last_level, antialiasModes[0]); // warm-up: the service's caches, Chromium's compile cache
+  /** @type {Map<string, Load[]>} */
+  const results = new Map(antialiasModes.map((a) => [a, []]));
   for (let r = 0; r < runs; r++) {
-    const x = await load(slug, decoders, m.last_level, antialias);
-    console.error(`${slug}, ${decoders} decoders, antialias ${antialias}: first ${x.first.toFixed(0)} ms, last decoded ${x.decoded.toFixed(0)} ms, last ${x.last.toFixed(0)} ms, decode ${x.decode.toFixed(0)} ms`);
-    results.push(x);
+    for (const antialias of antialiasModes) {
+      const x = await load(slug, decoders, m.last_level, antialias);
+      console.error(`${slug}, ${decoders} decoders, antialias ${antialias}: first ${x.first.toFixed(0)} ms, last decoded ${x.decoded.toFixed(0)} ms, last ${x.last.toFixed(0)} ms, decode ${x.decode.toFixed(0)} ms`);
+      results.get(antialias)?.push(x);
+    }
   }
-  return {
-    first: median(results.map((x) => x.first)),
-    decoded: median(results.map((x) => x.decoded)),
-    last: median(results.map((x) => x.last)),
-    decode: median(results.map((x) => x.decode)),
-    vertices: results[0].vertices,
-  };
+  /** @type {Map<string, Load>} */
+  const medians = new Map();
+  for (const [antialias, xs] of results) {
+    medians.set(antialias, {
+      first: median(xs.map((x) => x.first)),
+      decoded: median(xs.map((x) => x.decoded)),
+      last: median(xs.map((x) => x.last)),
+      decode: median(xs.map((x) => x.decode)),
+      vertices: xs[0].vertices,
+    });
+  }
+  return medians;
 }
 
 console.log(`# ${new Date().toISOString()}, ${cpus().length} cores, load ${loadavg().map((x) => x.toFixed(2)).join(' ')}; median of ${runs} cold loads`);
 console.log(`# plain: ${plain.last_level} batches, ${plain.levels.at(-1).vertices} vertices; charted: ${charted.last_level} batches`);
-console.log('| antialias | stream | decode workers | first level | last level decoded | last level drawn | decode (wall) | decoded / plain | drawn / plain |');
-console.log('|---|---|---:|---:|---:|---:|---:|---:|---:|');
 const ms = (/** @type {number} */ x) => `${x.toFixed(0)} ms`;
-for (const antialias of antialiasModes) {
-  const base = await measure('plain', 1, plain, antialias);
-  console.log(`| ${antialias} | format 4 | 1 | ${ms(base.first)} | ${ms(base.decoded)} | ${ms(base.last)} | ${ms(base.decode)} | 1.00 | 1.00 |`);
-  for (const w of workers) {
-    const r = await measure('charted', w, charted, antialias);
+/** @type {string[]} */
+const rows = [];
+const bases = await measure('plain', 1, plain);
+for (const [antialias, base] of bases) {
+  rows.push(`| ${antialias} | format 4 | 1 | ${ms(base.first)} | ${ms(base.decoded)} | ${ms(base.last)} | ${ms(base.decode)} | 1.00 | 1.00 |`);
+}
+for (const w of workers) {
+  for (const [antialias, r] of await measure('charted', w, charted)) {
+    const base = /** @type {Load} */ (bases.get(antialias));
     if (r.vertices !== base.vertices) throw new Error(`charted: ${r.vertices} vertices, plain ${base.vertices}`);
-    console.log(`| ${antialias} | format 5 | ${w} | ${ms(r.first)} | ${ms(r.decoded)} | ${ms(r.last)} | ${ms(r.decode)} | ${(r.decoded / base.decoded).toFixed(2)} | ${(r.last / base.last).toFixed(2)} |`);
+    rows.push(`| ${antialias} | format 5 | ${w} | ${ms(r.first)} | ${ms(r.decoded)} | ${ms(r.last)} | ${ms(r.decode)} | ${(r.decoded / base.decoded).toFixed(2)} | ${(r.last / base.last).toFixed(2)} |`);
   }
 }
+console.log('| antialias | stream | decode workers | first level | last level decoded | last level drawn | decode (wall) | decoded / plain | drawn / plain |');
+console.log('|---|---|---:|---:|---:|---:|---:|---:|---:|');
+rows.sort((a, b) => antialiasModes.indexOf(a.split(' | ')[0].slice(2)) - antialiasModes.indexOf(b.split(' | ')[0].slice(2)));
+for (const row of rows) console.log(row);
 await browser.close();
 await service.stop();
