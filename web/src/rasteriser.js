@@ -6,8 +6,8 @@
  * desktops, and in headless test browsers. There a frame of a multi-million-
  * triangle scan costs seconds of CPU, shared with the decoders, and
  * multisampling multiplies it: on a 2-core machine, 4× MSAA kept SwiftShader
- * busy for 7 s before the last level of a 2 M-vertex scan could be drawn,
- * against about 1 s without it (BENCHMARKS.md, "Charts"). So the renderer
+ * busy for 6–7 s before the last level of a 2 M-vertex scan could be drawn,
+ * against 0.7–1.4 s without it (BENCHMARKS.md, "Charts"). So the renderer
  * asks for antialiasing only on a GPU.
  */
 
