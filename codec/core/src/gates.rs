@@ -182,6 +182,14 @@ pub(crate) struct Traversal {
 }
 
 impl Traversal {
+    /// Room for a mesh of `needed` vertices and its faces, two a vertex
+    /// (`target` vertices' worth if the arrays move; see the decoder's `room`).
+    pub(crate) fn make_room(&mut self, needed: usize, target: usize) {
+        use crate::decoder::room::reserve;
+        reserve(&mut self.tag, needed, target);
+        reserve(&mut self.face_done, 2 * needed, 2 * target);
+    }
+
     /// Walks one pass over `mesh` from `seeds` (one gate `a → b` per
     /// connected component), asking `codes` for each gate's code and
     /// collecting at most `max_patches` patches in [`Traversal::borders`].

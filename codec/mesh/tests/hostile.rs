@@ -1040,6 +1040,36 @@ fn batch_claiming_millions_of_vertices_does_not_allocate_them() {
     assert!(r.is_err());
 }
 
+/// A real stream whose level table claims a final level at the default
+/// vertex limit: the decoder reserves toward the final count as batches
+/// come, but no further than a few times what each batch verifies, so the
+/// real batches still decode, in small memory.
+#[test]
+fn final_level_claiming_millions_reserves_only_what_batches_verify() {
+    let limits = Limits::default();
+    let s = sphere_stream();
+    let header = Header::parse(s).unwrap();
+    let k = header.batch_count();
+    assert!(k >= 2, "the sample stream needs two batches");
+    let prev = header.levels[k - 1];
+    let mut b = s.to_vec();
+    put_u32(&mut b, level_at(k), limits.max_vertices);
+    put_u32(
+        &mut b,
+        level_at(k) + 4,
+        prev.faces + 2 * (limits.max_vertices - prev.vertices),
+    );
+    let d = assert_small_peak("final level claiming 50 M vertices", || {
+        decode(&b, Some(k - 1), limits)
+    })
+    .expect("the batches before the last are real");
+    let real = decode(s, Some(k - 1), limits).unwrap();
+    assert_eq!(d.positions(), real.positions());
+    assert_eq!(d.indices(), real.indices());
+    // The last batch disagrees with the claim, and says so.
+    assert_stream_err(decode(&b, None, limits), &["level table"]);
+}
+
 // ---------------------------------------------------------------- mesh files
 
 mod files {

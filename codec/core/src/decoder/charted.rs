@@ -5,6 +5,7 @@
 use std::ops::Range;
 
 use super::conquest::{PassInput, Scratch};
+use super::room::{self, Growth};
 use super::{read_pass, Level};
 use crate::charts::{canonical_level, chart_connectivity, cut, decode_labels, CanonicalLevel};
 use crate::format::Reader;
@@ -139,7 +140,13 @@ impl Charted {
 
     /// Applies every chart's part, on up to `threads` threads; the first
     /// error in chart order, whatever the threads.
-    pub(super) fn apply(&mut self, parts: Vec<Part<'_>>, threads: usize) -> Result<()> {
+    /// `growth`: the whole level's, which each chart expects in proportion.
+    pub(super) fn apply(
+        &mut self,
+        parts: Vec<Part<'_>>,
+        growth: Growth,
+        threads: usize,
+    ) -> Result<()> {
         debug_assert_eq!(parts.len(), self.charts.len());
         #[cfg(not(target_arch = "wasm32"))]
         if threads > 1 && self.charts.len() > 1 {
@@ -154,7 +161,7 @@ impl Charted {
                         scope.spawn(|| {
                             let mut done = Vec::new();
                             while let Some((i, (chart, part))) = next() {
-                                done.push((i, chart.apply(part)));
+                                done.push((i, chart.apply(part, growth)));
                             }
                             done
                         })
@@ -172,12 +179,22 @@ impl Charted {
         self.charts
             .iter_mut()
             .zip(parts)
-            .try_for_each(|(chart, part)| chart.apply(part))
+            .try_for_each(|(chart, part)| chart.apply(part, growth))
     }
 
     /// Appends the vertices the charts gained to `level`, chart by chart in
     /// insertion order, and rebuilds the merged triangle list.
-    pub(super) fn merge(&mut self, level: &mut Level) {
+    pub(super) fn merge(&mut self, level: &mut Level, growth: Growth) {
+        let n = level.vertex_count();
+        let added: usize = self
+            .charts
+            .iter()
+            .map(|c| c.level.vertex_count() - c.global.len())
+            .sum();
+        let (needed, target) = growth.room(n, added);
+        level.reserve_vertices(needed, target);
+        let faces: usize = self.charts.iter().map(|c| c.level.conn.origin.len()).sum();
+        room::reserve(&mut self.indices, faces, faces + 6 * (target - needed));
         for chart in &mut self.charts {
             let new = chart.global.len()..chart.level.vertex_count();
             let first = level.positions_q.len() as u32;
@@ -268,7 +285,7 @@ impl Chart {
         start..out.len()
     }
 
-    fn apply(&mut self, part: Part<'_>) -> Result<()> {
+    fn apply(&mut self, part: Part<'_>, growth: Growth) -> Result<()> {
         self.before_last = self.level.vertex_count();
         let Some((cleaning, decimating, bytes)) = part else {
             return Ok(());
@@ -276,16 +293,9 @@ impl Chart {
         // Reserve no more than the part could possibly describe (a bit per vertex).
         let grow = (cleaning.inserted as usize + decimating.inserted as usize)
             .min(bytes.saturating_mul(8));
-        let level = &mut self.level;
-        level.positions_q.reserve(grow);
-        level.positions.reserve(grow);
-        level.conn.out.reserve(grow);
-        if let Some(colours) = &mut level.colours {
-            colours.reserve(grow);
-        }
-        level.conn.origin.reserve(6 * grow);
-        level.conn.twin.reserve(6 * grow);
-        level.undo_batch(&cleaning, &decimating, &mut self.scratch)
+        self.level.make_room(grow, growth, &mut self.scratch);
+        self.level
+            .undo_batch(&cleaning, &decimating, &mut self.scratch)
     }
 }
 

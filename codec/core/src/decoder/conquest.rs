@@ -23,6 +23,15 @@ pub(crate) struct Scratch {
     predictions: Vec<PatchPrediction>,
 }
 
+impl Scratch {
+    /// Room for a level of `needed` vertices (`target` if the arrays move).
+    pub(super) fn make_room(&mut self, needed: usize, target: usize) {
+        super::room::reserve(&mut self.umbrellas, needed, target);
+        super::room::reserve(&mut self.valences, needed, target);
+        self.traversal.make_room(needed, target);
+    }
+}
+
 pub(crate) struct PassInput<'a> {
     pub kind: PassKind,
     pub seeds: Vec<[u32; 2]>,

@@ -2,6 +2,7 @@
 
 mod charted;
 mod conquest;
+pub(crate) mod room;
 
 use crate::base_mesh;
 use crate::charts::MAX_CHARTS;
@@ -15,6 +16,7 @@ use crate::{Error, IndexedMesh, Result};
 pub use charted::ChartLevel;
 use charted::{read_part, Charted, Labelled};
 use conquest::{PassInput, Scratch};
+use room::Growth;
 
 /// Budget a decoder enforces before it allocates or grows anything.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -46,6 +48,30 @@ pub(crate) struct Level {
 impl Level {
     pub(crate) fn vertex_count(&self) -> usize {
         self.positions_q.len()
+    }
+
+    /// Room for `grow` more vertices and their faces (two each, six
+    /// half-edges), and in `scratch` for a level that size, reserved toward
+    /// the size `growth` expects (see [`room`]).
+    fn make_room(&mut self, grow: usize, growth: Growth, scratch: &mut Scratch) {
+        let n = self.vertex_count();
+        let (needed, target) = growth.room(n, grow);
+        self.reserve_vertices(needed, target);
+        scratch.make_room(needed, target);
+        let h = self.conn.origin.len();
+        let (needed, target) = (h + 6 * (needed - n), h + 6 * (target - n));
+        room::reserve(&mut self.conn.origin, needed, target);
+        room::reserve(&mut self.conn.twin, needed, target);
+    }
+
+    /// Room for `needed` vertices' positions and colours (`target` if they move).
+    fn reserve_vertices(&mut self, needed: usize, target: usize) {
+        room::reserve(&mut self.positions_q, needed, target);
+        room::reserve(&mut self.positions, needed, target);
+        room::reserve(&mut self.conn.out, needed, target);
+        if let Some(colours) = &mut self.colours {
+            room::reserve(colours, needed, target);
+        }
     }
 
     /// Position and colour of the next vertex whose fan is already in
@@ -237,14 +263,8 @@ impl Decoder {
         }
         // Reserve no more than the payload could possibly describe (a bit per vertex).
         let grow = (added as usize).min(payload.len().saturating_mul(8));
-        self.level.positions_q.reserve(grow);
-        self.level.positions.reserve(grow);
-        self.level.conn.out.reserve(grow);
-        if let Some(colours) = &mut self.level.colours {
-            colours.reserve(grow);
-        }
-        self.level.conn.origin.reserve(6 * grow);
-        self.level.conn.twin.reserve(6 * grow);
+        self.level
+            .make_room(grow, self.growth(n), &mut self.scratch);
         let undone = self
             .level
             .undo_batch(&cleaning, &decimating, &mut self.scratch);
@@ -266,6 +286,15 @@ impl Decoder {
             (info.vertices as usize, info.faces as usize)
         } else {
             (self.level.vertex_count(), self.face_count())
+        }
+    }
+
+    /// How much the level of `now` vertices is expected to grow by the end
+    /// of the stream (the header's claim, which [`room`] bounds).
+    fn growth(&self, now: usize) -> Growth {
+        Growth {
+            now,
+            last: self.header.final_level().vertices as usize,
         }
     }
 
@@ -346,15 +375,16 @@ impl Decoder {
                 }
             }
         }
+        let growth = self.growth(now.0);
         let charted = self.charted.as_mut().expect("cut above");
-        if let Err(e) = charted.apply(parts, self.threads) {
+        if let Err(e) = charted.apply(parts, growth, self.threads) {
             self.broken = true;
             return Err(e);
         }
         if some {
             charted.number_owned(now.0, &inserted, self.refined);
         } else {
-            charted.merge(&mut self.level);
+            charted.merge(&mut self.level, growth);
         }
         self.applied = expected;
         Ok(())
