@@ -30,20 +30,44 @@ export { shareCharts };
  * @property {((event: MessageEvent<import('./chart-helper.js').HelperReply>) => void) | null} onmessage
  */
 
+/**
+ * How far past the vertices a batch verifies the merged level may reserve
+ * toward the header's final count (as the codec's decoder does,
+ * codec/core/src/decoder/room.rs): a hostile header claiming millions of
+ * vertices costs at most this factor in memory.
+ */
+export const RESERVE_AHEAD = 4;
+
 /** The merged level of a charted stream, grown by every member's chart updates. */
 class ChartMerge {
   /**
    * @param {import('./codec.js').Level} start the level when the members stopped merging
-   * @param {number} capacity vertices to make room for (the final level's)
+   * @param {number} expected vertices the header says the last level has
    */
-  constructor(start, capacity) {
-    const room = 3 * Math.max(capacity, start.vertices);
+  constructor(start, expected) {
+    this.expected = expected;
     this.vertices = start.vertices;
-    this.positions = new Float32Array(room);
-    this.positions.set(start.positions.subarray(0, 3 * start.vertices));
-    this.colours = start.colours ? new Uint8Array(room) : null;
-    if (this.colours && start.colours) this.colours.set(start.colours.subarray(0, 3 * start.vertices));
+    this.positions = start.positions.slice(0, 3 * start.vertices);
+    this.colours = start.colours ? start.colours.slice(0, 3 * start.vertices) : null;
     this.indices = new Uint32Array(0);
+  }
+
+  /**
+   * Room for `needed` vertices, reserved toward the expected final count
+   * when the arrays must move, but no further than RESERVE_AHEAD × needed.
+   * @param {number} needed
+   */
+  #makeRoom(needed) {
+    if (3 * needed <= this.positions.length) return;
+    const room = 3 * Math.min(Math.max(this.expected, needed), RESERVE_AHEAD * needed);
+    const positions = new Float32Array(room);
+    positions.set(this.positions.subarray(0, 3 * this.vertices));
+    this.positions = positions;
+    if (this.colours) {
+      const colours = new Uint8Array(room);
+      colours.set(this.colours.subarray(0, 3 * this.vertices));
+      this.colours = colours;
+    }
   }
 
   /**
@@ -53,9 +77,10 @@ class ChartMerge {
   add(updates, vertices) {
     let total = 0;
     for (const u of updates) total += u.positions.length / 3;
-    if (this.vertices + total !== vertices || 3 * vertices > this.positions.length) {
+    if (this.vertices + total !== vertices) {
       throw new DecodeError(`the charts bring ${this.vertices + total} vertices, the level has ${vertices}`);
     }
+    this.#makeRoom(vertices);
     let faces = 0;
     for (const u of updates) {
       this.positions.set(u.positions, 3 * this.vertices);

@@ -9,7 +9,7 @@ import { readFileSync } from 'node:fs';
 import test from 'node:test';
 import { ChartHelper } from '../src/chart-helper.js';
 import { DecodeError, PARTED_TAG, VitrineCodec, splitStream } from '../src/codec.js';
-import { PooledDecoder, shareCharts } from '../src/decode-pool.js';
+import { PooledDecoder, RESERVE_AHEAD, shareCharts } from '../src/decode-pool.js';
 import { Reconstruction } from '../src/reconstruction.js';
 import { fixture, sha256, wasmPath } from './support/fixtures.mjs';
 
@@ -87,6 +87,39 @@ test('charts are shared out largest first, each to the least loaded member, help
   assert.deepEqual(shareCharts([5, 5, 5, 5, 5], 4), [[3], [0, 4], [1], [2]]);
   // More members than charts: the decode worker goes without.
   assert.deepEqual(shareCharts([3, 7], 3), [[], [1], [0]]);
+});
+
+test('a header claiming 50 M vertices in its last level: the pool reserves only what the batches verify', async () => {
+  const { base, batches } = splitStream(charted.stream);
+  // The level table (codec/core/FORMAT.md): 12 bytes a level from byte 28,
+  // vertices then faces; the last level claims the decoder's default limit.
+  const hostile = base.slice();
+  const table = new DataView(hostile.buffer, hostile.byteOffset, hostile.byteLength);
+  const at = 28 + 12 * batches.length;
+  const [before, facesBefore] = [table.getUint32(at - 12, true), table.getUint32(at - 8, true)];
+  const claimed = 50_000_000;
+  table.setUint32(at, claimed, true);
+  table.setUint32(at + 4, facesBefore + 2 * (claimed - before), true);
+  const codec = await VitrineCodec.instantiate(wasm);
+  const pool = new PooledDecoder(codec, hostile, await helpers(1));
+  let merged = 0;
+  for (const [k, batch] of batches.slice(0, -1).entries()) {
+    await pool.apply(batch);
+    const level = pool.view();
+    assert.equal(sha256(level.indices), charted.levels[k + 1].indices, `level ${k + 1}`);
+    if (batch[0] !== PARTED_TAG) continue;
+    merged++;
+    // The merged level's arrays, not the decoder's memory, once the charts are shared.
+    assert.ok(
+      level.positions.buffer.byteLength <= RESERVE_AHEAD * 12 * level.vertices,
+      `level ${k + 1}: ${level.positions.buffer.byteLength} bytes for ${level.vertices} vertices`,
+    );
+  }
+  assert.ok(merged >= 1, 'the pool merged a level');
+  const memory = /** @type {WebAssembly.Memory} */ (codec.exports.memory).buffer.byteLength;
+  assert.ok(memory < 64 << 20, `the decoder's memory: ${memory} bytes`);
+  await assert.rejects(pool.apply(/** @type {Uint8Array} */ (batches.at(-1))), DecodeError);
+  pool.free();
 });
 
 test('damage in a chart a helper refines fails the batch with a decode error', async () => {
