@@ -103,6 +103,7 @@ test('a point-cloud model page draws its first level at once, while the later le
   await page.goto(`${service.url}/m/cube`);
   const first = await until(page, 's.shownLevel === 0');
   assert.equal(first.status, 'refining');
+  assert.equal(first.antialias, false, 'the splat view says it does not multisample');
   assert.deepEqual(Object.keys(first.shownAtMs).map(Number), [0], 'only the first level was drawn');
   assert.equal(first.vertices, manifest.levels[0].points ?? manifest.levels[0].vertices);
   const coarse = await capture(page);

@@ -81,7 +81,7 @@ import { PointModel } from './splats/point-model.js';
  * @property {number} deriveMs time computing normals, edges and θ in the decode worker
  * @property {number} normalsMs time the renderer spent deriving normals (levels sent without them)
  * @property {boolean | null} antialias whether the picture is multisampled (null before the
- *   renderer starts): not on a CPU rasteriser (rasteriser.js)
+ *   renderer starts): not on a CPU rasteriser (rasteriser.js); never for a point cloud's splats
  * @property {number | null} firstFrameMs performance.now() of the first frame with a mesh
  * @property {Record<number, number>} shownAtMs performance.now() when each level was first drawn
  * @property {Record<number, number>} decodedAtMs performance.now() when the decode worker's notice of

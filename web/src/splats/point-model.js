@@ -51,6 +51,7 @@ export class PointModel {
   async start(module, request) {
     const host = this.#host;
     this.view = new SplatView(host.place, { camera: host.current, background: host.background, model: host.model });
+    host.set({ antialias: this.view.antialias });
     const worker = await host.createWorker();
     this.#worker = worker;
     worker.onerror = (event) => host.fail(`the splat worker failed: ${event.message}`);

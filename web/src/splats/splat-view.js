@@ -39,8 +39,13 @@ export class SplatView {
     this.canvas = document.createElement('canvas');
     this.canvas.className = 'splats';
     Object.assign(this.canvas.style, { position: 'absolute', inset: '0', width: '100%', height: '100%', pointerEvents: 'none' });
+    // Never multisampled: each splat fades out by its own Gaussian, so its
+    // edges are smooth without it, and blending thousands of overlapping
+    // splats is where a CPU rasteriser spends its time.
     const gl = this.canvas.getContext('webgl2', { antialias: false, preserveDrawingBuffer: false });
     if (!gl) throw new Error('The splat view needs WebGL2.');
+    /** Whether the picture is multisampled (the context's own answer). */
+    this.antialias = gl.getContextAttributes()?.antialias ?? false;
     place(this.canvas);
     try {
       this.renderer = new SplatRenderer(gl, options.background);
