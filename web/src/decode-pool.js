@@ -33,7 +33,7 @@ export { shareCharts };
 /**
  * How far past the vertices a batch verifies the merged level may reserve
  * toward the header's final count (as the codec's decoder does,
- * codec/core/src/decoder/room.rs): a hostile header claiming millions of
+ * codec/core/src/room.rs): a hostile header claiming millions of
  * vertices costs at most this factor in memory.
  */
 export const RESERVE_AHEAD = 4;

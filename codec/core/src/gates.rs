@@ -183,9 +183,9 @@ pub(crate) struct Traversal {
 
 impl Traversal {
     /// Room for a mesh of `needed` vertices and its faces, two a vertex
-    /// (`target` vertices' worth if the arrays move; see the decoder's `room`).
+    /// (`target` vertices' worth if the arrays move; see [`crate::room`]).
     pub(crate) fn make_room(&mut self, needed: usize, target: usize) {
-        use crate::decoder::room::reserve;
+        use crate::room::reserve;
         reserve(&mut self.tag, needed, target);
         reserve(&mut self.face_done, 2 * needed, 2 * target);
     }

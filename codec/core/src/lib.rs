@@ -32,6 +32,7 @@ mod patch;
 mod predict;
 mod priors;
 mod quantize;
+mod room;
 mod training;
 
 pub use charts::MAX_CHARTS;

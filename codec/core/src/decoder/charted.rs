@@ -5,11 +5,11 @@
 use std::ops::Range;
 
 use super::conquest::{PassInput, Scratch};
-use super::room::{self, Growth};
 use super::{read_pass, Level};
 use crate::charts::{canonical_level, chart_connectivity, cut, decode_labels, CanonicalLevel};
 use crate::format::Reader;
 use crate::gates::PassKind;
+use crate::room::{self, Growth};
 use crate::{Error, Result};
 
 pub(super) struct Charted {

@@ -26,8 +26,8 @@ pub(crate) struct Scratch {
 impl Scratch {
     /// Room for a level of `needed` vertices (`target` if the arrays move).
     pub(super) fn make_room(&mut self, needed: usize, target: usize) {
-        super::room::reserve(&mut self.umbrellas, needed, target);
-        super::room::reserve(&mut self.valences, needed, target);
+        crate::room::reserve(&mut self.umbrellas, needed, target);
+        crate::room::reserve(&mut self.valences, needed, target);
         self.traversal.make_room(needed, target);
     }
 }

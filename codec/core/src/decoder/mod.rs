@@ -2,7 +2,6 @@
 
 mod charted;
 mod conquest;
-pub(crate) mod room;
 
 use crate::base_mesh;
 use crate::charts::MAX_CHARTS;
@@ -12,11 +11,11 @@ use crate::format::{
 use crate::gates::{GateStatistics, PassKind};
 use crate::halfedge::Connectivity;
 use crate::quantize::Quantization;
+use crate::room::{self, Growth};
 use crate::{Error, IndexedMesh, Result};
 pub use charted::ChartLevel;
 use charted::{read_part, Charted, Labelled};
 use conquest::{PassInput, Scratch};
-use room::Growth;
 
 /// Budget a decoder enforces before it allocates or grows anything.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -11,12 +11,12 @@
 //! factor in memory.
 
 /// How far past the verified size a level may reserve.
-pub(super) const AHEAD: usize = 4;
+pub(crate) const AHEAD: usize = 4;
 
 /// How big a level is expected to end: the stream's final vertex count
 /// over the count now, applied to one level (the whole level or a chart).
 #[derive(Clone, Copy, Debug)]
-pub(super) struct Growth {
+pub(crate) struct Growth {
     pub now: usize,
     pub last: usize,
 }
@@ -33,7 +33,7 @@ impl Growth {
     /// Vertices to make room for in a level of `len` that a batch grows by
     /// `grow` (verified): the expected final size, held to `grow` at least
     /// and to [`AHEAD`] times the size after the batch at most.
-    pub(super) fn room(self, len: usize, grow: usize) -> (usize, usize) {
+    pub(crate) fn room(self, len: usize, grow: usize) -> (usize, usize) {
         let needed = len.saturating_add(grow);
         let target = self.hint(len).clamp(needed, needed.saturating_mul(AHEAD));
         (needed, target)
