@@ -5,6 +5,9 @@
 // scripts/bench-ab.sh. Every level of each stream, decoded serially (a
 // charted stream's charts in turn, as a viewer without workers does); prints
 // each build's median, and refuses builds that decode a different final level.
+// Last, each instance's linear memory: WebAssembly memory never shrinks, so
+// it is the most any one decode of these streams needed (with the streams'
+// input copies).
 //   node bench/wasm-ab.mjs [--runs 9] BEFORE.wasm AFTER.wasm … STREAM.vtr …
 // Keep a build aside with
 //   cp ../target/wasm32-unknown-unknown/wasm/vitrine_wasm.wasm /tmp/before.wasm
@@ -63,3 +66,5 @@ for (const stream of streams) {
   const median = (/** @type {number[]} */ t) => [...t].sort((a, b) => a - b)[t.length >> 1];
   console.log(`| ${basename(stream)} | ${times.map((t) => `${median(t).toFixed(1)} ms`).join(' | ')} |`);
 }
+const mib = (/** @type {VitrineCodec} */ codec) => (codec.exports.memory.buffer.byteLength / 2 ** 20).toFixed(0);
+console.log(`| memory, the most | ${codecs.map((codec) => `${mib(codec)} MiB`).join(' | ')} |`);

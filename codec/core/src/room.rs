@@ -3,7 +3,7 @@
 //! A level's arrays (and the scratch's, sized to the level every pass) grow
 //! batch by batch. Grown by doubling, each was copied every level or two,
 //! and WebAssembly's allocator cannot remap a block as glibc does: igea-2m
-//! decoded 2–5 % slower in WebAssembly and ended with a third more memory
+//! decoded 0–5 % slower in WebAssembly and ended with a third more memory
 //! (419 MiB against 309). The header's final count would let the decoder
 //! reserve once, but the header is untrusted, so the decoder reserves
 //! toward it no further than [`AHEAD`] times what the batch in hand verifies
