@@ -23,11 +23,13 @@ pub(crate) struct Growth {
 
 impl Growth {
     /// The expected final size of a level of `len` vertices now.
+    /// In u64: on wasm32 a usize product of two vertex counts overflows.
     fn hint(self, len: usize) -> usize {
         if self.now == 0 {
             return len;
         }
-        (len as u128 * self.last as u128 / self.now as u128).min(usize::MAX as u128) as usize
+        let hint = (len as u64).saturating_mul(self.last as u64) / self.now as u64;
+        usize::try_from(hint).unwrap_or(usize::MAX)
     }
 
     /// Vertices to make room for in a level of `len` that a batch grows by
@@ -68,6 +70,12 @@ mod tests {
         assert_eq!(hostile.room(10, 90), (100, 400));
         // A chart of a tenth of the level expects a tenth of the growth.
         assert_eq!(g.room(100, 10), (110, 300));
+        // Counts whose product overflows 32 bits (a usize on wasm32).
+        let big = Growth {
+            now: 100_000,
+            last: 2_000_000,
+        };
+        assert_eq!(big.room(100_000, 100_000), (200_000, 800_000));
         // Never less than the batch needs.
         let shrinking = Growth {
             now: 1_000,
