@@ -22,11 +22,11 @@
 // rasterise its last frame for seconds, which delayed the next page's
 // navigation by up to 15 s.
 //   node bench/pool-viewer.mjs --mesh /work/scans/igea-2m.ply [--runs 3] [--workers 1,2,4] [--antialias auto,on]
-import { readFileSync } from 'node:fs';
 import { loadavg, cpus } from 'node:os';
 import { parseArgs } from 'node:util';
 import { launch } from '../test/support/browser.mjs';
 import { startService } from '../test/support/service.mjs';
+import { median, quiet } from './machine.mjs';
 
 const { values } = parseArgs({
   options: {
@@ -84,29 +84,6 @@ async function load(slug, decoders, last, antialias) {
   if (s.decoders !== (slug === 'plain' ? 1 : decoders)) throw new Error(`${slug}: ${s.decoders} decoders, asked for ${decoders}`);
   return { first: s.firstFrameMs, decoded: s.decodedAtMs[last], last: s.shownAtMs[last], decode: s.decodeMs, vertices: s.vertices };
 }
-
-/** Busy and total jiffies of every core since boot (/proc/stat). */
-function cpuTimes() {
-  const [, ...fields] = readFileSync('/proc/stat', 'utf8').split('\n')[0].trim().split(/\s+/);
-  const t = fields.map(Number);
-  const idle = t[3] + t[4];
-  const total = t.reduce((a, b) => a + b, 0);
-  return { busy: total - idle, total };
-}
-
-/** Waits until the machine's cores were less than 15 % busy over half a second (at most 60 s). */
-async function quiet() {
-  const until = performance.now() + 60_000;
-  while (performance.now() < until) {
-    const a = cpuTimes();
-    await new Promise((resolve) => setTimeout(resolve, 500));
-    const b = cpuTimes();
-    if ((b.busy - a.busy) / Math.max(1, b.total - a.total) < 0.15) return;
-  }
-}
-
-/** @param {number[]} xs */
-const median = (xs) => [...xs].sort((a, b) => a - b)[xs.length >> 1];
 
 /** @typedef {{ first: number, decoded: number, last: number, decode: number, vertices: number }} Load */
 

@@ -515,6 +515,85 @@ test('touch: one finger turns, a pinch zooms, two fingers pan', async () => {
   await page.close();
 });
 
+/** @param {Page} page @returns {Promise<import('../src/renderer.js').FrameStats>} */
+function frameStats(page) {
+  return page.evaluate(() => /** @type {any} */ (document.querySelector('vitrine-viewer')).viewer.renderer.frameStats());
+}
+
+/**
+ * Drags the mouse in circles over the canvas until `condition` (over the
+ * viewer's state `s`) holds; the button stays down.
+ * @param {Page} page
+ * @param {string} condition
+ */
+async function dragUntil(page, condition) {
+  await page.mouse.move(WIDTH / 2, HEIGHT / 2);
+  await page.mouse.down();
+  const end = Date.now() + 30_000;
+  let met = false;
+  for (let i = 0; !met && Date.now() < end; i++) {
+    await page.mouse.move(WIDTH / 2 + 80 * Math.cos(i / 5), HEIGHT / 2 + 40 * Math.sin(i / 5));
+    met = await page.evaluate((body) => new Function('s', `return (${body});`)(/** @type {any} */ (document.querySelector('vitrine-viewer')).viewer.state), condition);
+  }
+  assert.ok(met, `while dragging: ${condition}`);
+}
+
+test('while the view moves a coarser level stands in (motion=coarse), the level itself at rest and in the wireframe', async () => {
+  const last = manifest.levels[manifest.last_level];
+  for (const path of ['/embed/torus?motion=coarse', '/embed/torus?motion=coarse&offscreen=off']) {
+    const { page, problems } = await open(path);
+    await until(page, `s.status === 'complete' && s.drawnLevel === ${manifest.last_level}`);
+    const kept = await frameStats(page);
+    // The finest level shown with at most a quarter of the last level's triangles (src/motion.js).
+    assert.ok(kept.standInLevel !== null && kept.standInLevel < manifest.last_level, JSON.stringify(kept));
+    const standIn = manifest.levels[kept.standInLevel];
+    assert.ok(standIn.faces <= last.vertices / 2, `stand-in of ${standIn.faces} triangles for ${last.faces}`);
+    assert.equal(kept.standInFrames, 0, 'nothing moved yet');
+    await dragUntil(page, `s.drawnLevel === ${kept.standInLevel}`);
+    // Picking (measurements, annotations) reads the level itself, not the stand-in.
+    const picked = await page.evaluate(async () => {
+      const viewer = /** @type {any} */ (document.querySelector('vitrine-viewer')).viewer;
+      const drawn = viewer.state.drawnLevel;
+      const target = viewer.camera.state.target;
+      const eye = viewer.camera.basis().eye;
+      const direction = target.map((/** @type {number} */ t, /** @type {number} */ k) => t - eye[k]);
+      return { drawn, pick: await viewer.renderer.pick({ origin: eye, direction }, 0.01) };
+    });
+    await page.mouse.up();
+    assert.equal(picked.pick.level, manifest.last_level, `picked while level ${picked.drawn} was drawn`);
+    const s = await state(page);
+    assert.equal(s.shownLevel, manifest.last_level, 'the level on screen is still the last');
+    // Once the view rests, the last level is drawn again.
+    await until(page, `s.drawnLevel === ${manifest.last_level}`, 5_000);
+    const moved = await frameStats(page);
+    assert.ok(moved.standInFrames > 0, JSON.stringify(moved));
+    // The wireframe shows the level's own triangles, moving or not.
+    await page.locator('vitrine-viewer canvas').focus();
+    await page.keyboard.press('w');
+    await page.waitForFunction(() => /** @type {any} */ (document.querySelector('vitrine-viewer')).viewer.renderer.edges);
+    const wired = await frameStats(page);
+    await dragUntil(page, 'true');
+    for (let i = 0; i < 5; i++) await page.mouse.move(100 + 20 * i, 100 + 10 * i);
+    await page.mouse.up();
+    assert.equal((await state(page)).drawnLevel, manifest.last_level);
+    assert.equal((await frameStats(page)).standInFrames, wired.standInFrames, 'no stand-in in the wireframe');
+    assert.deepEqual(problems, []);
+    await page.close();
+  }
+  // `full` keeps no stand-in and draws the level in every frame.
+  const { page } = await open('/embed/torus?motion=full');
+  await until(page, `s.status === 'complete' && s.drawnLevel === ${manifest.last_level}`);
+  await dragUntil(page, 'true');
+  for (let i = 0; i < 5; i++) await page.mouse.move(100 + 20 * i, 100 + 10 * i);
+  await page.mouse.up();
+  const full = await frameStats(page);
+  assert.equal(full.standInLevel, null);
+  assert.equal(full.standInFrames, 0);
+  // Every mode times the level's frames (auto decides on them).
+  assert.equal(full.timedFrame?.triangles, last.faces);
+  await page.close();
+});
+
 test('a damaged batch becomes a visible message, and retry recovers', async () => {
   const page = await browser.context.newPage();
   await page.route('**/batches/3*', async (route) => {

@@ -4,7 +4,7 @@
  * model page at `/m/{slug}` (viewer, description, embed snippets) and the
  * bare viewer at `/embed/{slug}` for iframes, and the quality study at
  * `/study/{slug}?invitation=…` (study/page.js). `?device=`, `?token=`,
- * `?level=`, `?offscreen=off`, `?decoders=` and `?antialias=` on a page's URL are passed to the viewer.
+ * `?level=`, `?offscreen=off`, `?decoders=`, `?antialias=` and `?motion=` on a page's URL are passed to the viewer.
  */
 
 import './element.js';
@@ -35,7 +35,7 @@ function el(tag, attributes = {}, children = []) {
 /** @param {string} slug */
 function viewerElement(slug) {
   const viewer = el('vitrine-viewer', { src: `/api/models/${slug}` });
-  for (const key of ['device', 'token', 'level', 'offscreen', 'decoders', 'antialias']) {
+  for (const key of ['device', 'token', 'level', 'offscreen', 'decoders', 'antialias', 'motion']) {
     const value = params.get(key);
     if (value !== null) viewer.setAttribute(key, value);
   }

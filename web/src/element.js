@@ -13,11 +13,14 @@
  * quality study), `background` (`#rrggbb`: the canvas's colour; the study's
  * black), `decoders` (workers that decode a charted stream together, 1–4;
  * default: the device's cores, at most 4), `antialias` (`on` or `off`;
- * default: on a GPU, off on a CPU rasteriser: rasteriser.js). `chrome="none"` draws the model and nothing else. The
+ * default: on a GPU, off on a CPU rasteriser: rasteriser.js), `motion` (what is
+ * drawn while the view moves: `auto`, a coarser level where the level on
+ * screen is slow to draw; `full`; `coarse`: motion.js). `chrome="none"` draws the model and nothing else. The
  * worker and the decoder are loaded from beside this script, so the element
  * works on another origin (the service answers CORS).
  */
 
+import { motionMode } from './motion.js';
 import { ViewerUi } from './ui.js';
 import { Viewer } from './viewer.js';
 
@@ -79,6 +82,7 @@ export class VitrineViewerElement extends HTMLElement {
       background: parseColour(this.getAttribute('background')),
       decoders: positiveInteger(this.getAttribute('decoders')),
       antialias: onOff(this.getAttribute('antialias')),
+      motion: motionMode(this.getAttribute('motion')),
     });
     void this.viewer.start();
   }

@@ -12,7 +12,7 @@
  */
 
 import { occludedPoints, pickLevel } from './pick.js';
-import { Renderer } from './renderer.js';
+import { Renderer, frameStats } from './renderer.js';
 
 /** @typedef {import('./reconstruction.js').LevelMessage} LevelMessage */
 /** @typedef {import('./renderer.js').AtlasResolution} AtlasResolution */
@@ -24,8 +24,9 @@ import { Renderer } from './renderer.js';
  * @property {(level: { level: number, vertices: number, normalsMs: number }) => void} onSwap a level is
  *   complete on the GPU (normalsMs: the renderer's time deriving normals so far)
  * @property {(level: number) => void} onHeld a level above the hold is complete on the GPU, off screen
- * @property {(frame: { level: number | null, colourResolution: AtlasResolution | null, reliefTop: number | null, at: number }) => void} onFrame
- *   a frame was drawn: the level and colour texture in it, the top of its θ scale in degrees
+ * @property {(frame: { level: number | null, standIn: boolean, colourResolution: AtlasResolution | null, reliefTop: number | null, at: number }) => void} onFrame
+ *   a frame was drawn: the level and colour texture in it (`standIn`: that level stood in for the
+ *   one on screen while the view moved; motion.js), the top of its θ scale in degrees
  *   (null: not in the relief view), at (performance.now() of this page)
  * @property {(bounds: import('./geometry.js').Bounds) => import('./camera.js').OrbitCamera} camera
  *   the viewer's camera, made from the base mesh's bounds by whoever needs it first
@@ -55,6 +56,8 @@ import { Renderer } from './renderer.js';
  * @property {(eye: number[], points: number[][], tolerance: number) => Promise<boolean[]>} occlusion which
  *   points the level on screen hides from the eye
  * @property {() => Promise<Blob>} snapshot the view as a PNG
+ * @property {() => Promise<import('./renderer.js').FrameStats | null>} frameStats frames drawn, and the
+ *   stand-in's (benchmarks and tests of motion.js)
  * @property {() => Promise<number>} finish resolves when the GPU has drawn every frame asked
  *   for so far, with performance.now() then (benchmarks: frames are drawn some time after they are issued)
  * @property {(port: MessagePort) => void} attach the port a decode worker posts its levels
@@ -76,8 +79,10 @@ export function canTransfer(canvas) {
  * worker reports WebGL2, else on the main thread.
  * @param {HTMLCanvasElement} canvas
  * @param {RenderHooks} hooks
- * @param {{ offscreen: boolean, createWorker: () => Promise<Worker>, background?: [number, number, number], antialias?: boolean | null }} options
- *   `antialias`: multisample (null or absent: on a GPU only; rasteriser.js)
+ * @param {{ offscreen: boolean, createWorker: () => Promise<Worker>, background?: [number, number, number], antialias?: boolean | null,
+ *   motion?: import('./motion.js').MotionMode }} options
+ *   `antialias`: multisample (null or absent: on a GPU only; rasteriser.js); `motion`: what is drawn
+ *   while the view moves (motion.js; default `auto`)
  * @returns {Promise<RenderHost>}
  */
 export async function openRenderer(canvas, hooks, options) {
@@ -89,11 +94,11 @@ export async function openRenderer(canvas, hooks, options) {
         worker.onerror = () => resolve(false);
       });
       performance.mark(`vitrine:render-worker-${ready ? 'ready' : 'without-webgl2'}`);
-      if (ready) return WorkerRenderer.start(canvas, worker, hooks, options.background, options.antialias);
+      if (ready) return WorkerRenderer.start(canvas, worker, hooks, options);
       worker.terminate();
     }
   }
-  return new MainRenderer(canvas, hooks, options.background, options.antialias);
+  return new MainRenderer(canvas, hooks, options);
 }
 
 /** The fallback: the renderer on the page's own canvas. */
@@ -103,22 +108,24 @@ class MainRenderer {
   /**
    * @param {HTMLCanvasElement} canvas
    * @param {RenderHooks} hooks
-   * @param {[number, number, number]} [background]
-   * @param {boolean | null} [antialias]
+   * @param {{ background?: [number, number, number], antialias?: boolean | null, motion?: import('./motion.js').MotionMode }} options
    */
-  constructor(canvas, hooks, background, antialias) {
+  constructor(canvas, hooks, { background, antialias, motion }) {
     this.hooks = hooks;
     this.renderer = new Renderer(canvas, null, {
       onSwap: (level) => hooks.onSwap({ level: level.level, vertices: level.vertices, normalsMs: this.renderer.normalsMs }),
       onHeld: (level) => hooks.onHeld(level.level),
-      onFrame: () =>
+      onFrame: () => {
+        const drawn = this.renderer.drawn;
         hooks.onFrame({
-          level: this.renderer.current?.source.level ?? null,
+          level: drawn?.source.level ?? null,
+          standIn: Boolean(drawn && drawn === this.renderer.standIn),
           colourResolution: this.renderer.colourResolution,
           reliefTop: this.renderer.reliefTop,
           at: performance.now(),
-        }),
-    }, { background, antialias: antialias ?? undefined });
+        });
+      },
+    }, { background, antialias: antialias ?? undefined, motion });
   }
 
   get camera() {
@@ -226,6 +233,10 @@ class MainRenderer {
     return this.renderer.snapshot();
   }
 
+  async frameStats() {
+    return frameStats(this.renderer);
+  }
+
   async finish() {
     this.renderer.finish();
     return performance.now();
@@ -279,11 +290,10 @@ class WorkerRenderer {
    * @param {HTMLCanvasElement} canvas
    * @param {Worker} worker
    * @param {RenderHooks} hooks
-   * @param {[number, number, number]} [background]
-   * @param {boolean | null} [antialias]
+   * @param {{ background?: [number, number, number], antialias?: boolean | null, motion?: import('./motion.js').MotionMode }} options
    * @returns {Promise<RenderHost>}
    */
-  static start(canvas, worker, hooks, background, antialias) {
+  static start(canvas, worker, hooks, { background, antialias, motion }) {
     const host = new WorkerRenderer(canvas, worker, hooks);
     const { width, height } = canvas;
     const offscreen = canvas.transferControlToOffscreen();
@@ -304,7 +314,7 @@ class WorkerRenderer {
         }
       };
       worker.onerror = (event) => reject(new Error(`the render worker failed: ${event.message}`));
-      worker.postMessage({ type: 'canvas', canvas: offscreen, width, height, background, antialias }, [offscreen]);
+      worker.postMessage({ type: 'canvas', canvas: offscreen, width, height, background, antialias, motion }, [offscreen]);
     });
   }
 
@@ -352,6 +362,7 @@ class WorkerRenderer {
         this.colourResolution = message.colourResolution;
         this.hooks.onFrame({
           level: message.level,
+          standIn: message.standIn,
           colourResolution: message.colourResolution,
           reliefTop: message.reliefTop,
           at: message.at - performance.timeOrigin,
@@ -454,6 +465,11 @@ class WorkerRenderer {
     const answer = await this.#ask({ type: 'snapshot' });
     if (answer instanceof Blob) return answer;
     throw new Error(String(answer?.error ?? 'the picture could not be encoded'));
+  }
+
+  /** @returns {Promise<import('./renderer.js').FrameStats | null>} */
+  frameStats() {
+    return this.#ask({ type: 'frameStats' });
   }
 
   /** @returns {Promise<Capture>} */

@@ -21,18 +21,19 @@ import { OrbitCamera } from './camera.js';
 import { frameBox } from './frame.js';
 import { occludedPoints, pickLevel } from './pick.js';
 import { isSoftwareRasteriser, probeRenderer } from './rasteriser.js';
-import { Renderer } from './renderer.js';
+import { Renderer, frameStats } from './renderer.js';
 
 /**
  * Commands from the page.
- * @typedef {{ type: 'canvas', canvas: OffscreenCanvas, width: number, height: number, background?: [number, number, number], antialias?: boolean | null }
+ * @typedef {{ type: 'canvas', canvas: OffscreenCanvas, width: number, height: number, background?: [number, number, number], antialias?: boolean | null,
+ *     motion?: import('./motion.js').MotionMode }
  *   | { type: 'source', port: MessagePort }
  *   | { type: 'size', width: number, height: number }
  *   | { type: 'camera', state: import('./camera.js').OrbitState | null, radius?: number | null }
  *   | { type: 'look', look: import('./program.js').Look }
  *   | { type: 'pick', id: number, ray: import('./pick.js').Ray, snap: number }
  *   | { type: 'occlusion', id: number, eye: number[], points: number[][], tolerance: number }
- *   | { type: 'snapshot', id: number }
+ *   | { type: 'snapshot', id: number } | { type: 'frameStats', id: number }
  *   | { type: 'wireframe', on: boolean }
  *   | { type: 'relief', on: boolean }
  *   | { type: 'hold', level: number | null }
@@ -49,7 +50,7 @@ import { Renderer } from './renderer.js';
  *   | { type: 'failed', message: string }
  *   | { type: 'swap', level: number, vertices: number, normalsMs: number }
  *   | { type: 'held', level: number }
- *   | { type: 'frame', level: number | null, colourResolution: import('./renderer.js').AtlasResolution | null,
+ *   | { type: 'frame', level: number | null, standIn: boolean, colourResolution: import('./renderer.js').AtlasResolution | null,
  *       reliefTop: number | null, at: number }
  *   | { type: 'status', lost: boolean, settled: boolean, edges: boolean, frames: number }
  *   | { type: 'captured', id: number, width: number, height: number, rgba: Uint8Array }
@@ -131,8 +132,9 @@ function fromDecoder(message) {
  * @param {OffscreenCanvas} canvas @param {number} width @param {number} height
  * @param {[number, number, number] | undefined} background
  * @param {boolean | null | undefined} antialias multisample (null or absent: on a GPU only; rasteriser.js)
+ * @param {import('./motion.js').MotionMode | undefined} motion what is drawn while the view moves (motion.js)
  */
-function start(canvas, width, height, background, antialias) {
+function start(canvas, width, height, background, antialias, motion) {
   canvas.width = width;
   canvas.height = height;
   try {
@@ -144,19 +146,21 @@ function start(canvas, width, height, background, antialias) {
         onHeld: (level) => report({ type: 'held', level: level.level }),
         onFrame: () => {
           // The page wants each level's, colour texture's and relief
-          // scale's first frame, not every frame of an orbit: one small
-          // message per change.
-          const level = renderer?.current?.source.level ?? null;
+          // scale's first frame, and each change between the level and
+          // its stand-in (motion.js), not every frame of an orbit: one
+          // small message per change.
+          const level = renderer?.drawn?.source.level ?? null;
+          const standIn = Boolean(renderer?.drawn && renderer.drawn === renderer.standIn);
           const colourResolution = renderer?.colourResolution ?? null;
           const reliefTop = renderer?.reliefTop ?? null;
-          const key = `${level} ${colourResolution} ${reliefTop}`;
+          const key = `${level} ${standIn} ${colourResolution} ${reliefTop}`;
           if (key === lastFrame) return;
           lastFrame = key;
-          report({ type: 'frame', level, colourResolution, reliefTop, at: epochNow() });
+          report({ type: 'frame', level, standIn, colourResolution, reliefTop, at: epochNow() });
         },
         onTick: sendStatus,
       },
-      { ...WORKER_UPLOAD, background, antialias: antialias ?? (rendererName !== null && !isSoftwareRasteriser(rendererName)) },
+      { ...WORKER_UPLOAD, background, motion, antialias: antialias ?? (rendererName !== null && !isSoftwareRasteriser(rendererName)) },
     );
   } catch (error) {
     report({ type: 'failed', message: error instanceof Error ? error.message : String(error) });
@@ -172,7 +176,7 @@ scope.onmessage = (event) => {
   const command = event.data;
   switch (command.type) {
     case 'canvas':
-      start(command.canvas, command.width, command.height, command.background, command.antialias);
+      start(command.canvas, command.width, command.height, command.background, command.antialias, command.motion);
       break;
     case 'source':
       // A new decode worker (a retry): the old one's port is closed, so nothing late arrives from it.
@@ -234,6 +238,9 @@ scope.onmessage = (event) => {
       );
       break;
     }
+    case 'frameStats':
+      report({ type: 'answer', id: command.id, value: renderer ? frameStats(renderer) : null });
+      break;
     case 'finish':
       renderer?.finish();
       report({ type: 'finished', id: command.id, at: epochNow() });

@@ -29,6 +29,7 @@
  */
 
 import { multiply } from './camera.js';
+import { MotionPolicy, REST_MS } from './motion.js';
 import { NormalsTask, deriveNormals } from './normals-task.js';
 import { DEFAULT_LOOK, bindCcc, bindLook, bindRelief, createAtlasTexture, createCellTexture, createProgram } from './program.js';
 import { isSoftwareRasteriser, probeRenderer } from './rasteriser.js';
@@ -66,6 +67,7 @@ const cancelFrame = typeof cancelAnimationFrame === 'function' ? (id) => cancelA
  * @property {number} [uploadChunkBytes] bytes per bufferSubData (default 256 KB)
  * @property {boolean} [antialias] multisample (default: on a GPU, not on a CPU rasteriser; rasteriser.js)
  * @property {[number, number, number]} [background] clear colour, 0–1 components (default shading.js BACKGROUND)
+ * @property {import('./motion.js').MotionMode} [motion] what is drawn while the view moves (motion.js; default `auto`)
  */
 
 /** @typedef {HTMLCanvasElement | OffscreenCanvas} AnyCanvas */
@@ -87,6 +89,16 @@ export class Renderer {
   current = null;
   /** @type {GpuMesh | null} */
   pending = null;
+  /**
+   * A coarser level shown before `current`, drawn in its place while the
+   * view moves where `current` is slow to draw (motion.js).
+   * @type {GpuMesh | null}
+   */
+  standIn = null;
+  /** The level in the last frame drawn: `current`, or `standIn` while moving. @type {GpuMesh | null} */
+  drawn = null;
+  /** Frames that drew the stand-in. */
+  standInFrames = 0;
   wireframe = false;
   /** The relief view: colour by θ where the level on screen has it. */
   relief = false;
@@ -135,6 +147,22 @@ export class Renderer {
   #next = null;
   /** @type {any} WEBGL_lose_context, for tests */
   #loseContext = null;
+  /** @type {MotionPolicy} */
+  #motion;
+  /**
+   * The finest level received that the stand-in may be (motion.js): it
+   * becomes the stand-in once it is neither on screen nor on its way there,
+   * drawn or not (levels that arrive while the first is drawn are skipped).
+   * @type {LevelMessage | null}
+   */
+  #candidate = null;
+  /** The view of the last frame drawn, to tell motion (view and projection, then the look). */
+  /** @type {{ matrix: Float32Array<ArrayBufferLike>, look: import('./program.js').Look, width: number, height: number }} */
+  #lastView = { matrix: new Float32Array(0), look: DEFAULT_LOOK, width: 0, height: 0 };
+  /** A frame of `current` whose cost is being timed: its fence, when it was issued, its triangles. @type {{ fence: WebGLSync, at: number, triangles: number } | null} */
+  #timing = null;
+  /** Draws the level again once motion has stopped. @type {ReturnType<typeof setTimeout> | null} */
+  #rest = null;
 
   /**
    * @param {AnyCanvas} canvas
@@ -153,6 +181,7 @@ export class Renderer {
     this.uploadBudgetMs = options.uploadBudgetMs ?? UPLOAD_BUDGET_MS;
     this.uploadChunkBytes = options.uploadChunkBytes ?? UPLOAD_CHUNK_BYTES;
     this.background = options.background ?? BACKGROUND;
+    this.#motion = new MotionPolicy(options.motion ?? 'auto');
     const antialias = options.antialias ?? !isSoftwareRasteriser(probeRenderer() ?? '');
     const gl = /** @type {WebGL2RenderingContext | null} */ (
       canvas.getContext('webgl2', { antialias, powerPreference: 'high-performance' })
@@ -205,6 +234,12 @@ export class Renderer {
     this.#cellTexture = null;
     this.#atlasTexture = null;
     this.#store.lose();
+    // The stand-in's buffers went with the context: it is uploaded again
+    // after the levels (and drawn once it is complete).
+    const standIn = this.standIn?.source ?? null;
+    this.standIn = null;
+    this.drawn = null;
+    this.#timing = null;
     this.#init();
     this.#uploadColour();
     const shown = this.current?.source;
@@ -216,6 +251,7 @@ export class Renderer {
     // A held level goes back behind the one that was on screen.
     if (shown && newest && newest !== shown && this.#holds(newest.level)) this.show(shown);
     if (newest) this.show(newest);
+    if (standIn) this.standIn = this.#allocate(standIn);
     this.requestFrame();
   }
 
@@ -225,6 +261,10 @@ export class Renderer {
    */
   show(level) {
     this.#store.receive(level);
+    const candidate = this.#candidate;
+    if (this.#motion.keeps(level.indices.length / 3, candidate && candidate.indices.length / 3, this.#store.capacity)) {
+      this.#candidate = level;
+    }
     if (this.lost) {
       this.#next = null;
       this.pending = { ...emptyMesh(), source: level };
@@ -236,7 +276,8 @@ export class Renderer {
       this.#next = level;
       return;
     }
-    if (this.pending) this.#release(this.pending);
+    // A level superseded before it was shown may be the stand-in.
+    if (this.pending) this.#retire(this.pending);
     this.pending = this.#allocate(level);
     this.#parked = false;
     this.#schedule();
@@ -426,8 +467,15 @@ export class Renderer {
     let issued = false;
     const pending = this.pending;
     const start = performance.now();
+    this.#pollTiming(start);
     const inBudget = () => performance.now() - start < this.uploadBudgetMs;
-    if (pending && this.#parked) {
+    if (this.standIn?.uploads.length && caughtUp) {
+      // A stand-in allocated from a level skipped on its way to the screen
+      // (or after a lost context): small, and wanted before the next level
+      // is complete, since that one is what moving would be slow to draw.
+      issued = true;
+      this.#upload(this.standIn, this.standIn.source.vertices, inBudget);
+    } else if (pending && this.#parked) {
       if (!this.#holds(pending.source.level)) this.#swap(pending);
     } else if (pending && caughtUp) {
       issued = true;
@@ -446,22 +494,89 @@ export class Renderer {
     if (this.#dirty) {
       this.#dirty = false;
       issued = true;
-      this.#draw();
-      this.frames++;
-      this.hooks.onFrame?.();
+      this.#drawFrame(start);
     }
     if (issued) {
       if (this.#fence) gl.deleteSync(this.#fence);
       this.#fence = gl.fenceSync(gl.SYNC_GPU_COMMANDS_COMPLETE, 0);
       gl.flush();
     }
-    if ((this.pending && !this.#parked) || this.current?.uploads.length) this.#schedule();
+    const uploading = (this.pending && !this.#parked) || this.current?.uploads.length || this.standIn?.uploads.length;
+    if (uploading || this.#timing) this.#schedule();
     this.hooks.onTick?.();
+  }
+
+  /**
+   * Draws the level on screen, or the stand-in while the view moves where
+   * the level is slow (motion.js); times the level's frames.
+   * @param {number} now
+   */
+  #drawFrame(now) {
+    this.#noteMotion(now);
+    const current = this.current;
+    const standIn = this.standIn;
+    const coarse =
+      current !== null &&
+      standIn !== null &&
+      standIn.uploads.length === 0 &&
+      standIn.normalJob === null &&
+      !this.wireframe &&
+      !this.relief &&
+      this.#motion.drawsStandIn(now, triangles(current), triangles(standIn));
+    this.#draw(coarse ? standIn : current);
+    if (coarse) {
+      this.standInFrames++;
+      // Once the view has rested, the level itself.
+      if (this.#rest !== null) clearTimeout(this.#rest);
+      this.#rest = setTimeout(() => {
+        this.#rest = null;
+        this.requestFrame();
+      }, REST_MS);
+    } else if (current && !this.#timing) {
+      const gl = this.gl;
+      const fence = gl.fenceSync(gl.SYNC_GPU_COMMANDS_COMPLETE, 0);
+      if (fence) this.#timing = { fence, at: now, triangles: triangles(current) };
+    }
+    this.frames++;
+    this.hooks.onFrame?.();
+  }
+
+  /**
+   * Whether the camera or the look (model rotation, light, section)
+   * differs from the last frame's: if so, the view moved now. The first
+   * frame with a camera, and a resized canvas, are not motion.
+   * @param {number} now
+   */
+  #noteMotion(now) {
+    const { width, height } = this.canvas;
+    const camera = this.camera;
+    const matrix = camera ? multiply(camera.projection(width / Math.max(1, height)), camera.view()) : new Float32Array(0);
+    const last = this.#lastView;
+    const resized = last.width !== width || last.height !== height;
+    const turned = !resized && matrix.some((x, i) => x !== last.matrix[i]);
+    if (last.matrix.length > 0 && (turned || last.look !== this.look)) this.#motion.moved(now);
+    this.#lastView = { matrix, look: this.look, width, height };
+  }
+
+  /** Reads the timed frame's fence: once the GPU is done, the frame's cost is known. @param {number} now */
+  #pollTiming(now) {
+    const timing = this.#timing;
+    if (!timing) return;
+    const gl = this.gl;
+    if (gl.getSyncParameter(timing.fence, gl.SYNC_STATUS) !== gl.SIGNALED) return;
+    gl.deleteSync(timing.fence);
+    this.#timing = null;
+    this.#motion.time(timing.triangles, now - timing.at);
+  }
+
+  /** The last timed frame of a level: its triangles and its milliseconds to the GPU done (motion.js). */
+  get timedFrame() {
+    return this.#motion.timed;
   }
 
   /** @param {GpuMesh} pending complete on the GPU: it replaces the level on screen */
   #swap(pending) {
-    if (this.current) this.#release(this.current);
+    if (this.current) this.#retire(this.current);
     this.current = pending;
     this.pending = null;
     this.#parked = false;
@@ -471,6 +586,7 @@ export class Renderer {
       this.pending = this.#allocate(this.#next);
       this.#next = null;
     }
+    this.#adoptCandidate();
   }
 
   /**
@@ -484,16 +600,21 @@ export class Renderer {
     return mesh;
   }
 
-  /** Derives the pending level's normals in tasks of their own, a budget's worth each (normals-task.js). */
+  /** Derives the stand-in's and the pending level's normals in tasks of their own, a budget's worth each (normals-task.js). */
   #normals = new NormalsTask(() => this.#normalsTask());
 
   #normalsTask() {
-    const mesh = this.pending;
+    // The stand-in first (small, and wanted before the next level is complete), then the pending level.
+    const mesh = this.standIn?.normalJob ? this.standIn : this.pending?.normalJob ? this.pending : null;
     if (!mesh?.normalJob || this.lost) return;
     const start = performance.now();
     this.#deriveNormals(mesh, () => performance.now() - start < this.uploadBudgetMs);
-    if (mesh.normalJob) this.#normals.queue();
-    else this.#schedule();
+    if (mesh.normalJob) {
+      this.#normals.queue();
+      return;
+    }
+    this.#schedule();
+    if (this.pending?.normalJob || this.standIn?.normalJob) this.#normals.queue();
   }
 
   /**
@@ -518,7 +639,7 @@ export class Renderer {
 
   /** The vertex store's GPU buffers, (re)made when they are missing or too small. */
   #ensureStore() {
-    return this.#store.ensureGpu(this.gl, [this.current, this.pending]);
+    return this.#store.ensureGpu(this.gl, [this.current, this.pending, this.standIn]);
   }
 
   /**
@@ -537,6 +658,34 @@ export class Renderer {
     releaseMesh(this.gl, mesh);
   }
 
+  /**
+   * A level leaves the screen, or its way there: it becomes the stand-in if
+   * it is the candidate (motion.js), else it is freed.
+   * @param {GpuMesh} mesh
+   */
+  #retire(mesh) {
+    if (mesh.source === this.#candidate && this.standIn?.source !== mesh.source) this.#standIn(mesh);
+    else this.#release(mesh);
+  }
+
+  /** @param {GpuMesh} mesh the new stand-in (its normals and uploads are finished in later tasks and frames) */
+  #standIn(mesh) {
+    if (this.standIn) this.#release(this.standIn);
+    this.standIn = mesh;
+    if (mesh.normalJob) this.#normals.queue();
+  }
+
+  /**
+   * Makes the candidate the stand-in once it is no level's way to the
+   * screen: a level skipped while the first was drawn was never allocated.
+   */
+  #adoptCandidate() {
+    const candidate = this.#candidate;
+    if (!candidate || this.standIn?.source === candidate) return;
+    if ([this.current, this.pending].some((m) => m?.source === candidate) || this.#next === candidate) return;
+    this.#standIn(this.#allocate(candidate));
+  }
+
   /** Switches the shader to the CCC lookup when a mapping and a colour texture are on the GPU. */
   #bindColour() {
     const mapping = this.#mapping;
@@ -547,11 +696,12 @@ export class Renderer {
     bindCcc(this.gl, this.#uniforms, on ? { parameters: mapping.parameters, atlas, cellTexture, atlasTexture } : null);
   }
 
-  #draw() {
+  /** @param {GpuMesh | null} mesh the level to draw (the stand-in while moving) */
+  #draw(mesh = this.current) {
     const gl = this.gl;
     gl.viewport(0, 0, this.canvas.width, this.canvas.height);
     gl.clear(gl.COLOR_BUFFER_BIT | gl.DEPTH_BUFFER_BIT);
-    const mesh = this.current;
+    this.drawn = mesh;
     this.reliefTop = null;
     if (!mesh || !this.camera || !this.#program) return;
     const view = this.camera.view();
@@ -590,4 +740,28 @@ export class Renderer {
     }
     gl.bindVertexArray(null);
   }
+}
+
+/** @param {GpuMesh} mesh */
+function triangles(mesh) {
+  return mesh.source.indices.length / 3;
+}
+
+/**
+ * How the renderer has drawn so far (benchmarks and tests of motion.js).
+ * @typedef {object} FrameStats
+ * @property {number} frames frames drawn
+ * @property {number} standInFrames of them, frames of the stand-in
+ * @property {number | null} standInLevel the level kept as the stand-in
+ * @property {{ triangles: number, ms: number } | null} timedFrame the last timed frame of a level
+ */
+
+/** @param {Renderer} renderer @returns {FrameStats} */
+export function frameStats(renderer) {
+  return {
+    frames: renderer.frames,
+    standInFrames: renderer.standInFrames,
+    standInLevel: renderer.standIn?.source.level ?? null,
+    timedFrame: renderer.timedFrame,
+  };
 }

@@ -37,6 +37,9 @@ import { PointModel } from './splats/point-model.js';
  * @property {number | null} [decoders] workers that decode a charted stream together
  *   (decode-pool.js): the decode worker and helpers; null or absent: as many as the
  *   device has cores, at most {@link MAX_DECODERS}; 1: no helpers
+ * @property {import('./motion.js').MotionMode | null} [motion] what is drawn while the view
+ *   moves (motion.js): `auto` (null or absent) a coarser level where the level on screen is
+ *   slow to draw, `full` always that level, `coarse` always the coarser one
  */
 
 /**
@@ -70,6 +73,8 @@ import { PointModel } from './splats/point-model.js';
  * @typedef {object} ViewerState
  * @property {'loading' | 'refining' | 'complete' | 'capped' | 'error'} status
  * @property {number} shownLevel level on screen (-1: none yet)
+ * @property {number} drawnLevel level in the last frame: `shownLevel`, or below it while the view
+ *   moves and a coarser level stands in for it (motion.js; -1: no frame yet)
  * @property {number} decodedLevel newest level the worker sent
  * @property {number} readyLevel newest level complete on the GPU (on screen or held off it)
  * @property {number} targetLevel level the viewer is heading for (cap or `level` option)
@@ -147,6 +152,7 @@ export class Viewer {
   state = {
     status: 'loading',
     shownLevel: -1,
+    drawnLevel: -1,
     decodedLevel: -1,
     readyLevel: -1,
     targetLevel: 0,
@@ -701,6 +707,7 @@ export class Viewer {
         createWorker: () => this.#createWorker(this.options.renderWorkerUrl),
         background: this.options.background,
         antialias: this.options.antialias,
+        motion: this.options.motion ?? 'auto',
       },
     ).then(
       (renderer) => (this.renderer = renderer),
@@ -815,6 +822,7 @@ export class Viewer {
   /** @param {{ level: number | null, colourResolution: 'low' | 'full' | null, reliefTop: number | null, at: number }} frame */
   #framed(frame) {
     if (frame.reliefTop !== this.state.reliefTop) this.#set({ reliefTop: frame.reliefTop });
+    if (frame.level !== null && frame.level !== this.state.drawnLevel) this.#set({ drawnLevel: frame.level });
     const resolution = frame.colourResolution;
     if (resolution && !(resolution in this.state.colourAtMs)) {
       this.state.colourAtMs[resolution] = frame.at;

@@ -1,0 +1,119 @@
+// @ts-check
+/**
+ * What the renderer draws while the view moves. A scan's last level can
+ * have millions of triangles: a desktop GPU draws them in a few
+ * milliseconds, but a tablet's may take tens, and a CPU rasteriser (a
+ * blocklisted GPU, a virtual machine; rasteriser.js) about a second on a
+ * small machine, while sharing its cores with the decoders. Orbiting then
+ * stutters at a frame a second. So the renderer keeps one coarser level
+ * (the *stand-in*: the finest level already shown with at most a quarter of
+ * the target's triangles, and at most {@link STAND_IN_TRIANGLES}) and draws
+ * it in place of the level on screen while the view moves, where a frame
+ * of that level took longer than {@link SLOW_FRAME_MS}; {@link REST_MS}
+ * after the last move, the level is drawn again. Picking, measuring,
+ * snapshots and the wireframe and relief views always use the level itself.
+ *
+ * Keeping the stand-in costs its normals and indices only (vertices are
+ * shared by every level: vertex-store.js), a few MB at most. The cost of a
+ * frame is timed with a fence (renderer.js), which resolves to an animation
+ * frame: a fast GPU's frames read as one frame interval, well under the
+ * threshold.
+ */
+
+/** Motion that has stopped this long is over: the next frame draws the level on screen. */
+export const REST_MS = 250;
+
+/** A frame of the level that took longer than this (under 20 a second) makes motion use the stand-in. */
+export const SLOW_FRAME_MS = 50;
+
+/**
+ * The most triangles a stand-in has: about 60 ms a frame on SwiftShader at
+ * 800 × 600 on 2 cores, and what a phone's GPU draws in a frame.
+ */
+export const STAND_IN_TRIANGLES = 250_000;
+
+/**
+ * `auto`: the stand-in while moving where the level's frames are slow;
+ * `full`: always the level (no stand-in kept); `coarse`: the stand-in
+ * whenever the view moves (weak devices, tests).
+ * @typedef {'auto' | 'full' | 'coarse'} MotionMode
+ */
+
+/** @param {unknown} value @returns {MotionMode | null} */
+export function motionMode(value) {
+  return value === 'auto' || value === 'full' || value === 'coarse' ? value : null;
+}
+
+export class MotionPolicy {
+  /** performance.now() of the last change of view (−∞: never moved) */
+  movedAt = -Infinity;
+  /**
+   * The last timed frame of a level: its triangles and milliseconds from
+   * issue to the GPU done.
+   * @type {{ triangles: number, ms: number } | null}
+   */
+  timed = null;
+
+  /** @param {MotionMode} [mode] @param {number} [maxTriangles] */
+  constructor(mode = 'auto', maxTriangles = STAND_IN_TRIANGLES) {
+    this.mode = mode;
+    this.maxTriangles = maxTriangles;
+  }
+
+  /**
+   * The most triangles of a stand-in for levels heading for `capacity`
+   * vertices (about two triangles each): a quarter of that, at most
+   * `maxTriangles`.
+   * @param {number} capacity
+   */
+  budget(capacity) {
+    return Math.min(this.maxTriangles, Math.floor(capacity / 2));
+  }
+
+  /**
+   * Whether a level leaving the screen becomes the stand-in (replacing
+   * `standIn`, its triangles, or null): it is within the budget and finer.
+   * @param {number} triangles
+   * @param {number | null} standIn
+   * @param {number} capacity vertices of the target level
+   */
+  keeps(triangles, standIn, capacity) {
+    return this.mode !== 'full' && triangles <= this.budget(capacity) && (standIn === null || triangles > standIn);
+  }
+
+  /** The view changed at `now`. @param {number} now */
+  moved(now) {
+    this.movedAt = now;
+  }
+
+  /** @param {number} now */
+  moving(now) {
+    return now - this.movedAt < REST_MS;
+  }
+
+  /**
+   * A frame of a level of `triangles` took `ms` from issue to the GPU done.
+   * @param {number} triangles
+   * @param {number} ms
+   */
+  time(triangles, ms) {
+    this.timed = { triangles, ms };
+  }
+
+  /**
+   * Whether the next frame draws the stand-in (of `standIn` triangles, or
+   * null) in place of the level on screen (`current` triangles): the view
+   * is moving, the stand-in is at most half as heavy, and (`auto`) a frame
+   * of a level no heavier than this one was slow. An untimed level is drawn
+   * (and timed) once.
+   * @param {number} now
+   * @param {number} current
+   * @param {number | null} standIn
+   */
+  drawsStandIn(now, current, standIn) {
+    if (this.mode === 'full' || standIn === null || 2 * standIn > current || !this.moving(now)) return false;
+    if (this.mode === 'coarse') return true;
+    const timed = this.timed;
+    return timed !== null && timed.triangles <= current && timed.ms > SLOW_FRAME_MS;
+  }
+}
