@@ -150,6 +150,9 @@ test('a participant answers every step through the page; answers, durations, loc
   const yaw0 = JSON.parse(await cameraState(page)).yaw;
   await page.waitForTimeout(400);
   assert.notEqual(JSON.parse(await cameraState(page)).yaw, yaw0, 'the turntable turns');
+  // Every frame, turning or not, is of the level being judged: no coarser stand-in (src/motion.js).
+  const frames = await page.evaluate(() => /** @type {any} */ (document.querySelector('vitrine-viewer')).viewer.renderer.frameStats());
+  assert.ok(frames.frames > 1 && frames.standInLevel === null && frames.standInFrames === 0, JSON.stringify(frames));
   const begun = requests.length;
   await page.getByRole('button', { name: 'Begin the steps' }).click();
 

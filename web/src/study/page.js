@@ -239,6 +239,8 @@ export class StudyPage {
       hold: String(hold),
       background: '#000000',
       chrome: 'none',
+      // Participants judge each level as it is: never a coarser one while it turns (motion.js).
+      motion: 'full',
     }));
     if (this.offscreen) element.setAttribute('offscreen', this.offscreen);
     element.addEventListener('vitrine-interaction', (event) => {
