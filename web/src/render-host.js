@@ -24,9 +24,9 @@ import { Renderer, frameStats } from './renderer.js';
  * @property {(level: { level: number, vertices: number, normalsMs: number }) => void} onSwap a level is
  *   complete on the GPU (normalsMs: the renderer's time deriving normals so far)
  * @property {(level: number) => void} onHeld a level above the hold is complete on the GPU, off screen
- * @property {(frame: { level: number | null, standIn: boolean, colourResolution: AtlasResolution | null, reliefTop: number | null, at: number }) => void} onFrame
- *   a frame was drawn: the level and colour texture in it (`standIn`: that level stood in for the
- *   one on screen while the view moved; motion.js), the top of its θ scale in degrees
+ * @property {(frame: { level: number | null, colourResolution: AtlasResolution | null, reliefTop: number | null, at: number }) => void} onFrame
+ *   a frame was drawn: the level and colour texture in it (the level may be a coarser one standing in
+ *   for the one on screen while the view moves; motion.js), the top of its θ scale in degrees
  *   (null: not in the relief view), at (performance.now() of this page)
  * @property {(bounds: import('./geometry.js').Bounds) => import('./camera.js').OrbitCamera} camera
  *   the viewer's camera, made from the base mesh's bounds by whoever needs it first
@@ -115,16 +115,13 @@ class MainRenderer {
     this.renderer = new Renderer(canvas, null, {
       onSwap: (level) => hooks.onSwap({ level: level.level, vertices: level.vertices, normalsMs: this.renderer.normalsMs }),
       onHeld: (level) => hooks.onHeld(level.level),
-      onFrame: () => {
-        const drawn = this.renderer.drawn;
+      onFrame: () =>
         hooks.onFrame({
-          level: drawn?.source.level ?? null,
-          standIn: Boolean(drawn && drawn === this.renderer.standIn),
+          level: this.renderer.drawn?.source.level ?? null,
           colourResolution: this.renderer.colourResolution,
           reliefTop: this.renderer.reliefTop,
           at: performance.now(),
-        });
-      },
+        }),
     }, { background, antialias: antialias ?? undefined, motion });
   }
 
@@ -362,7 +359,6 @@ class WorkerRenderer {
         this.colourResolution = message.colourResolution;
         this.hooks.onFrame({
           level: message.level,
-          standIn: message.standIn,
           colourResolution: message.colourResolution,
           reliefTop: message.reliefTop,
           at: message.at - performance.timeOrigin,

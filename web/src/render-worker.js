@@ -50,7 +50,7 @@ import { Renderer, frameStats } from './renderer.js';
  *   | { type: 'failed', message: string }
  *   | { type: 'swap', level: number, vertices: number, normalsMs: number }
  *   | { type: 'held', level: number }
- *   | { type: 'frame', level: number | null, standIn: boolean, colourResolution: import('./renderer.js').AtlasResolution | null,
+ *   | { type: 'frame', level: number | null, colourResolution: import('./renderer.js').AtlasResolution | null,
  *       reliefTop: number | null, at: number }
  *   | { type: 'status', lost: boolean, settled: boolean, edges: boolean, frames: number }
  *   | { type: 'captured', id: number, width: number, height: number, rgba: Uint8Array }
@@ -150,13 +150,12 @@ function start(canvas, width, height, background, antialias, motion) {
           // its stand-in (motion.js), not every frame of an orbit: one
           // small message per change.
           const level = renderer?.drawn?.source.level ?? null;
-          const standIn = Boolean(renderer?.drawn && renderer.drawn === renderer.standIn);
           const colourResolution = renderer?.colourResolution ?? null;
           const reliefTop = renderer?.reliefTop ?? null;
-          const key = `${level} ${standIn} ${colourResolution} ${reliefTop}`;
+          const key = `${level} ${colourResolution} ${reliefTop}`;
           if (key === lastFrame) return;
           lastFrame = key;
-          report({ type: 'frame', level, standIn, colourResolution, reliefTop, at: epochNow() });
+          report({ type: 'frame', level, colourResolution, reliefTop, at: epochNow() });
         },
         onTick: sendStatus,
       },
