@@ -538,7 +538,7 @@ async function dragUntil(page, condition) {
   assert.ok(met, `while dragging: ${condition}`);
 }
 
-test('while the view moves a coarser level stands in (motion=coarse), the level itself at rest and in the wireframe', async () => {
+test('while the view moves or is held a coarser level stands in (motion=coarse), the level itself at rest and in the wireframe', async () => {
   const last = manifest.levels[manifest.last_level];
   for (const path of ['/embed/torus?motion=coarse', '/embed/torus?motion=coarse&offscreen=off']) {
     const { page, problems } = await open(path);
@@ -559,6 +559,9 @@ test('while the view moves a coarser level stands in (motion=coarse), the level 
       const direction = target.map((/** @type {number} */ t, /** @type {number} */ k) => t - eye[k]);
       return { drawn, pick: await viewer.renderer.pick({ origin: eye, direction }, 0.01) };
     });
+    // A drag that pauses is still a drag: the stand-in stays until the release.
+    await page.waitForTimeout(800);
+    assert.equal((await state(page)).drawnLevel, kept.standInLevel, 'held still, the pointer down');
     await page.mouse.up();
     assert.equal(picked.pick.level, manifest.last_level, `picked while level ${picked.drawn} was drawn`);
     const s = await state(page);

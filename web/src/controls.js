@@ -24,6 +24,8 @@ const WHEEL_ZOOM_PER_PX = 0.0015;
  * @property {() => void} toggleFullscreen
  * @property {(kind: Interaction) => void} [interacted] the visitor moved the camera (every move; the
  *   study's log coalesces them)
+ * @property {(on: boolean) => void} [grabbed] a pointer went down on the view (true), or the last
+ *   one came up (false): the renderer keeps drawing as if moving in between (motion.js)
  */
 
 /** @typedef {'orbit' | 'pan' | 'zoom' | 'pinch' | 'key'} Interaction */
@@ -44,8 +46,10 @@ export class OrbitControls {
   set locked(on) {
     this.#locked = on;
     if (on) {
+      const held = this.#pointers.size > 0;
       this.#pointers.clear();
       this.#pinch = null;
+      if (held) this.actions.grabbed?.(false);
     }
   }
 
@@ -77,6 +81,7 @@ export class OrbitControls {
       this.canvas.setPointerCapture(e.pointerId);
     } catch {}
     this.#pointers.set(e.pointerId, { x: e.clientX, y: e.clientY });
+    if (this.#pointers.size === 1) this.actions.grabbed?.(true);
     this.#panning = e.pointerType === 'mouse' && (e.button === 1 || e.button === 2 || e.shiftKey);
     this.#pinch = this.#pointers.size === 2 ? this.#twoFingers() : null;
     e.preventDefault();
@@ -113,6 +118,7 @@ export class OrbitControls {
     if (!this.#pointers.delete(e.pointerId)) return;
     // Lifting one of two fingers continues as a one-finger rotation from here.
     this.#pinch = this.#pointers.size === 2 ? this.#twoFingers() : null;
+    if (this.#pointers.size === 0) this.actions.grabbed?.(false);
   }
 
   #twoFingers() {

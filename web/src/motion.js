@@ -10,7 +10,8 @@
  * the target's triangles, and at most {@link STAND_IN_TRIANGLES}) and draws
  * it in place of the level on screen while the view moves, where a frame
  * of that level took longer than {@link SLOW_FRAME_MS}; {@link REST_MS}
- * after the last move, the level is drawn again. Picking, measuring,
+ * after the last move, the level is drawn again (after the release, when a
+ * pointer holds the view: a drag that pauses is still a drag). Picking, measuring,
  * snapshots and the wireframe and relief views always use the level itself.
  *
  * Keeping the stand-in costs its normals and indices only (vertices are
@@ -47,6 +48,8 @@ export function motionMode(value) {
 export class MotionPolicy {
   /** performance.now() of the last change of view (−∞: never moved) */
   movedAt = -Infinity;
+  /** The visitor holds the view (a pointer is down): moving until released, however still. */
+  grabbed = false;
   /**
    * The last timed frame of a level: its triangles and milliseconds from
    * issue to the GPU done.
@@ -88,7 +91,19 @@ export class MotionPolicy {
 
   /** @param {number} now */
   moving(now) {
-    return now - this.movedAt < REST_MS;
+    return this.grabbed || now - this.movedAt < REST_MS;
+  }
+
+  /**
+   * A pointer went down on the view, or the last came up (`now`): a drag
+   * that pauses is still a drag, so the level (a frame that may take
+   * seconds) waits for the release and the rest after it.
+   * @param {boolean} on
+   * @param {number} now
+   */
+  grab(on, now) {
+    if (this.grabbed && !on) this.movedAt = now;
+    this.grabbed = on;
   }
 
   /**

@@ -47,6 +47,8 @@ import { Renderer, frameStats } from './renderer.js';
  * @property {(level: number | null) => void} setHold show levels up to this one only (null: all);
  *   those above are uploaded and wait off screen (renderer.js `hold`)
  * @property {() => void} requestFrame
+ * @property {(on: boolean) => void} setGrabbed the visitor holds the view (a pointer is down): it
+ *   counts as moving until released (motion.js)
  * @property {(mapping: import('./renderer.js').ColourMapping | null) => void} setColourMapping
  * @property {(source: ImageBitmap, resolution: AtlasResolution) => void} setColourAtlas
  * @property {() => Promise<Capture>} capture draws and reads the pixels (rows bottom-up)
@@ -195,6 +197,11 @@ class MainRenderer {
 
   requestFrame() {
     this.renderer.requestFrame();
+  }
+
+  /** @param {boolean} on */
+  setGrabbed(on) {
+    this.renderer.setGrabbed(on);
   }
 
   /** @param {import('./renderer.js').ColourMapping | null} mapping */
@@ -402,6 +409,11 @@ class WorkerRenderer {
   requestFrame() {
     const camera = this.camera;
     this.worker.postMessage({ type: 'camera', state: camera ? camera.state : null, radius: camera?.radius ?? null });
+  }
+
+  /** @param {boolean} on */
+  setGrabbed(on) {
+    this.worker.postMessage({ type: 'grab', on });
   }
 
   /** @param {import('./renderer.js').ColourMapping | null} mapping */

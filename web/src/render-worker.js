@@ -34,7 +34,7 @@ import { Renderer, frameStats } from './renderer.js';
  *   | { type: 'pick', id: number, ray: import('./pick.js').Ray, snap: number }
  *   | { type: 'occlusion', id: number, eye: number[], points: number[][], tolerance: number }
  *   | { type: 'snapshot', id: number } | { type: 'frameStats', id: number }
- *   | { type: 'wireframe', on: boolean }
+ *   | { type: 'wireframe', on: boolean } | { type: 'grab', on: boolean }
  *   | { type: 'relief', on: boolean }
  *   | { type: 'hold', level: number | null }
  *   | { type: 'colourMapping', mapping: import('./renderer.js').ColourMapping | null }
@@ -200,6 +200,9 @@ scope.onmessage = (event) => {
       break;
     case 'wireframe':
       renderer?.setWireframe(command.on);
+      break;
+    case 'grab':
+      renderer?.setGrabbed(command.on);
       break;
     case 'relief':
       renderer?.setRelief(command.on);

@@ -526,12 +526,7 @@ export class Renderer {
     this.#draw(coarse ? standIn : current);
     if (coarse) {
       this.standInFrames++;
-      // Once the view has rested, the level itself.
-      if (this.#rest !== null) clearTimeout(this.#rest);
-      this.#rest = setTimeout(() => {
-        this.#rest = null;
-        this.requestFrame();
-      }, REST_MS);
+      this.#awaitRest();
     } else if (current && !this.#timing) {
       const gl = this.gl;
       const fence = gl.fenceSync(gl.SYNC_GPU_COMMANDS_COMPLETE, 0);
@@ -539,6 +534,26 @@ export class Renderer {
     }
     this.frames++;
     this.hooks.onFrame?.();
+  }
+
+  /** Draws the level once the view has rested (not while it is held: the release does). */
+  #awaitRest() {
+    if (this.#rest !== null) clearTimeout(this.#rest);
+    this.#rest = setTimeout(() => {
+      this.#rest = null;
+      if (!this.#motion.grabbed) this.requestFrame();
+    }, REST_MS);
+  }
+
+  /**
+   * The visitor holds the view (a pointer is down), or let it go: while
+   * held it counts as moving (motion.js), and the level comes back after
+   * the release.
+   * @param {boolean} on
+   */
+  setGrabbed(on) {
+    this.#motion.grab(on, performance.now());
+    if (!on && this.drawn && this.drawn === this.standIn) this.#awaitRest();
   }
 
   /**

@@ -255,6 +255,7 @@ export class Viewer {
       toggleWireframe: () => this.points === null && this.setWireframe(!this.#wireframe),
       toggleFullscreen: () => ui.toggleFullscreen(),
       interacted: (kind) => this.#emit('vitrine-interaction', { kind }),
+      grabbed: (on) => this.renderer?.setGrabbed(on),
     });
     ui.onReset = () => this.resetView();
     ui.onWireframe = () => this.setWireframe(!this.#wireframe);

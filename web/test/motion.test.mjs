@@ -70,3 +70,17 @@ test('motion modes parse from attributes and URLs', () => {
   assert.equal(motionMode('fast'), null);
   assert.equal(motionMode(null), null);
 });
+
+test('a held view counts as moving until the release, then rests', () => {
+  const policy = new MotionPolicy('coarse');
+  policy.moved(0);
+  policy.grab(true, 10);
+  // The drag pauses: long past the rest, the pointer is still down.
+  assert.equal(policy.drawsStandIn(10 * REST_MS, 4_000_000, 235_000), true);
+  policy.grab(false, 5_000);
+  assert.equal(policy.drawsStandIn(5_000 + REST_MS - 1, 4_000_000, 235_000), true, 'the rest counts from the release');
+  assert.equal(policy.drawsStandIn(5_000 + REST_MS, 4_000_000, 235_000), false);
+  // A release without a grab (a lost pointer) moves nothing.
+  policy.grab(false, 9_000);
+  assert.equal(policy.drawsStandIn(9_001, 4_000_000, 235_000), false);
+});
