@@ -6,7 +6,7 @@
  * blocklisted GPU, a virtual machine; rasteriser.js) about a second on a
  * small machine, while sharing its cores with the decoders. Orbiting then
  * stutters at a frame a second. So the renderer keeps one coarser level
- * (the *stand-in*: the finest level already shown with at most a quarter of
+ * (the *stand-in*: the finest level received with at most a quarter of
  * the target's triangles, and at most {@link STAND_IN_TRIANGLES}) and draws
  * it in place of the level on screen while the view moves, where a frame
  * of that level took longer than {@link SLOW_FRAME_MS}; {@link REST_MS}
@@ -28,8 +28,10 @@ export const REST_MS = 250;
 export const SLOW_FRAME_MS = 50;
 
 /**
- * The most triangles a stand-in has: about 60 ms a frame on SwiftShader at
- * 800 × 600 on 2 cores, and what a phone's GPU draws in a frame.
+ * The most triangles a stand-in has. On SwiftShader at 800 × 600 on 2
+ * cores, frames of a 200 k-triangle stand-in came about 145 ms apart, of a
+ * 36 k one 80 ms (the rest of a frame's cost is fixed), against 1–3 s for
+ * a 4.3 M-triangle level (BENCHMARKS.md, "Viewer").
  */
 export const STAND_IN_TRIANGLES = 250_000;
 
