@@ -10,8 +10,9 @@
  * the target's triangles, and at most {@link STAND_IN_TRIANGLES}) and draws
  * it in place of the level on screen while the view moves, where a frame
  * of that level took longer than {@link SLOW_FRAME_MS}; {@link REST_MS}
- * after the last move, the level is drawn again (after the release, when a
- * pointer holds the view: a drag that pauses is still a drag). Picking, measuring,
+ * after the last move (longer where the level's frames take seconds:
+ * {@link MAX_REST_MS}), the level is drawn again (after the release, when
+ * a pointer holds the view: a drag that pauses is still a drag). Picking, measuring,
  * snapshots and the wireframe and relief views always use the level itself.
  *
  * Keeping the stand-in costs its normals and indices only (vertices are
@@ -23,6 +24,14 @@
 
 /** Motion that has stopped this long is over: the next frame draws the level on screen. */
 export const REST_MS = 250;
+
+/**
+ * The longest rest: where a frame of the level takes seconds (a CPU
+ * rasteriser), the view must stay still for half a frame, up to this, before
+ * one is started, since every move made while it is drawn waits for it. A
+ * pause between wheel turns or key presses then keeps the stand-in.
+ */
+export const MAX_REST_MS = 1000;
 
 /** A frame of the level that took longer than this (under 20 a second) makes motion use the stand-in. */
 export const SLOW_FRAME_MS = 50;
@@ -93,7 +102,12 @@ export class MotionPolicy {
 
   /** @param {number} now */
   moving(now) {
-    return this.grabbed || now - this.movedAt < REST_MS;
+    return this.grabbed || now - this.movedAt < this.restMs();
+  }
+
+  /** How long the view must stay still before the level is drawn: {@link REST_MS}, or half its last timed frame, at most {@link MAX_REST_MS}. */
+  restMs() {
+    return Math.min(MAX_REST_MS, Math.max(REST_MS, (this.timed?.ms ?? 0) / 2));
   }
 
   /**

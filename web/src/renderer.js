@@ -29,7 +29,7 @@
  */
 
 import { multiply } from './camera.js';
-import { MotionPolicy, REST_MS } from './motion.js';
+import { MotionPolicy } from './motion.js';
 import { NormalsTask, deriveNormals } from './normals-task.js';
 import { DEFAULT_LOOK, bindCcc, bindLook, bindRelief, createAtlasTexture, createCellTexture, createProgram } from './program.js';
 import { isSoftwareRasteriser, probeRenderer } from './rasteriser.js';
@@ -542,7 +542,7 @@ export class Renderer {
     this.#rest = setTimeout(() => {
       this.#rest = null;
       if (!this.#motion.grabbed) this.requestFrame();
-    }, REST_MS);
+    }, this.#motion.restMs());
   }
 
   /**

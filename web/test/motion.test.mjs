@@ -1,6 +1,6 @@
 import assert from 'node:assert/strict';
 import { test } from 'node:test';
-import { MotionPolicy, REST_MS, SLOW_FRAME_MS, STAND_IN_TRIANGLES, motionMode } from '../src/motion.js';
+import { MAX_REST_MS, MotionPolicy, REST_MS, SLOW_FRAME_MS, STAND_IN_TRIANGLES, motionMode } from '../src/motion.js';
 
 /**
  * The levels a stand-in is chosen from as they leave the screen one after
@@ -83,4 +83,17 @@ test('a held view counts as moving until the release, then rests', () => {
   // A release without a grab (a lost pointer) moves nothing.
   policy.grab(false, 9_000);
   assert.equal(policy.drawsStandIn(9_001, 4_000_000, 235_000), false);
+});
+
+test('where the level takes seconds a frame, the view must stay still longer before one starts', () => {
+  const policy = new MotionPolicy('auto');
+  policy.time(4_000_000, 30);
+  assert.equal(policy.restMs(), REST_MS, 'a fast level: the usual rest');
+  policy.time(4_000_000, 1_200);
+  assert.equal(policy.restMs(), 600, 'half a frame');
+  policy.moved(0);
+  assert.equal(policy.drawsStandIn(599, 4_000_000, 235_000), true, 'a pause between wheel turns keeps the stand-in');
+  assert.equal(policy.drawsStandIn(600, 4_000_000, 235_000), false);
+  policy.time(4_000_000, 3_100);
+  assert.equal(policy.restMs(), MAX_REST_MS);
 });
