@@ -6,14 +6,16 @@
 // drawn, with the viewer's `motion` modes alternated load by load (`full`:
 // the level on screen in every frame, as before 5 Dec 2026; `auto`: a
 // coarser level while moving where the level's frames are slow; motion.js).
-// Two scenarios per load:
+// Three scenarios, a load each:
 // - `rest`: the last level on screen, then a drag of --seconds;
+// - `wheel`: the last level on screen, then a wheel turn every 400 ms for
+//   --seconds (zooming in, then out): pauses that a drag does not have;
 // - `refine`: a drag from the first frame until the last level is decoded,
 //   then the mouse released (when is that level drawn?).
 // Times are from navigation start (ViewerState.decodedAtMs, shownAtMs);
 // frames are the render worker's (renderer.js frameStats). Each load starts
 // on a quiet machine. Median of --runs.
-//   node bench/orbit-bench.mjs --mesh /work/scans/igea-2m.ply [--runs 3] [--seconds 5] [--modes full,auto]
+//   node bench/orbit-bench.mjs --mesh /work/scans/igea-2m.ply [--runs 3] [--seconds 5] [--modes full,auto] [--scenarios rest,wheel,refine]
 import { cpus, loadavg } from 'node:os';
 import { parseArgs } from 'node:util';
 import { launch } from '../test/support/browser.mjs';
@@ -26,6 +28,7 @@ const { values } = parseArgs({
     runs: { type: 'string', default: '3' },
     seconds: { type: 'string', default: '5' },
     modes: { type: 'string', default: 'full,auto' },
+    scenarios: { type: 'string', default: 'rest,wheel,refine' },
   },
 });
 if (!values.mesh) {
@@ -36,6 +39,8 @@ const runs = Number(values.runs);
 const seconds = Number(values.seconds);
 const modes = values.modes.split(',');
 for (const m of modes) if (!['auto', 'full', 'coarse'].includes(m)) throw new Error(`--modes: auto, full or coarse, not ${m}`);
+const scenarios = /** @type {Array<'rest' | 'wheel' | 'refine'>} */ (values.scenarios.split(','));
+for (const x of scenarios) if (!['rest', 'wheel', 'refine'].includes(x)) throw new Error(`--scenarios: rest, wheel or refine, not ${x}`);
 
 const t0 = performance.now();
 const service = await startService({ models: [{ slug: 'scan', title: 'Scan', kind: 'file', file: values.mesh, policy: 'open' }] });
@@ -77,6 +82,7 @@ async function drag(page, done) {
  * @typedef {object} Orbit
  * @property {number} fps frames a second during the drag
  * @property {number} standInShare the share of those frames that drew the stand-in
+ * @property {number} levelFrames frames of the level itself during the motion (seconds each on SwiftShader)
  * @property {number | null} standInLevel
  * @property {number} decoded last level decoded (ms from navigation; `refine`)
  * @property {number} drawn last level drawn (ms from navigation; `refine`), or after the
@@ -87,7 +93,7 @@ async function drag(page, done) {
 /**
  * One cold load and one drag.
  * @param {string} mode
- * @param {'rest' | 'refine'} scenario
+ * @param {'rest' | 'wheel' | 'refine'} scenario
  * @returns {Promise<Orbit>}
  */
 async function orbit(mode, scenario) {
@@ -100,7 +106,7 @@ async function orbit(mode, scenario) {
       [n],
       { timeout: 300_000, polling: 50 },
     );
-  if (scenario === 'rest') {
+  if (scenario !== 'refine') {
     await shown(last);
     await page.evaluate(() => /** @type {any} */ (document.querySelector('vitrine-viewer')).viewer.renderer.finish());
   } else {
@@ -112,14 +118,23 @@ async function orbit(mode, scenario) {
   const before = await stats(page);
   const start = performance.now();
   const until = start + seconds * 1000;
-  await drag(page, async () =>
-    scenario === 'rest' ? performance.now() >= until : (await state(page)).decodedAtMs[last] !== undefined,
-  );
+  if (scenario === 'wheel') {
+    await page.mouse.move(400, 300);
+    const turns = Math.floor((seconds * 1000) / 400);
+    for (let i = 0; i < turns; i++) {
+      await page.mouse.wheel(0, i < turns / 2 ? -120 : 120);
+      await sleep(400);
+    }
+  } else {
+    await drag(page, async () =>
+      scenario === 'rest' ? performance.now() >= until : (await state(page)).decodedAtMs[last] !== undefined,
+    );
+  }
   const after = await stats(page);
   const elapsed = (performance.now() - start) / 1000;
   await page.mouse.up();
   const released = await page.evaluate(() => performance.now());
-  if (scenario === 'rest') {
+  if (scenario !== 'refine') {
     // The level itself, drawn again once the view rests, and that frame done
     // on the GPU (after the frames queued while dragging).
     await page.waitForFunction((n) => /** @type {any} */ (document.querySelector('vitrine-viewer')).viewer.state.drawnLevel === n, last, {
@@ -137,9 +152,10 @@ async function orbit(mode, scenario) {
   return {
     fps: frames / elapsed,
     standInShare: (after.standInFrames - before.standInFrames) / Math.max(1, frames),
+    levelFrames: frames - (after.standInFrames - before.standInFrames),
     standInLevel: after.standInLevel,
     decoded: s.decodedAtMs[last],
-    drawn: scenario === 'rest' ? restedAt - released : s.shownAtMs[last],
+    drawn: scenario === 'refine' ? s.shownAtMs[last] : restedAt - released,
     timed: after.timedFrame,
   };
 }
@@ -149,14 +165,14 @@ console.log(
     `${values.mesh}: ${last} batches, ${manifest.levels.at(-1).faces} triangles at the last level, format ${manifest.stream_format}; median of ${runs} cold loads`,
 );
 const rows = [];
-for (const scenario of /** @type {const} */ (['rest', 'refine'])) {
+for (const scenario of scenarios) {
   /** @type {Map<string, Orbit[]>} */
   const results = new Map(modes.map((m) => [m, []]));
   for (let r = 0; r < runs; r++) {
     for (const mode of modes) {
       const x = await orbit(mode, scenario);
       console.error(
-        `${scenario}, ${mode}: ${x.fps.toFixed(1)} frames/s (stand-in ${(100 * x.standInShare).toFixed(0)} %, level ${x.standInLevel}), ` +
+        `${scenario}, ${mode}: ${x.fps.toFixed(1)} frames/s (stand-in ${(100 * x.standInShare).toFixed(0)} %, level ${x.standInLevel}; ${x.levelFrames} of the level), ` +
           `decoded ${x.decoded.toFixed(0)} ms, drawn ${x.drawn.toFixed(0)} ms, timed ${JSON.stringify(x.timed)}`,
       );
       results.get(mode)?.push(x);
@@ -165,13 +181,13 @@ for (const scenario of /** @type {const} */ (['rest', 'refine'])) {
   for (const [mode, xs] of results) {
     const m = (/** @type {(x: Orbit) => number} */ f) => median(xs.map(f));
     rows.push(
-      `| ${scenario} | ${mode} | ${m((x) => x.fps).toFixed(1)} | ${(100 * m((x) => x.standInShare)).toFixed(0)} % | ` +
+      `| ${scenario} | ${mode} | ${m((x) => x.fps).toFixed(1)} | ${(100 * m((x) => x.standInShare)).toFixed(0)} % | ${m((x) => x.levelFrames)} | ` +
         `${scenario === 'refine' ? `${m((x) => x.decoded).toFixed(0)} ms` : '–'} | ${m((x) => x.drawn).toFixed(0)} ms |`,
     );
   }
 }
-console.log('| drag | motion | frames/s while dragging | stand-in frames | last level decoded | last level drawn (refine) / drawn and done after release (rest) |');
-console.log('|---|---|---:|---:|---:|---:|');
+console.log('| motion of the view | `motion` | frames/s while moving | stand-in frames | frames of the level while moving | last level decoded | last level drawn (refine) / drawn again after the motion |');
+console.log('|---|---|---:|---:|---:|---:|---:|');
 for (const row of rows) console.log(row);
 await browser.close();
 await service.stop();
