@@ -15,6 +15,7 @@ import { readFileSync } from 'node:fs';
 import { basename } from 'node:path';
 import { parseArgs } from 'node:util';
 import { VitrineCodec, splitStream } from '../src/codec.js';
+import { median } from './machine.mjs';
 
 const { values, positionals } = parseArgs({
   allowPositionals: true,
@@ -68,7 +69,6 @@ for (const stream of streams) {
       times[i].push(performance.now() - t0);
     }
   }
-  const median = (/** @type {number[]} */ t) => [...t].sort((a, b) => a - b)[t.length >> 1];
   console.log(`| ${basename(stream)} | ${times.map((t) => `${median(t).toFixed(1)} ms`).join(' | ')} |`);
 }
 const mib = (/** @type {VitrineCodec} */ codec) => (codec.exports.memory.buffer.byteLength / 2 ** 20).toFixed(0);
