@@ -27,6 +27,19 @@ pub const THUMBNAIL_SIZE: u32 = 512;
 /// The units `--unit` takes.
 pub const UNITS: [&str; 4] = ["mm", "cm", "m", "in"];
 
+/// Metres in one of [`UNITS`] (glTF's unit is the metre: a download in
+/// millimetres is scaled by this, or an AR viewer shows a bust 1,000 times
+/// its size).
+pub fn metres_per_unit(unit: &str) -> Option<f32> {
+    match unit {
+        "mm" => Some(0.001),
+        "cm" => Some(0.01),
+        "m" => Some(1.0),
+        "in" => Some(0.0254),
+        _ => None,
+    }
+}
+
 /// The up axis when `--up` is not given, from the format's convention and
 /// the shape:
 ///

@@ -14,7 +14,9 @@ mod store;
 pub use guards::{threshold_name, FeatureSetting, FeatureSummary, GuardOptions, Guards};
 
 use crate::source::{default_colour_mode, read_back, QualityReference};
-use crate::storage::{valid_slug, Bounds, NewThumbnail, OnExisting, Storage, StoredModel, UpAxis};
+use crate::storage::{
+    valid_slug, Bounds, NewThumbnail, OnExisting, Rights, Storage, StoredModel, UpAxis,
+};
 use anyhow::{bail, Context};
 use std::path::Path;
 use std::sync::Arc;
@@ -43,6 +45,8 @@ pub struct ModelMeta {
     pub up: Option<UpAxis>,
     /// The unit of model coordinates (`mm`, `cm`, `m`, `in`), if known.
     pub unit: Option<String>,
+    /// Credit line and licence.
+    pub rights: Rights,
 }
 
 impl ModelMeta {
@@ -57,6 +61,7 @@ impl ModelMeta {
             source: None,
             up: None,
             unit: None,
+            rights: Rights::default(),
         }
     }
 }

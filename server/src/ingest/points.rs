@@ -140,6 +140,7 @@ pub async fn ingest_points(
         mapping: None,
         up_axis: Some(up),
         unit: meta.unit.clone(),
+        rights: meta.rights.clone(),
         bounds: Some(encoding.bounds),
         thumbnail: Some(encoding.thumbnail.clone()),
     };

@@ -62,6 +62,7 @@ pub(super) async fn store(
         mapping,
         up_axis: curated.map(|c| c.up),
         unit: meta.unit.clone(),
+        rights: meta.rights.clone(),
         bounds: curated.map(|c| c.bounds),
         thumbnail: curated.and_then(|c| c.thumbnail.clone()),
     };

@@ -7,7 +7,7 @@ use super::manifest::{self, Manifest};
 use super::servable::{ServableModel, SlugParam};
 use super::visitor::{HintQuery, VisitorHints};
 use super::AppState;
-use crate::storage::{ModelKind, ModelSummary};
+use crate::storage::{Licence, ModelKind, ModelSummary, LICENCES};
 use axum::extract::State;
 use axum::response::{IntoResponse, Response};
 use axum::Json;
@@ -123,5 +123,30 @@ pub async fn manifest(
     let cap = state.level_cap(&record, &visitor);
     let mut response = Json(manifest::build(&state, &record, &visitor, cap)).into_response();
     cache_headers::visitor_json(&mut response, &hints);
+    response
+}
+
+#[derive(Serialize, ToSchema)]
+pub struct LicenceList {
+    /// In the order an upload form offers them.
+    licences: &'static [Licence],
+}
+
+/// The licences and rights statements a version may be published under
+/// (the `licence` of an upload or a version change).
+#[utoipa::path(
+    get,
+    path = "/api/licences",
+    responses((status = 200, description = "Every licence a version may name (`Cache-Control: public, max-age=3600`)", body = LicenceList))
+)]
+pub async fn licences() -> Response {
+    let mut response = Json(LicenceList {
+        licences: &LICENCES,
+    })
+    .into_response();
+    response.headers_mut().insert(
+        axum::http::header::CACHE_CONTROL,
+        axum::http::HeaderValue::from_static("public, max-age=3600"),
+    );
     response
 }

@@ -3,20 +3,32 @@
 //! for `<model-viewer>`, AR viewers and social platforms. It is the level's
 //! decoded mesh (the stream's quantized positions, vertex colour when the
 //! stream has it), never the original file.
+//!
+//! The file stands as the model does in the viewer and at its real size:
+//! its node turns the recorded up axis to glTF's +Y and scales the recorded
+//! unit to metres (AR viewers place it at that size). It names the model
+//! and carries the version's credit and licence (`asset.copyright`, and a
+//! Dublin Core `KHR_xmp_json_ld` packet with the licence's deed and the
+//! model page), so a scan that leaves the site keeps its credit.
 
 use super::error::{AppError, ErrorBody, LevelCappedBody};
 use super::payload::{cache_control, level_bytes, not_modified, not_modified_response, within_cap};
 use super::servable::{ServableModel, SlugParam};
 use super::visitor::HintQuery;
+use super::web::public_base;
 use super::AppState;
-use crate::storage::ModelKind;
+use crate::ingest::curation::metres_per_unit;
+use crate::storage::{ModelKind, ModelRecord, UpAxis};
 use axum::extract::{RawQuery, State};
 use axum::http::{header, HeaderMap, HeaderValue};
 use axum::response::{IntoResponse, Response};
 use bytes::Bytes;
 use serde::Deserialize;
+use serde_json::json;
+use sha2::{Digest, Sha256};
 use utoipa::IntoParams;
 use vitrine_codec::{Decoder, Limits};
+use vitrine_mesh::export::GlbDocument;
 
 /// Downloads decoded at once; more wait for 503 and `Retry-After` (a level
 /// of a 2 M-vertex scan takes about a second of one core).
@@ -81,12 +93,15 @@ pub async fn download(
     if level > 0 {
         within_cap(&state, &record, &visitor, level)?;
     }
-    // The level's payload digest names the whole prefix within its compression.
+    let doc = document(&record, &public_base(&state, &headers));
+    // The level's payload digest names the whole prefix within its
+    // compression; what the document says (rights can change) has its own.
     let sha = &record.levels[level as usize].sha256;
     let etag = HeaderValue::from_str(&format!(
-        "\"glb-{}-{level}-{}\"",
+        "\"glb-{}-{level}-{}-{}\"",
         record.compression_id,
-        &sha[..sha.len().min(24)]
+        &sha[..sha.len().min(24)],
+        document_digest(&doc)
     ))
     .map_err(|e| AppError::Internal(e.to_string()))?;
     // Named by slug, not by compression: never immutable (cache_headers).
@@ -107,7 +122,7 @@ pub async fn download(
     for k in 0..=level {
         payloads.push(level_bytes(&state, &record, k).await?);
     }
-    let glb = tokio::task::spawn_blocking(move || glb_of(&payloads))
+    let glb = tokio::task::spawn_blocking(move || glb_of(&payloads, &doc))
         .await
         .map_err(|e| AppError::Internal(format!("download task: {e}")))??;
     let disposition = format!("attachment; filename=\"{}-level-{level}.glb\"", record.slug);
@@ -129,8 +144,62 @@ pub async fn download(
     Ok((headers, Bytes::from(glb)).into_response())
 }
 
+/// What the GLB says beside the mesh: see the module's comment.
+fn document(record: &ModelRecord, base: &str) -> GlbDocument {
+    let curation = &record.curation;
+    let rows = curation.up_axis.unwrap_or(UpAxis::Y).to_y_up();
+    let scale = curation
+        .unit
+        .as_deref()
+        .and_then(metres_per_unit)
+        .unwrap_or(1.0);
+    let mut matrix = [0.0f32; 16];
+    for (r, row) in rows.iter().enumerate() {
+        for (c, &value) in row.iter().enumerate() {
+            matrix[4 * c + r] = value * scale;
+        }
+    }
+    matrix[15] = 1.0;
+    // Y up in metres (or in no stated unit) needs no node transform.
+    let identity = rows == UpAxis::Y.to_y_up() && scale == 1.0;
+    let rights = &curation.rights;
+    let alt = |text: &str| json!({ "@type": "rdf:Alt", "rdf:_1": { "@language": "x-default", "@value": text } });
+    let mut xmp = json!({
+        "@context": {
+            "dc": "http://purl.org/dc/elements/1.1/",
+            "rdf": "http://www.w3.org/1999/02/22-rdf-syntax-ns#",
+            "xmpRights": "http://ns.adobe.com/xap/1.0/rights/",
+        },
+        "dc:title": alt(&record.title),
+        "dc:format": "model/gltf-binary",
+        "dc:source": format!("{base}/m/{}", record.slug),
+    });
+    if !record.description.trim().is_empty() {
+        xmp["dc:description"] = alt(record.description.trim());
+    }
+    if let Some(notice) = rights.notice() {
+        xmp["dc:rights"] = alt(&notice);
+    }
+    if let Some(licence) = rights.licence {
+        xmp["xmpRights:WebStatement"] = licence.url.into();
+    }
+    GlbDocument {
+        copyright: rights.notice(),
+        name: Some(record.title.clone()),
+        matrix: (!identity).then_some(matrix),
+        xmp: Some(xmp),
+    }
+}
+
+/// A short digest of everything [`document`] wrote, for the ETag.
+fn document_digest(doc: &GlbDocument) -> String {
+    let said = json!([doc.copyright, doc.name, doc.matrix, doc.xmp]).to_string();
+    let digest = Sha256::digest(said.as_bytes());
+    digest[..6].iter().map(|b| format!("{b:02x}")).collect()
+}
+
 /// Decodes the base and batches as the viewer does and writes the mesh.
-fn glb_of(payloads: &[Bytes]) -> Result<Vec<u8>, AppError> {
+fn glb_of(payloads: &[Bytes], doc: &GlbDocument) -> Result<Vec<u8>, AppError> {
     let stored = |e: vitrine_codec::Error| AppError::Internal(format!("stored level: {e}"));
     let (base, batches) = payloads
         .split_first()
@@ -140,7 +209,7 @@ fn glb_of(payloads: &[Bytes]) -> Result<Vec<u8>, AppError> {
         decoder.apply_batch(batch).map_err(stored)?;
     }
     let mut out = Vec::new();
-    vitrine_mesh::export::write_glb(&decoder.to_mesh(), &mut out)
+    vitrine_mesh::export::write_glb_document(&decoder.to_mesh(), doc, &mut out)
         .map_err(|e| AppError::Internal(format!("writing GLB: {e}")))?;
     Ok(out)
 }

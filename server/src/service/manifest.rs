@@ -4,7 +4,7 @@
 
 use super::cap::{good_enough_level, Audience, CapReason, DeviceClass, LevelCap};
 use super::{AppState, Visitor};
-use crate::storage::{ModelKind, ModelRecord, TextureRef};
+use crate::storage::{Licence, ModelKind, ModelRecord, TextureRef};
 use serde::Serialize;
 use utoipa::ToSchema;
 
@@ -55,6 +55,17 @@ pub struct Manifest<'a> {
     bounds: Option<ManifestBounds>,
     /// `/api/models/{slug}/thumbnail?v={version}`, or null.
     thumbnail: Option<String>,
+    /// Who made the scan and on what terms it may be reused: the viewer
+    /// shows them under the model.
+    rights: ManifestRights<'a>,
+}
+
+#[derive(Serialize, ToSchema)]
+struct ManifestRights<'a> {
+    /// Credit line, or null.
+    credit: Option<&'a str>,
+    /// Licence or rights statement, or null.
+    licence: Option<&'static Licence>,
 }
 
 #[derive(Serialize, ToSchema)]
@@ -261,6 +272,10 @@ pub fn build<'a>(
             .thumbnail_sha256
             .is_some()
             .then(|| super::curator::thumbnail::url(&record.slug, record.version)),
+        rights: ManifestRights {
+            credit: record.curation.rights.credit.as_deref(),
+            licence: record.curation.rights.licence,
+        },
     }
 }
 

@@ -79,6 +79,7 @@ fn list(viewer: Option<&Viewer>) -> OpenApiRouter<AppState> {
     OpenApiRouter::with_openapi(Api::openapi())
         .routes(routes!(api::list, upload::upload))
         .routes(routes!(api::manifest))
+        .routes(routes!(api::licences))
         .routes(routes!(thumbnail::thumbnail))
         .routes(routes!(annotations::list, annotations::create))
         .routes(routes!(annotations::update, annotations::delete))

@@ -10,11 +10,12 @@ use super::servable::{PathParams, ServableModel, SlugParam};
 use super::study::StudySlug;
 use super::visitor::{HintQuery, VisitorHints};
 use super::AppState;
-use crate::storage::{valid_slug, ModelRecord};
+use crate::storage::{valid_slug, ModelKind, ModelRecord};
 use axum::extract::{Request, State};
 use axum::http::{header, HeaderMap, HeaderValue};
 use axum::response::{Html, IntoResponse, Response};
 use axum::routing::get_service;
+use serde_json::json;
 use std::convert::Infallible;
 use std::path::{Path, PathBuf};
 use tower::Service;
@@ -150,7 +151,7 @@ pub async fn model_page(
 
 /// The absolute base of links in the page: `--public-base-url`, else the
 /// request's `Host` (with `X-Forwarded-Proto`'s scheme behind a proxy).
-fn public_base(state: &AppState, headers: &HeaderMap) -> String {
+pub(super) fn public_base(state: &AppState, headers: &HeaderMap) -> String {
     if let Some(base) = &state.config().uploads.public_base_url {
         return base.trim_end_matches('/').to_owned();
     }
@@ -194,7 +195,53 @@ fn open_graph(state: &AppState, headers: &HeaderMap, record: &ModelRecord) -> St
             ))
         ));
     }
+    if let Some(licence) = record.curation.rights.licence {
+        tags.push_str(&format!(
+            "<link rel=\"license\" href=\"{}\">\n",
+            escape(licence.url)
+        ));
+    }
+    tags.push_str(&structured_data(record, &base));
     tags
+}
+
+/// The model as schema.org's `3DModel` (JSON-LD), with its credit and
+/// licence, so search engines can show them (and the GLB download, where
+/// every visitor may take it).
+fn structured_data(record: &ModelRecord, base: &str) -> String {
+    let page = format!("{base}/m/{}", record.slug);
+    let mut model = json!({
+        "@context": "https://schema.org",
+        "@type": "3DModel",
+        "name": record.title,
+        "url": page,
+    });
+    if !record.description.trim().is_empty() {
+        model["description"] = record.description.trim().into();
+    }
+    if record.curation.thumbnail_sha256.is_some() {
+        model["image"] = format!("{base}{}", thumbnail::url(&record.slug, record.version)).into();
+    }
+    let rights = &record.curation.rights;
+    if let Some(credit) = &rights.credit {
+        model["creditText"] = credit.as_str().into();
+    }
+    if let Some(licence) = rights.licence {
+        model["license"] = licence.url.into();
+    }
+    if let Some(notice) = rights.notice() {
+        model["copyrightNotice"] = notice.into();
+    }
+    if record.policy.downloads && record.policy.public_access && record.kind == ModelKind::Mesh {
+        model["encoding"] = json!([{
+            "@type": "MediaObject",
+            "contentUrl": format!("{base}/api/models/{}/download.glb", record.slug),
+            "encodingFormat": "model/gltf-binary",
+        }]);
+    }
+    // `</script>` in a title must not end the element: JSON allows `<\/`.
+    let text = model.to_string().replace("</", "<\\/");
+    format!("<script type=\"application/ld+json\">{text}</script>\n")
 }
 
 fn html_response(html: String) -> Response {

@@ -69,8 +69,21 @@ macro_rules! sql_storage {
                             None => None,
                         },
                         thumbnail_sha256: row.try_get("thumbnail_sha256").map_err(get)?,
+                        rights: Self::rights_from_row(row)?,
                     },
                 })
+            }
+
+            /// Columns `model.credit` and `model.licence` of a row.
+            fn rights_from_row(
+                row: &<$db as sqlx::Database>::Row,
+            ) -> $crate::storage::Result<$crate::storage::Rights> {
+                use sqlx::Row;
+                let get = |e: sqlx::Error| StorageError::Corrupt(e.to_string());
+                Ok($crate::storage::Rights::from_stored(
+                    row.try_get("credit").map_err(get)?,
+                    row.try_get("licence").map_err(get)?,
+                ))
             }
 
             /// Column `model.kind` of a row.

@@ -12,7 +12,7 @@ macro_rules! record_select {
          m.good_enough_level, m.created_at, p.name AS policy_name, p.public_access, \
          p.public_max_vertex_fraction, p.public_full_resolution, p.token_full_resolution, p.downloads, \
          c.id AS compression_id, c.codec_version, c.quantization_bits, c.has_colour, c.mapping_id, \
-         tm.parameters AS mapping_parameters, m.up_axis, m.unit, m.bounds, \
+         tm.parameters AS mapping_parameters, m.up_axis, m.unit, m.bounds, m.credit, m.licence, \
          th.sha256 AS thumbnail_sha256 \
          FROM model m JOIN audience_policy p ON p.id = m.policy_id \
          JOIN compression c ON c.model_id = m.id \
@@ -65,8 +65,9 @@ pub(super) const MAX_VERSION: &str = "SELECT MAX(version) AS v FROM model WHERE 
 pub(super) const INSERT_MODEL: &str =
     "INSERT INTO model (slug, version, title, description, policy_id, \
      good_enough_level, source_name, source_vertices, source_faces, status, created_at, \
-     up_axis, unit, bounds, kind) \
-     VALUES ($1, $2, $3, $4, $5, $6, $7, $8, $9, 'ready', $10, $11, $12, $13, $14) RETURNING id";
+     up_axis, unit, bounds, kind, credit, licence) \
+     VALUES ($1, $2, $3, $4, $5, $6, $7, $8, $9, 'ready', $10, $11, $12, $13, $14, $15, $16) \
+     RETURNING id";
 pub(super) const INSERT_THUMBNAIL: &str = "INSERT INTO thumbnail \
      (model_id, media_type, width, height, byte_len, sha256, bytes, created_at) \
      VALUES ($1, $2, $3, $4, $5, $6, $7, $8)";

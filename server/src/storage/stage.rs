@@ -42,6 +42,8 @@ macro_rules! stage_body {
             .bind($model.unit.clone())
             .bind($model.bounds.map(|b| b.to_json()))
             .bind($model.kind.name())
+            .bind($model.rights.credit.clone())
+            .bind($model.rights.licence.map(|l| l.id))
             .fetch_one(&mut *$tx)
             .await
             .map_err(conflict)?;

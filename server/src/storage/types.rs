@@ -3,8 +3,9 @@
 use serde::Serialize;
 
 pub use super::curator::{
-    AnnotationRecord, Bounds, JobRecord, JobState, NewAnnotation, NewJob, ThumbnailPayload, UpAxis,
-    VersionRecord,
+    parse_credit, parse_licence, AnnotationRecord, Bounds, JobRecord, JobState, Licence,
+    NewAnnotation, NewJob, Rights, ThumbnailPayload, UpAxis, VersionRecord, LICENCES,
+    MAX_CREDIT_BYTES,
 };
 
 /// Who may fetch how much of a model (table `audience_policy`).
@@ -175,6 +176,8 @@ pub struct Curation {
     pub bounds: Option<Bounds>,
     /// The thumbnail's digest, when the version has one.
     pub thumbnail_sha256: Option<String>,
+    /// Credit line and licence, when recorded.
+    pub rights: Rights,
 }
 
 impl ModelRecord {
@@ -320,6 +323,8 @@ pub struct NewModel {
     /// `mm`, `cm`, `m` or `in`.
     pub unit: Option<String>,
     pub bounds: Option<Bounds>,
+    /// Credit line and licence.
+    pub rights: Rights,
     /// A picture rendered at ingest, stored in the same transaction.
     pub thumbnail: Option<NewThumbnail>,
 }

@@ -90,7 +90,7 @@ pub async fn glb_download_of_a_level(db: TestDb) {
 
 /// The Khronos glTF validator (npm `gltf-validator`, through
 /// web/scripts/validate-gltf.mjs) finds no error in `glb`.
-fn assert_valid_glb(glb: &[u8]) {
+pub fn assert_valid_glb(glb: &[u8]) {
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
     assert!(
         root.join("web/node_modules/gltf-validator").exists(),

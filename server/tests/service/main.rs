@@ -14,6 +14,7 @@ mod kill;
 mod points;
 mod proxy;
 mod quality;
+mod rights;
 mod slow;
 mod spec;
 mod story;
@@ -78,6 +79,7 @@ on_both_backends!(
     study::scripted_participants,
     study::bad_study_requests,
     download::glb_download_of_a_level,
+    rights::rights_served_and_carried,
     curators::annotations_and_scopes,
     uploads::uploads_as_jobs,
     curation::curation_in_manifest_and_thumbnail,

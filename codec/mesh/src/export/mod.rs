@@ -134,19 +134,45 @@ pub fn write_obj(mesh: &IndexedMesh, w: &mut impl Write) -> Result<()> {
     Ok(())
 }
 
+/// What a GLB says beside its mesh: who to credit, what the mesh is called,
+/// where it stands in glTF's frame, and Dublin Core metadata. All optional;
+/// the default says nothing.
+#[derive(Clone, Debug, Default)]
+pub struct GlbDocument {
+    /// `asset.copyright`, "a copyright message suitable for display to
+    /// credit the content creator" (glTF 2.0).
+    pub copyright: Option<String>,
+    /// The name of the mesh and of its node.
+    pub name: Option<String>,
+    /// Column-major 4×4 matrix of the mesh's node: what turns the mesh's
+    /// coordinates into glTF's (+Y up, metres). Must be finite.
+    pub matrix: Option<[f32; 16]>,
+    /// A `KHR_xmp_json_ld` packet (a JSON-LD object with its `@context`)
+    /// for the whole asset: title, rights, source.
+    pub xmp: Option<serde_json::Value>,
+}
+
 /// Writes a glTF 2.0 binary: one mesh, one triangle primitive with
 /// POSITION (float VEC3 with min/max), COLOR_0 when coloured (float VEC3,
 /// linear as the spec wants: the sRGB bytes are converted exactly so that
 /// the importer recovers them) and uint32 indices.
 pub fn write_glb(mesh: &IndexedMesh, w: &mut impl Write) -> Result<()> {
+    write_glb_document(mesh, &GlbDocument::default(), w)
+}
+
+/// [`write_glb`], saying what `doc` holds beside the mesh.
+pub fn write_glb_document(mesh: &IndexedMesh, doc: &GlbDocument, w: &mut impl Write) -> Result<()> {
     validate(mesh)?;
+    if doc.matrix.is_some_and(|m| m.iter().any(|x| !x.is_finite())) {
+        return Err(Error::Parameter("GLB node matrix is not finite".into()));
+    }
     if mesh.positions.is_empty() || mesh.triangles.is_empty() {
         return Err(Error::Parameter(
             "cannot write an empty mesh as glTF (accessors need at least one element)".into(),
         ));
     }
     let layout = BinLayout::of(mesh);
-    let json = glb_json(mesh, &layout);
+    let json = glb_json(mesh, doc, &layout);
     let bin_len = layout.len();
     let total = 12 + 8 + json.len() + 8 + bin_len;
     let total = u32::try_from(total)
@@ -188,7 +214,7 @@ impl BinLayout {
 }
 
 /// The GLB's JSON chunk, padded with spaces to a multiple of 4 bytes.
-fn glb_json(mesh: &IndexedMesh, layout: &BinLayout) -> String {
+fn glb_json(mesh: &IndexedMesh, doc: &GlbDocument, layout: &BinLayout) -> String {
     let n = mesh.positions.len();
     let BinLayout {
         pos_len,
@@ -208,17 +234,38 @@ fn glb_json(mesh: &IndexedMesh, layout: &BinLayout) -> String {
     } else {
         Default::default()
     };
+    let text = |s: &str| serde_json::Value::from(s).to_string();
+    let mut asset = String::new();
+    if let Some(copyright) = &doc.copyright {
+        asset += &format!(r#","copyright":{}"#, text(copyright));
+    }
+    let mut named = String::new();
+    if let Some(name) = &doc.name {
+        named += &format!(r#","name":{}"#, text(name));
+    }
+    let mut node = named.clone();
+    if let Some(m) = &doc.matrix {
+        let m: Vec<String> = m.iter().map(|x| x.to_string()).collect();
+        node += &format!(r#","matrix":[{}]"#, m.join(","));
+    }
+    let mut root = String::new();
+    if let Some(packet) = &doc.xmp {
+        asset += r#","extensions":{"KHR_xmp_json_ld":{"packet":0}}"#;
+        root += &format!(
+            r#","extensionsUsed":["KHR_xmp_json_ld"],"extensions":{{"KHR_xmp_json_ld":{{"packets":[{packet}]}}}}"#
+        );
+    }
     let mut json = format!(
         concat!(
-            r#"{{"asset":{{"version":"2.0","generator":"vitrine-codec"}},"#,
-            r#""scene":0,"scenes":[{{"nodes":[0]}}],"nodes":[{{"mesh":0}}],"#,
-            r#""meshes":[{{"primitives":[{{"attributes":{{"POSITION":0{ca}}},"indices":1,"mode":4}}]}}],"#,
+            r#"{{"asset":{{"version":"2.0","generator":"vitrine-codec"{asset}}},"#,
+            r#""scene":0,"scenes":[{{"nodes":[0]}}],"nodes":[{{"mesh":0{node}}}],"#,
+            r#""meshes":[{{"primitives":[{{"attributes":{{"POSITION":0{ca}}},"indices":1,"mode":4}}]{named}}}],"#,
             r#""buffers":[{{"byteLength":{bin_len}}}],"#,
             r#""bufferViews":[{{"buffer":0,"byteOffset":0,"byteLength":{pos_len},"target":34962}},"#,
             r#"{{"buffer":0,"byteOffset":{pos_len},"byteLength":{idx_len},"target":34963}}{cv}],"#,
             r#""accessors":[{{"bufferView":0,"componentType":5126,"count":{n},"type":"VEC3","#,
             r#""min":[{min0},{min1},{min2}],"max":[{max0},{max1},{max2}]}},"#,
-            r#"{{"bufferView":1,"componentType":5125,"count":{ni},"type":"SCALAR"}}{cacc}]}}"#
+            r#"{{"bufferView":1,"componentType":5125,"count":{ni},"type":"SCALAR"}}{cacc}]{root}}}"#
         ),
         ca = colour_attr,
         bin_len = layout.len(),
@@ -234,6 +281,10 @@ fn glb_json(mesh: &IndexedMesh, layout: &BinLayout) -> String {
         max2 = max[2],
         ni = 3 * mesh.triangles.len(),
         cacc = colour_acc,
+        asset = asset,
+        node = node,
+        named = named,
+        root = root,
     );
     let padded = json.len().next_multiple_of(4);
     json.extend(std::iter::repeat_n(' ', padded - json.len()));

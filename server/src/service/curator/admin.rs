@@ -7,7 +7,7 @@ use super::Curator;
 use crate::service::error::{AppError, ErrorBody};
 use crate::service::servable::PathParams;
 use crate::service::AppState;
-use crate::storage::{valid_slug, VersionRecord};
+use crate::storage::{parse_credit, parse_licence, valid_slug, Rights, VersionRecord};
 use axum::extract::rejection::JsonRejection;
 use axum::extract::State;
 use axum::Json;
@@ -27,6 +27,10 @@ pub struct Version {
     levels: u32,
     /// Unix milliseconds.
     created_at: i64,
+    /// Credit line, or null.
+    credit: Option<String>,
+    /// Licence identifier (`GET /api/licences`), or null.
+    licence: Option<&'static str>,
 }
 
 impl From<VersionRecord> for Version {
@@ -39,6 +43,8 @@ impl From<VersionRecord> for Version {
             good_enough_level: v.good_enough_level,
             levels: v.levels,
             created_at: v.created_at_ms,
+            credit: v.rights.credit,
+            licence: v.rights.licence.map(|l| l.id),
         }
     }
 }
@@ -73,11 +79,25 @@ pub struct VersionChange {
     #[serde(default, deserialize_with = "present")]
     #[schema(value_type = Option<u32>)]
     good_enough_level: Option<Option<u32>>,
+    /// Credit line (one line, at most 300 bytes), or null or `""` to clear
+    /// it. Absent: unchanged. Rights change without ingesting again.
+    #[serde(default, deserialize_with = "present")]
+    #[schema(value_type = Option<String>)]
+    credit: Option<Option<String>>,
+    /// Licence identifier (`GET /api/licences`), or null or `""` to clear
+    /// it. Absent: unchanged.
+    #[serde(default, deserialize_with = "present")]
+    #[schema(value_type = Option<String>)]
+    licence: Option<Option<String>>,
 }
 
 /// Tells an explicit null (`Some(None)`) from an absent field (`None`).
-fn present<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Option<Option<u32>>, D::Error> {
-    Option::<u32>::deserialize(d).map(Some)
+fn present<'de, D, T>(d: D) -> Result<Option<Option<T>>, D::Error>
+where
+    D: serde::Deserializer<'de>,
+    T: Deserialize<'de>,
+{
+    Option::<T>::deserialize(d).map(Some)
 }
 
 async fn versions_of(state: &AppState, slug: &str) -> Result<Vec<VersionRecord>, AppError> {
@@ -120,8 +140,9 @@ pub async fn versions(
     }))
 }
 
-/// Withdraws a version or puts it back, or sets its good-enough level
-/// (curator token). Answers the version as it now is.
+/// Withdraws a version or puts it back, sets its good-enough level, or
+/// changes its credit line or licence (curator token). Answers the version
+/// as it now is.
 #[utoipa::path(
     put,
     path = "/api/admin/models/{slug}/versions/{version}",
@@ -134,7 +155,8 @@ pub async fn versions(
         (status = 401, description = "No token, or an unknown one", body = ErrorBody),
         (status = 403, description = "Not a curator token, or one for another model", body = ErrorBody),
         (status = 404, description = "No such model or version", body = ErrorBody),
-        (status = 422, description = "Unknown status, or a level past the last", body = ErrorBody),
+        (status = 422, description = "Unknown status or licence, a level past the last, or a \
+            credit line over 300 bytes or of several lines", body = ErrorBody),
     )
 )]
 pub async fn change(
@@ -165,7 +187,23 @@ pub async fn change(
             )));
         }
     }
+    let rights = match (&change.credit, &change.licence) {
+        (None, None) => None,
+        (credit, licence) => Some(Rights {
+            credit: match credit {
+                Some(credit) => parse_credit(credit.as_deref()).map_err(AppError::Unprocessable)?,
+                None => current.rights.credit.clone(),
+            },
+            licence: match licence {
+                Some(id) => parse_licence(id.as_deref()).map_err(AppError::Unprocessable)?,
+                None => current.rights.licence,
+            },
+        }),
+    };
     let storage = state.storage();
+    if let Some(rights) = &rights {
+        storage.set_version_rights(&slug, version, rights).await?;
+    }
     if let Some(status) = &change.status {
         storage.set_version_status(&slug, version, status).await?;
     }

@@ -1,6 +1,6 @@
 //! `POST /api/models`: a curator uploads a scan as `multipart/form-data`
 //! (`file`, `slug`, `title`, optional `description`, `policy`, `colour`,
-//! `kind`). A point cloud (a PLY without faces, LAS, LAZ) is stored as a
+//! `kind`, `unit`, `up`, `credit`, `licence`). A point cloud (a PLY without faces, LAS, LAZ) is stored as a
 //! point stream.
 //! The file is streamed to a spool file on disk, never held in memory; its
 //! name as sent never becomes a path (the spool file's name is generated
@@ -13,7 +13,7 @@ use super::Curator;
 use crate::ingest::{IngestOptions, ModelMeta};
 use crate::service::error::{AppError, ErrorBody};
 use crate::service::AppState;
-use crate::storage::{valid_slug, ModelKind, NewJob, OnExisting};
+use crate::storage::{valid_slug, ModelKind, NewJob, OnExisting, Rights, UpAxis};
 use axum::extract::multipart::{Field, Multipart, MultipartError};
 use axum::extract::State;
 use axum::http::StatusCode;
@@ -53,6 +53,18 @@ pub struct UploadForm {
     /// `mesh` or `points` (default: `points` for LAS, LAZ and a PLY that
     /// declares no faces, else `mesh`).
     kind: Option<String>,
+    /// The unit of the file's coordinates: `mm`, `cm`, `m` or `in`
+    /// (measurements are given in it; downloads are scaled to metres).
+    unit: Option<String>,
+    /// Which model axis points up: `x`, `y`, `z`, `-x`, `-y` or `-z`
+    /// (default: detected, as `vitrine ingest --up`).
+    up: Option<String>,
+    /// Credit line shown under the model and carried by its downloads; one
+    /// line, at most 300 bytes.
+    credit: Option<String>,
+    /// Licence or rights statement, an identifier from `GET /api/licences`
+    /// (`CC-BY-4.0`, `CC0-1.0`, `InC`, …).
+    licence: Option<String>,
 }
 
 #[derive(Serialize, ToSchema)]
@@ -210,6 +222,10 @@ struct Fields {
     policy: Option<String>,
     colour: Option<String>,
     kind: Option<String>,
+    unit: Option<String>,
+    up: Option<String>,
+    credit: Option<String>,
+    licence: Option<String>,
 }
 
 impl Fields {
@@ -221,9 +237,14 @@ impl Fields {
             "policy" => &mut self.policy,
             "colour" => &mut self.colour,
             "kind" => &mut self.kind,
+            "unit" => &mut self.unit,
+            "up" => &mut self.up,
+            "credit" => &mut self.credit,
+            "licence" => &mut self.licence,
             other => {
                 return Err(AppError::Unprocessable(format!(
-                    "unknown form field {other:?} (file, slug, title, description, policy, colour, kind)"
+                    "unknown form field {other:?} (file, slug, title, description, policy, \
+                     colour, kind, unit, up, credit, licence)"
                 )))
             }
         };
@@ -251,6 +272,20 @@ impl Fields {
             meta.policy = policy;
         }
         meta.on_existing = OnExisting::NewVersion;
+        meta.unit = match self.unit.as_deref() {
+            None | Some("") => None,
+            Some(unit @ ("mm" | "cm" | "m" | "in")) => Some(unit.to_owned()),
+            Some(unit) => return Err(bad(format!("unit {unit:?} must be mm, cm, m or in"))),
+        };
+        meta.up = match self.up.as_deref() {
+            None | Some("") => None,
+            Some(name) => Some(
+                name.parse::<UpAxis>()
+                    .map_err(|e| bad(format!("up: {e}")))?,
+            ),
+        };
+        meta.rights =
+            Rights::parse(self.credit.as_deref(), self.licence.as_deref()).map_err(bad)?;
         let colour = match self.colour.as_deref() {
             None | Some("") => None,
             Some(name) => Some(name.parse::<ColourMode>().map_err(|_| {

@@ -275,6 +275,10 @@ macro_rules! curator_storage {
                                 "batch_count",
                             )? + 1,
                             created_at_ms: row.try_get("created_at").map_err(c)?,
+                            rights: $crate::storage::Rights::from_stored(
+                                row.try_get("credit").map_err(c)?,
+                                row.try_get("licence").map_err(c)?,
+                            ),
                         })
                     })
                     .collect()
@@ -290,6 +294,23 @@ macro_rules! curator_storage {
                     .bind(slug.to_owned())
                     .bind(i64::from(version))
                     .bind(status.to_owned())
+                    .execute(&self.pool)
+                    .await
+                    .map_err(Self::classify)?;
+                Ok(done.rows_affected() > 0)
+            }
+
+            async fn set_version_rights(
+                &self,
+                slug: &str,
+                version: u32,
+                rights: &$crate::storage::Rights,
+            ) -> $crate::storage::Result<bool> {
+                let done = sqlx::query($crate::storage::curator::sql::SET_RIGHTS)
+                    .bind(slug.to_owned())
+                    .bind(i64::from(version))
+                    .bind(rights.credit.clone())
+                    .bind(rights.licence.map(|l| l.id))
                     .execute(&self.pool)
                     .await
                     .map_err(Self::classify)?;

@@ -4,9 +4,11 @@
 //! one macro implementing it for each backend (`backend.rs`).
 
 mod backend;
+mod rights;
 pub(crate) mod sql;
 
 pub(in crate::storage) use backend::curator_storage;
+pub use rights::{parse_credit, parse_licence, Licence, Rights, LICENCES, MAX_CREDIT_BYTES};
 
 use super::Result;
 use async_trait::async_trait;
@@ -52,6 +54,21 @@ impl UpAxis {
 
     pub fn parse(name: &str) -> Option<UpAxis> {
         UpAxis::ALL.into_iter().find(|a| a.name() == name)
+    }
+
+    /// The rotation that stands the model upright in a +Y-up frame (glTF's,
+    /// and the viewer's: `upRotation` in web/src/frame.js), as rows: world
+    /// axis `r` is `rows[r] · p`. A proper rotation (determinant 1), so
+    /// faces keep their winding.
+    pub fn to_y_up(self) -> [[f32; 3]; 3] {
+        match self {
+            UpAxis::Y => [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
+            UpAxis::NegY => [[1.0, 0.0, 0.0], [0.0, -1.0, 0.0], [0.0, 0.0, -1.0]],
+            UpAxis::Z => [[1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, -1.0, 0.0]],
+            UpAxis::NegZ => [[1.0, 0.0, 0.0], [0.0, 0.0, -1.0], [0.0, 1.0, 0.0]],
+            UpAxis::X => [[0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]],
+            UpAxis::NegX => [[0.0, 1.0, 0.0], [-1.0, 0.0, 0.0], [0.0, 0.0, 1.0]],
+        }
     }
 
     /// The unit vector of the axis.
@@ -199,6 +216,8 @@ pub struct VersionRecord {
     /// Levels including the base (of its newest compression).
     pub levels: u32,
     pub created_at_ms: i64,
+    /// Credit line and licence.
+    pub rights: Rights,
 }
 
 /// A version's thumbnail.
@@ -280,6 +299,12 @@ pub trait CuratorStorage: Send + Sync {
         no_curators()
     }
 
+    /// Sets a version's credit line and licence (either may be cleared);
+    /// `false` if no such version.
+    async fn set_version_rights(&self, slug: &str, version: u32, rights: &Rights) -> Result<bool> {
+        no_curators()
+    }
+
     /// Sets (or clears, with `None`) a version's good-enough level.
     async fn set_good_enough_level(
         &self,
@@ -299,4 +324,26 @@ fn no_curators<T>() -> Result<T> {
     Err(super::StorageError::Unknown(
         "this storage keeps no annotations, jobs or thumbnails".into(),
     ))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::UpAxis;
+
+    #[test]
+    fn every_up_axis_turns_to_plus_y_by_a_rotation() {
+        for axis in UpAxis::ALL {
+            let r = axis.to_y_up();
+            let v = axis.vector();
+            let turned: Vec<f32> = r
+                .iter()
+                .map(|row| row.iter().zip(v).map(|(a, b)| a * b).sum())
+                .collect();
+            assert_eq!(turned, [0.0, 1.0, 0.0], "{axis:?}");
+            let det = r[0][0] * (r[1][1] * r[2][2] - r[1][2] * r[2][1])
+                - r[0][1] * (r[1][0] * r[2][2] - r[1][2] * r[2][0])
+                + r[0][2] * (r[1][0] * r[2][1] - r[1][1] * r[2][0]);
+            assert_eq!(det, 1.0, "{axis:?}");
+        }
+    }
 }

@@ -25,7 +25,7 @@ pub(crate) const UPDATE_JOB: &str = "UPDATE ingest_job SET state = $2, progress 
      error = $5, model_version = $6, updated_at = $7 WHERE id = $1";
 
 pub(crate) const VERSIONS: &str = "SELECT m.id, m.version, m.title, m.status, p.name AS policy, \
-     m.good_enough_level, m.created_at, \
+     m.good_enough_level, m.created_at, m.credit, m.licence, \
      (SELECT c.batch_count FROM compression c WHERE c.model_id = m.id ORDER BY c.id DESC LIMIT 1) \
      AS batch_count \
      FROM model m JOIN audience_policy p ON p.id = m.policy_id \
@@ -33,5 +33,7 @@ pub(crate) const VERSIONS: &str = "SELECT m.id, m.version, m.title, m.status, p.
 pub(crate) const SET_STATUS: &str = "UPDATE model SET status = $3 WHERE slug = $1 AND version = $2";
 pub(crate) const SET_GOOD_ENOUGH: &str = "UPDATE model SET good_enough_level = $3, \
      good_enough_study_id = NULL WHERE slug = $1 AND version = $2";
+pub(crate) const SET_RIGHTS: &str =
+    "UPDATE model SET credit = $3, licence = $4 WHERE slug = $1 AND version = $2";
 pub(crate) const THUMBNAIL: &str =
     "SELECT media_type, sha256, bytes FROM thumbnail WHERE model_id = $1";

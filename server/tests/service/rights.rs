@@ -1,0 +1,277 @@
+//! Credit line and licence over real HTTP: recorded at ingest, served in the
+//! manifest, stated on the model page (`<link rel="license">`, schema.org
+//! JSON-LD), carried by GLB downloads (with the up axis and unit applied),
+//! changed by a curator without ingesting again; bad values refused.
+
+use super::curators::token;
+use super::harness::{test_config, TestDb, TestServer};
+use reqwest::StatusCode;
+use serde_json::{json, Value};
+use vitrine::ingest::{ingest_mesh, IngestOptions, ModelMeta};
+use vitrine::storage::{Rights, TokenScope, UpAxis};
+use vitrine_codec::{Decoder, Limits};
+use vitrine_mesh::import::{import_bytes, ImportOptions, MeshFormat};
+
+const CREDIT: &str = "Scan: Museo de Prueba </script><b>, 2019";
+const CC_BY: &str = "https://creativecommons.org/licenses/by/4.0/";
+
+/// A Z-up stele in millimetres: 40 wide (x), 20 deep (y), 120 tall (z).
+fn stele() -> vitrine_codec::IndexedMesh {
+    let mut mesh = vitrine_samples::icosphere(3);
+    for p in &mut mesh.positions {
+        p[0] *= 20.0;
+        p[1] *= 10.0;
+        p[2] *= 60.0;
+    }
+    mesh
+}
+
+/// The JSON chunk of a GLB.
+fn glb_json(glb: &[u8]) -> Value {
+    let len = u32::from_le_bytes(glb[12..16].try_into().unwrap()) as usize;
+    assert_eq!(&glb[16..20], b"JSON");
+    serde_json::from_slice(&glb[20..20 + len]).unwrap()
+}
+
+fn extent(mesh: &vitrine_codec::IndexedMesh, axis: usize) -> f64 {
+    let values = mesh.positions.iter().map(|p| f64::from(p[axis]));
+    values.clone().fold(f64::MIN, f64::max) - values.fold(f64::MAX, f64::min)
+}
+
+pub async fn rights_served_and_carried(db: TestDb) {
+    let mut meta = ModelMeta::new("stele", "Stele of the test");
+    meta.policy = "open-download".into();
+    meta.up = Some(UpAxis::Z);
+    meta.unit = Some("mm".into());
+    meta.rights = Rights::parse(Some(CREDIT), Some("CC-BY-4.0")).unwrap();
+    let report = ingest_mesh(&*db.storage, stele(), meta, &IngestOptions::default())
+        .await
+        .unwrap();
+    // A model with neither.
+    let mut plain = ModelMeta::new("plain", "Plain");
+    plain.policy = "open".into();
+    ingest_mesh(&*db.storage, stele(), plain, &IngestOptions::default())
+        .await
+        .unwrap();
+    let curator = token(&db, TokenScope::Curator, None).await;
+    let server = TestServer::start(db.storage.clone(), test_config()).await;
+    let http = reqwest::Client::new();
+    let get_json = |path: &str| {
+        let request = http.get(server.url(path));
+        async move { request.send().await.unwrap().json::<Value>().await.unwrap() }
+    };
+
+    // The manifest.
+    let manifest = get_json("/api/models/stele").await;
+    assert_eq!(manifest["rights"]["credit"], CREDIT);
+    assert_eq!(
+        manifest["rights"]["licence"],
+        json!({ "id": "CC-BY-4.0", "name": "CC BY 4.0", "url": CC_BY })
+    );
+    let plain = get_json("/api/models/plain").await;
+    assert_eq!(plain["rights"], json!({ "credit": null, "licence": null }));
+    let licences = get_json("/api/licences").await;
+    let ids: Vec<&str> = licences["licences"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|l| l["id"].as_str().unwrap())
+        .collect();
+    assert!(ids.contains(&"CC0-1.0") && ids.contains(&"InC"), "{ids:?}");
+
+    // The model page: a license link and schema.org JSON-LD whose strings
+    // cannot close the script element.
+    let page = http
+        .get(server.url("/m/stele"))
+        .send()
+        .await
+        .unwrap()
+        .text()
+        .await
+        .unwrap();
+    assert!(
+        page.contains(&format!("<link rel=\"license\" href=\"{CC_BY}\">")),
+        "{page}"
+    );
+    let start = page.find("<script type=\"application/ld+json\">").unwrap();
+    let script = &page[start + 35..];
+    let script = &script[..script.find("</script>").unwrap()];
+    assert!(!script.contains("</"), "{script}");
+    let data: Value = serde_json::from_str(script).unwrap();
+    assert_eq!(data["@type"], "3DModel");
+    assert_eq!(data["name"], "Stele of the test");
+    assert_eq!(data["license"], CC_BY);
+    assert_eq!(data["creditText"], CREDIT);
+    assert!(data["url"].as_str().unwrap().ends_with("/m/stele"));
+    assert!(data["encoding"][0]["contentUrl"]
+        .as_str()
+        .unwrap()
+        .ends_with("/api/models/stele/download.glb"));
+    let plain_page = http
+        .get(server.url("/m/plain"))
+        .send()
+        .await
+        .unwrap()
+        .text()
+        .await
+        .unwrap();
+    assert!(!plain_page.contains("rel=\"license\""));
+    assert!(
+        !plain_page.contains("\"encoding\""),
+        "no downloads under `open`"
+    );
+
+    // The download: credit and deed in `asset.copyright` and the XMP
+    // packet; a node that stands the stele up (+Y) in metres.
+    let last = report.levels - 1;
+    let url = server.url(&format!("/api/models/stele/download.glb?level={last}"));
+    let reply = http.get(&url).send().await.unwrap();
+    assert_eq!(reply.status(), StatusCode::OK);
+    let etag = reply.headers()["etag"].to_str().unwrap().to_owned();
+    let glb = reply.bytes().await.unwrap();
+    let doc = glb_json(&glb);
+    let copyright = doc["asset"]["copyright"].as_str().unwrap();
+    assert!(
+        copyright.starts_with(CREDIT) && copyright.contains(CC_BY),
+        "{copyright}"
+    );
+    assert_eq!(doc["nodes"][0]["name"], "Stele of the test");
+    let packet = &doc["extensions"]["KHR_xmp_json_ld"]["packets"][0];
+    assert_eq!(doc["asset"]["extensions"]["KHR_xmp_json_ld"]["packet"], 0);
+    assert_eq!(packet["xmpRights:WebStatement"], CC_BY);
+    assert_eq!(packet["dc:rights"]["rdf:_1"]["@value"], copyright);
+    assert_eq!(packet["dc:title"]["rdf:_1"]["@value"], "Stele of the test");
+    super::download::assert_valid_glb(&glb);
+    // Read back through the node: the decoded level, turned z → y and
+    // scaled mm → m (120 mm tall: 0.12 m along y).
+    let compression = report.stored.compression_id;
+    let decoded = {
+        let base = db.storage.base_payload(compression).await.unwrap().unwrap();
+        let mut decoder = Decoder::new(&base, Limits::default()).unwrap();
+        for k in 1..=last as u32 {
+            let batch = db
+                .storage
+                .batch_payload(compression, k)
+                .await
+                .unwrap()
+                .unwrap();
+            decoder.apply_batch(&batch).unwrap();
+        }
+        decoder.to_mesh()
+    };
+    let back = import_bytes(&glb, MeshFormat::Glb, &ImportOptions::default()).unwrap();
+    assert_eq!(back.triangles, decoded.triangles);
+    for (b, d) in back.positions.iter().zip(&decoded.positions) {
+        let want = [
+            d[0] as f64 * 0.001,
+            d[2] as f64 * 0.001,
+            -d[1] as f64 * 0.001,
+        ];
+        for k in 0..3 {
+            assert!(
+                (b[k] as f64 - want[k]).abs() < 1e-7,
+                "{b:?} against {want:?}"
+            );
+        }
+    }
+    assert!((extent(&back, 1) - extent(&decoded, 2) * 0.001).abs() < 1e-6);
+
+    // A curator changes the licence only: the credit stays, the manifest
+    // and the download follow, and the download's ETag changes.
+    let version = server.url("/api/admin/models/stele/versions/1");
+    let changed: Value = http
+        .put(&version)
+        .bearer_auth(&curator)
+        .json(&json!({ "licence": "CC0-1.0" }))
+        .send()
+        .await
+        .unwrap()
+        .json()
+        .await
+        .unwrap();
+    assert_eq!(changed["licence"], "CC0-1.0");
+    assert_eq!(changed["credit"], CREDIT);
+    let manifest = get_json("/api/models/stele").await;
+    assert_eq!(manifest["rights"]["licence"]["id"], "CC0-1.0");
+    let again = http
+        .get(&url)
+        .header("if-none-match", &etag)
+        .send()
+        .await
+        .unwrap();
+    assert_eq!(again.status(), StatusCode::OK, "new rights, new ETag");
+    assert_ne!(again.headers()["etag"].to_str().unwrap(), etag);
+    let doc = glb_json(&again.bytes().await.unwrap());
+    assert!(doc["asset"]["copyright"]
+        .as_str()
+        .unwrap()
+        .contains("publicdomain/zero/1.0"));
+    // Clearing both: no copyright at all.
+    let cleared: Value = http
+        .put(&version)
+        .bearer_auth(&curator)
+        .json(&json!({ "licence": null, "credit": "" }))
+        .send()
+        .await
+        .unwrap()
+        .json()
+        .await
+        .unwrap();
+    assert_eq!(cleared["licence"], Value::Null);
+    assert_eq!(cleared["credit"], Value::Null);
+    let doc = glb_json(&http.get(&url).send().await.unwrap().bytes().await.unwrap());
+    assert!(doc["asset"].get("copyright").is_none(), "{doc}");
+
+    // Bad values: an unknown licence, a credit of two lines, a researcher.
+    for (body, status) in [
+        (
+            json!({ "licence": "CC-BY" }),
+            StatusCode::UNPROCESSABLE_ENTITY,
+        ),
+        (
+            json!({ "credit": "a\nb" }),
+            StatusCode::UNPROCESSABLE_ENTITY,
+        ),
+        (
+            json!({ "credit": "x".repeat(301) }),
+            StatusCode::UNPROCESSABLE_ENTITY,
+        ),
+    ] {
+        let reply = http
+            .put(&version)
+            .bearer_auth(&curator)
+            .json(&body)
+            .send()
+            .await
+            .unwrap();
+        assert_eq!(reply.status(), status, "{body}");
+    }
+    let unknown: Value = http
+        .put(&version)
+        .bearer_auth(&curator)
+        .json(&json!({ "licence": "CC-BY" }))
+        .send()
+        .await
+        .unwrap()
+        .json()
+        .await
+        .unwrap();
+    assert!(
+        unknown["message"].as_str().unwrap().contains("CC-BY-4.0"),
+        "{unknown}"
+    );
+    let researcher = token(&db, TokenScope::Researcher, None).await;
+    let refused = http
+        .put(&version)
+        .bearer_auth(&researcher)
+        .json(&json!({ "licence": "InC" }))
+        .send()
+        .await
+        .unwrap();
+    assert_eq!(refused.status(), StatusCode::FORBIDDEN);
+    let manifest = get_json("/api/models/stele").await;
+    assert_eq!(
+        manifest["rights"],
+        json!({ "credit": null, "licence": null })
+    );
+}
