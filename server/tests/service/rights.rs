@@ -275,3 +275,85 @@ pub async fn rights_served_and_carried(db: TestDb) {
         json!({ "credit": null, "licence": null })
     );
 }
+
+/// The upload form's `unit`, `up`, `credit` and `licence`: recorded as
+/// given; bad values refused before any job starts.
+pub async fn rights_and_placement_through_uploads(db: TestDb) {
+    use super::uploads::{form, job_until_finished, sample_ply, upload_config};
+    let spool = tempfile::tempdir().unwrap();
+    let curator = token(&db, TokenScope::Curator, None).await;
+    let server = TestServer::start(db.storage.clone(), upload_config(spool.path())).await;
+    let http = reqwest::Client::new();
+    let upload = server.url("/api/models");
+    let with = |fields: &[(&'static str, &'static str)]| {
+        let mut form = form("vase.ply", sample_ply(), "vase");
+        for &(name, value) in fields {
+            form = form.text(name, value);
+        }
+        http.post(&upload)
+            .bearer_auth(&curator)
+            .multipart(form)
+            .send()
+    };
+    for (fields, says) in [
+        (
+            &[("licence", "CC BY")][..],
+            "licence \"CC BY\" must be one of",
+        ),
+        (&[("unit", "ft")][..], "unit \"ft\""),
+        (&[("up", "w")][..], "up: \"w\""),
+        (&[("credit", "one\ntwo")][..], "one line"),
+    ] {
+        let reply = with(fields).await.unwrap();
+        assert_eq!(
+            reply.status(),
+            StatusCode::UNPROCESSABLE_ENTITY,
+            "{fields:?}"
+        );
+        let body: Value = reply.json().await.unwrap();
+        assert!(body["message"].as_str().unwrap().contains(says), "{body}");
+    }
+    let jobs: Value = http
+        .get(server.url("/api/jobs"))
+        .bearer_auth(&curator)
+        .send()
+        .await
+        .unwrap()
+        .json()
+        .await
+        .unwrap();
+    assert_eq!(jobs["jobs"], json!([]), "refused forms start no job");
+
+    let reply = with(&[
+        ("unit", "cm"),
+        ("up", "-z"),
+        ("credit", "Photogrammetry: Vitrine test lab"),
+        ("licence", "InC-EDU"),
+    ])
+    .await
+    .unwrap();
+    assert_eq!(reply.status(), StatusCode::ACCEPTED);
+    let accepted: Value = reply.json().await.unwrap();
+    let status = server.url(accepted["status_url"].as_str().unwrap());
+    let done = job_until_finished(&http, &status, &curator).await;
+    assert_eq!(done["state"], "done", "{done}");
+    let manifest: Value = http
+        .get(server.url("/api/models/vase"))
+        .send()
+        .await
+        .unwrap()
+        .json()
+        .await
+        .unwrap();
+    assert_eq!(manifest["unit"], "cm");
+    assert_eq!(manifest["up"], "-z");
+    assert_eq!(
+        manifest["rights"]["credit"],
+        "Photogrammetry: Vitrine test lab"
+    );
+    assert_eq!(manifest["rights"]["licence"]["id"], "InC-EDU");
+    assert_eq!(
+        manifest["rights"]["licence"]["url"],
+        "http://rightsstatements.org/vocab/InC-EDU/1.0/"
+    );
+}

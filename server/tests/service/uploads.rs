@@ -12,7 +12,7 @@ use vitrine::storage::TokenScope;
 use vitrine::ServiceConfig;
 
 /// A PLY of the sample torus, as a file a curator would upload.
-fn sample_ply() -> Vec<u8> {
+pub fn sample_ply() -> Vec<u8> {
     let mut bytes = Vec::new();
     vitrine_mesh::export::write_ply(&super::harness::sample_mesh(), &mut bytes).unwrap();
     bytes

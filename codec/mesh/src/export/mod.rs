@@ -388,6 +388,52 @@ mod tests {
     }
 
     #[test]
+    fn a_document_names_credits_and_places_the_mesh() {
+        let m = mesh(true);
+        let doc = GlbDocument {
+            copyright: Some("Scan: \"Museo\" </script>".into()),
+            name: Some("Stele".into()),
+            // Z up to Y up, millimetres to metres.
+            matrix: Some([
+                0.001, 0.0, 0.0, 0.0, 0.0, 0.0, -0.001, 0.0, 0.0, 0.001, 0.0, 0.0, 0.0, 0.0, 0.0,
+                1.0,
+            ]),
+            xmp: Some(
+                serde_json::json!({ "@context": { "dc": "http://purl.org/dc/elements/1.1/" } }),
+            ),
+        };
+        let mut out = Vec::new();
+        write_glb_document(&m, &doc, &mut out).unwrap();
+        let gltf = gltf::Gltf::from_slice(&out).unwrap();
+        assert_eq!(gltf.document.as_json().asset.copyright, doc.copyright);
+        let json_len = u32::from_le_bytes(out[12..16].try_into().unwrap()) as usize;
+        let json: serde_json::Value = serde_json::from_slice(&out[20..20 + json_len]).unwrap();
+        assert_eq!(json["nodes"][0]["name"], "Stele");
+        assert_eq!(json["meshes"][0]["name"], "Stele");
+        assert!(gltf
+            .document
+            .extensions_used()
+            .any(|e| e == "KHR_xmp_json_ld"));
+        // Read back through the node: (x, y, z) mm -> (x, z, -y) m.
+        let back = import_bytes(&out, MeshFormat::Glb, &ImportOptions::default()).unwrap();
+        for (b, p) in back.positions.iter().zip(&m.positions) {
+            let want = [p[0] * 0.001, p[2] * 0.001, -p[1] * 0.001];
+            for k in 0..3 {
+                assert!((b[k] - want[k]).abs() < 1e-6, "{b:?} against {want:?}");
+            }
+        }
+        assert_eq!(back.triangles, m.triangles);
+        let mut bad = doc.clone();
+        bad.matrix.as_mut().unwrap()[0] = f32::NAN;
+        assert!(write_glb_document(&m, &bad, &mut Vec::new()).is_err());
+        // The default document writes what write_glb always wrote.
+        let (mut plain, mut default) = (Vec::new(), Vec::new());
+        write_glb(&m, &mut plain).unwrap();
+        write_glb_document(&m, &GlbDocument::default(), &mut default).unwrap();
+        assert_eq!(plain, default);
+    }
+
+    #[test]
     fn bad_meshes_are_refused() {
         let mut m = mesh(true);
         m.triangles.push([0, 1, 4]);
