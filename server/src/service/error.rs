@@ -66,6 +66,9 @@ pub enum AppError {
     /// This session has used its requests.
     #[error("{0}")]
     TooManyRequests(String),
+    /// A variant of a standard this service does not serve (oEmbed's XML).
+    #[error("{0}")]
+    NotImplemented(String),
     #[error("internal error: {0}")]
     Internal(String),
 }
@@ -108,6 +111,7 @@ impl AppError {
             AppError::Unprocessable(_) => StatusCode::UNPROCESSABLE_ENTITY,
             AppError::TooManyRequests(_) => StatusCode::TOO_MANY_REQUESTS,
             AppError::NotAllowed(_) => StatusCode::FORBIDDEN,
+            AppError::NotImplemented(_) => StatusCode::NOT_IMPLEMENTED,
         }
     }
 
@@ -130,6 +134,7 @@ impl AppError {
             AppError::Unprocessable(_) => ErrorCode::Unprocessable,
             AppError::TooManyRequests(_) => ErrorCode::TooManyRequests,
             AppError::NotAllowed(_) => ErrorCode::NotAllowed,
+            AppError::NotImplemented(_) => ErrorCode::NotImplemented,
         }
     }
 
@@ -193,6 +198,7 @@ pub enum ErrorCode {
     Unprocessable,
     TooManyRequests,
     NotAllowed,
+    NotImplemented,
     Timeout,
     /// The instance is shutting down (`/readyz` only): send requests elsewhere.
     ShuttingDown,

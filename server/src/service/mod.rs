@@ -19,6 +19,7 @@ mod layers;
 pub mod load;
 mod manifest;
 mod metrics;
+mod oembed;
 mod ops;
 mod payload;
 mod routes;

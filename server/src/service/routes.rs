@@ -5,7 +5,7 @@
 use super::curator::{admin, annotations, jobs, thumbnail, upload};
 use super::error::AppError;
 use super::web::{self, Viewer};
-use super::{api, download, guard, ops, payload, study, AppState, ServiceConfig};
+use super::{api, download, guard, oembed, ops, payload, study, AppState, ServiceConfig};
 use axum::http::{header, HeaderValue};
 use axum::response::{IntoResponse, Response};
 use axum::routing::any;
@@ -80,6 +80,7 @@ fn list(viewer: Option<&Viewer>) -> OpenApiRouter<AppState> {
         .routes(routes!(api::list, upload::upload))
         .routes(routes!(api::manifest))
         .routes(routes!(api::licences))
+        .routes(routes!(oembed::oembed))
         .routes(routes!(thumbnail::thumbnail))
         .routes(routes!(annotations::list, annotations::create))
         .routes(routes!(annotations::update, annotations::delete))

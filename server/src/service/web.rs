@@ -195,6 +195,19 @@ fn open_graph(state: &AppState, headers: &HeaderMap, record: &ModelRecord) -> St
             ))
         ));
     }
+    // oEmbed discovery: a CMS given this page's link embeds the viewer
+    // (public models only: a CMS asks without a token).
+    if record.policy.public_access {
+        let page = format!("{base}/m/{}", record.slug);
+        tags.push_str(&format!(
+            "<link rel=\"alternate\" type=\"application/json+oembed\" href=\"{}\" title=\"{}\">\n",
+            escape(&format!(
+                "{base}/api/oembed?{}",
+                serde_urlencoded::to_string([("url", page.as_str())]).unwrap_or_default()
+            )),
+            escape(&record.title)
+        ));
+    }
     if let Some(licence) = record.curation.rights.licence {
         tags.push_str(&format!(
             "<link rel=\"license\" href=\"{}\">\n",

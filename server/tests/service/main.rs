@@ -81,6 +81,7 @@ on_both_backends!(
     download::glb_download_of_a_level,
     rights::rights_served_and_carried,
     rights::rights_and_placement_through_uploads,
+    rights::oembed_for_pasted_links,
     curators::annotations_and_scopes,
     uploads::uploads_as_jobs,
     curation::curation_in_manifest_and_thumbnail,

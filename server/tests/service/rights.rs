@@ -357,3 +357,105 @@ pub async fn rights_and_placement_through_uploads(db: TestDb) {
         "http://rightsstatements.org/vocab/InC-EDU/1.0/"
     );
 }
+
+/// oEmbed: a pasted model link becomes the embedded viewer, for public
+/// models only; the model page announces the endpoint.
+pub async fn oembed_for_pasted_links(db: TestDb) {
+    let mut meta = ModelMeta::new("stele", "Stele \"A\" <1>");
+    meta.policy = "open".into();
+    meta.rights = Rights::parse(Some(CREDIT), Some("CC-BY-4.0")).unwrap();
+    ingest_mesh(&*db.storage, stele(), meta, &IngestOptions::default())
+        .await
+        .unwrap();
+    let mut hidden = ModelMeta::new("hidden", "Hidden");
+    hidden.policy = "researchers".into();
+    ingest_mesh(&*db.storage, stele(), hidden, &IngestOptions::default())
+        .await
+        .unwrap();
+    let server = TestServer::start(db.storage.clone(), test_config()).await;
+    let http = reqwest::Client::new();
+    let ask = |query: &[(&str, &str)]| http.get(server.url("/api/oembed")).query(query).send();
+
+    // Discovery: the page's link, followed as a CMS would.
+    let page = http
+        .get(server.url("/m/stele"))
+        .send()
+        .await
+        .unwrap()
+        .text()
+        .await
+        .unwrap();
+    let marker = "type=\"application/json+oembed\" href=\"";
+    let href = &page[page.find(marker).unwrap() + marker.len()..];
+    let href = href[..href.find('"').unwrap()].replace("&amp;", "&");
+    assert!(href.starts_with(&server.url("/api/oembed?url=")), "{href}");
+    let reply = http.get(&href).send().await.unwrap();
+    assert_eq!(reply.status(), StatusCode::OK);
+    assert_eq!(reply.headers()["cache-control"], "public, max-age=300");
+    let embed: Value = reply.json().await.unwrap();
+    assert_eq!(embed["type"], "rich");
+    assert_eq!(embed["version"], "1.0");
+    assert_eq!(embed["title"], "Stele \"A\" <1>");
+    assert_eq!(embed["author_name"], CREDIT);
+    assert_eq!(
+        (embed["width"].as_u64(), embed["height"].as_u64()),
+        (Some(800), Some(600))
+    );
+    let html = embed["html"].as_str().unwrap();
+    assert!(
+        html.starts_with(&format!("<iframe src=\"{}\"", server.url("/embed/stele"))),
+        "{html}"
+    );
+    assert!(
+        html.contains("title=\"Stele &quot;A&quot; &lt;1&gt;\""),
+        "{html}"
+    );
+    assert!(embed["thumbnail_url"]
+        .as_str()
+        .unwrap()
+        .contains("/api/models/stele/thumbnail?v=1"));
+    // The embed the iframe opens is served.
+    let frame = http.get(server.url("/embed/stele")).send().await.unwrap();
+    assert_eq!(frame.status(), StatusCode::OK);
+
+    // Bounds, another host's name for the site, an embed link.
+    let small: Value = ask(&[
+        ("url", "https://museo.example/embed/stele?x=1"),
+        ("maxwidth", "500"),
+        ("maxheight", "300"),
+    ])
+    .await
+    .unwrap()
+    .json()
+    .await
+    .unwrap();
+    assert_eq!(
+        (small["width"].as_u64(), small["height"].as_u64()),
+        (Some(400), Some(300))
+    );
+    // Restricted, unknown, not a model page, XML, no url.
+    for (query, status) in [
+        (
+            vec![("url", "https://museo.example/m/hidden")],
+            StatusCode::NOT_FOUND,
+        ),
+        (
+            vec![("url", "https://museo.example/m/nowhere")],
+            StatusCode::NOT_FOUND,
+        ),
+        (
+            vec![("url", "https://museo.example/admin")],
+            StatusCode::NOT_FOUND,
+        ),
+        (
+            vec![("url", "https://museo.example/m/stele"), ("format", "xml")],
+            StatusCode::NOT_IMPLEMENTED,
+        ),
+        (vec![], StatusCode::BAD_REQUEST),
+    ] {
+        let reply = ask(&query).await.unwrap();
+        assert_eq!(reply.status(), status, "{query:?}");
+    }
+    let hidden_page = http.get(server.url("/m/hidden")).send().await.unwrap();
+    assert_eq!(hidden_page.status(), StatusCode::NOT_FOUND);
+}
