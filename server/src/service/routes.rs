@@ -15,6 +15,7 @@ use utoipa::openapi::security::{HttpAuthScheme, HttpBuilder, SecurityScheme};
 use utoipa::openapi::OpenApi as Description;
 use utoipa::{Modify, OpenApi};
 use utoipa_axum::router::OpenApiRouter;
+use utoipa_axum::router::UtoipaMethodRouterExt;
 use utoipa_axum::routes;
 
 #[derive(OpenApi)]
@@ -120,10 +121,12 @@ fn list(viewer: Option<&Viewer>) -> OpenApiRouter<AppState> {
             routes!(web::study_page),
             viewer.map(Viewer::index),
         ))
-        .routes(web::or_viewer(
-            routes!(web::admin_page),
-            viewer.map(Viewer::index),
-        ))
+        // The curators' page is never framed (a click-jacked "withdraw");
+        // `/embed/{slug}` is the page other sites frame.
+        .routes(
+            web::or_viewer(routes!(web::admin_page), viewer.map(Viewer::index))
+                .map(|page| page.layer(axum::middleware::map_response(web::not_framed))),
+        )
 }
 
 fn ops_list() -> OpenApiRouter<AppState> {

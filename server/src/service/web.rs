@@ -64,6 +64,17 @@ where
     route.map(|handler| viewer.map_or(handler, get_service))
 }
 
+/// Refuses to be shown inside another site's frame.
+pub async fn not_framed(mut response: Response) -> Response {
+    let headers = response.headers_mut();
+    headers.insert(header::X_FRAME_OPTIONS, HeaderValue::from_static("DENY"));
+    headers.insert(
+        header::CONTENT_SECURITY_POLICY,
+        HeaderValue::from_static("frame-ancestors 'none'"),
+    );
+    response
+}
+
 /// Gallery (the viewer's index.html, or a built-in list).
 #[utoipa::path(
     get,

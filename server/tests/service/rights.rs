@@ -417,6 +417,14 @@ pub async fn oembed_for_pasted_links(db: TestDb) {
     // The embed the iframe opens is served.
     let frame = http.get(server.url("/embed/stele")).send().await.unwrap();
     assert_eq!(frame.status(), StatusCode::OK);
+    assert!(frame.headers().get("x-frame-options").is_none());
+    // The curators' page is never framed.
+    let admin = http.get(server.url("/admin")).send().await.unwrap();
+    assert_eq!(admin.headers()["x-frame-options"], "DENY");
+    assert_eq!(
+        admin.headers()["content-security-policy"],
+        "frame-ancestors 'none'"
+    );
 
     // Bounds, another host's name for the site, an embed link.
     let small: Value = ask(&[
