@@ -11,6 +11,7 @@ mod cache;
 mod cache_headers;
 pub mod cap;
 pub mod coherence;
+mod crawl;
 pub mod curator;
 mod download;
 mod error;

@@ -5,7 +5,6 @@
 //! visitor may see are embedded: a CMS asks without a token, and what it
 //! gets is published on pages everyone reads.
 
-use super::cap::DeviceClass;
 use super::error::{AppError, ErrorBody};
 use super::servable::ServableModel;
 use super::visitor::VisitorHints;
@@ -92,11 +91,7 @@ pub async fn oembed(
     let record = state.record_by_slug(slug).await?;
     // As a visitor without a token (a restricted model does not exist for
     // it): the consumer publishes what it gets.
-    let public = VisitorHints {
-        device: DeviceClass::Desktop,
-        device_explicit: false,
-        token: None,
-    };
+    let public = VisitorHints::anonymous();
     let model = ServableModel::decide(&state, record, &public).await?;
     let base = public_base(&state, &headers);
     let (width, height) = fit(query.maxwidth, query.maxheight);

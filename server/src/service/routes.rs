@@ -5,7 +5,7 @@
 use super::curator::{admin, annotations, jobs, thumbnail, upload};
 use super::error::AppError;
 use super::web::{self, Viewer};
-use super::{api, download, guard, oembed, ops, payload, study, AppState, ServiceConfig};
+use super::{api, crawl, download, guard, oembed, ops, payload, study, AppState, ServiceConfig};
 use axum::http::{header, HeaderValue};
 use axum::response::{IntoResponse, Response};
 use axum::routing::any;
@@ -110,6 +110,8 @@ fn list(viewer: Option<&Viewer>) -> OpenApiRouter<AppState> {
             routes!(web::gallery),
             viewer.map(Viewer::files),
         ))
+        .routes(routes!(crawl::sitemap))
+        .routes(routes!(crawl::robots))
         // The model page is always this handler: it adds the Open Graph
         // tags to the viewer's index.html.
         .routes(routes!(web::model_page))

@@ -115,6 +115,18 @@ pub struct VisitorHints {
     pub token: Option<String>,
 }
 
+impl VisitorHints {
+    /// A desktop visitor without a token: what a CMS fetching an oEmbed or
+    /// a crawler reading the sitemap is, and what they publish to anyone.
+    pub fn anonymous() -> VisitorHints {
+        VisitorHints {
+            device: DeviceClass::Desktop,
+            device_explicit: false,
+            token: None,
+        }
+    }
+}
+
 /// The query parameters every visitor route reads.
 #[derive(Deserialize, IntoParams)]
 #[into_params(parameter_in = Query)]

@@ -13,8 +13,8 @@ mod http;
 mod kill;
 mod points;
 mod proxy;
+mod publishing;
 mod quality;
-mod rights;
 mod slow;
 mod spec;
 mod story;
@@ -79,9 +79,10 @@ on_both_backends!(
     study::scripted_participants,
     study::bad_study_requests,
     download::glb_download_of_a_level,
-    rights::rights_served_and_carried,
-    rights::rights_and_placement_through_uploads,
-    rights::oembed_for_pasted_links,
+    publishing::rights_served_and_carried,
+    publishing::rights_and_placement_through_uploads,
+    publishing::oembed_for_pasted_links,
+    publishing::crawlers_find_public_models,
     curators::annotations_and_scopes,
     uploads::uploads_as_jobs,
     curation::curation_in_manifest_and_thumbnail,

@@ -1,7 +1,8 @@
-//! Credit line and licence over real HTTP: recorded at ingest, served in the
-//! manifest, stated on the model page (`<link rel="license">`, schema.org
-//! JSON-LD), carried by GLB downloads (with the up axis and unit applied),
-//! changed by a curator without ingesting again; bad values refused.
+//! Publishing over real HTTP. Credit line and licence: recorded at ingest
+//! or upload, served in the manifest, stated on the model page (`<link
+//! rel="license">`, schema.org JSON-LD), carried by GLB downloads (with the
+//! up axis and unit applied), changed by a curator without ingesting again;
+//! bad values refused. oEmbed for a pasted link; the sitemap and robots.txt.
 
 use super::curators::token;
 use super::harness::{test_config, TestDb, TestServer};
@@ -466,4 +467,60 @@ pub async fn oembed_for_pasted_links(db: TestDb) {
     }
     let hidden_page = http.get(server.url("/m/hidden")).send().await.unwrap();
     assert_eq!(hidden_page.status(), StatusCode::NOT_FOUND);
+}
+
+/// The sitemap lists public models' pages and nothing else; robots.txt
+/// points to it and keeps crawlers out of the curators' page and studies.
+pub async fn crawlers_find_public_models(db: TestDb) {
+    for (slug, policy) in [
+        ("stele", "open"),
+        ("vase", "exhibition"),
+        ("hidden", "researchers"),
+    ] {
+        let mut meta = ModelMeta::new(slug, slug);
+        meta.policy = policy.into();
+        ingest_mesh(&*db.storage, stele(), meta, &IngestOptions::default())
+            .await
+            .unwrap();
+    }
+    let server = TestServer::start(db.storage.clone(), test_config()).await;
+    let http = reqwest::Client::new();
+    let reply = http.get(server.url("/sitemap.xml")).send().await.unwrap();
+    assert_eq!(reply.status(), StatusCode::OK);
+    assert_eq!(reply.headers()["content-type"], "application/xml");
+    let xml = reply.text().await.unwrap();
+    assert!(xml.starts_with("<?xml") && xml.contains("sitemaps.org/schemas/sitemap/0.9"));
+    let locs: Vec<&str> = xml
+        .split("<loc>")
+        .skip(1)
+        .map(|s| &s[..s.find("</loc>").unwrap()])
+        .collect();
+    assert_eq!(
+        locs,
+        [server.url("/m/stele"), server.url("/m/vase")],
+        "{xml}"
+    );
+    let today = chrono::Utc::now().format("%Y-%m-%d").to_string();
+    assert_eq!(
+        xml.matches(&format!("<lastmod>{today}</lastmod>")).count(),
+        2,
+        "{xml}"
+    );
+    let robots = http
+        .get(server.url("/robots.txt"))
+        .send()
+        .await
+        .unwrap()
+        .text()
+        .await
+        .unwrap();
+    for line in [
+        "Disallow: /admin",
+        "Disallow: /study/",
+        "Disallow: /api/",
+        "Allow: /api/models/",
+    ] {
+        assert!(robots.lines().any(|l| l == line), "{line}: {robots}");
+    }
+    assert!(robots.contains(&format!("Sitemap: {}", server.url("/sitemap.xml"))));
 }
