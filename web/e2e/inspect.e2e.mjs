@@ -18,6 +18,7 @@ import { startService } from '../test/support/service.mjs';
 import { OrbitCamera } from '../src/camera.js';
 import { diagonal, formatReading, levelHausdorff, measurement } from '../src/measure.js';
 import { projectPoint } from '../src/pick.js';
+import { readTextChunks } from '../src/png-text.js';
 
 /** @typedef {import('playwright-core').Page} Page */
 
@@ -27,6 +28,13 @@ const HEIGHT = 480;
 const WIDE = { width: 1280, height: 800 };
 /** @type {[number, number, number]} */
 const SIZE = [40, 30, 20];
+/** A long credit line (258 of the server's 300 bytes), for the layout. */
+const CREDIT =
+  'Scan: Museo Nacional de Arqueología y Etnología, Departamento de Conservación; photogrammetry by the ' +
+  'Digital Heritage Laboratory, 2019, with the support of the Ministry of Culture and Sports; 3D processing and ' +
+  'colour calibration by the Conservation Studio';
+/** The snapshot's `Copyright` text chunk. */
+const NOTICE = `${CREDIT}. Licence: CC BY-NC-SA 4.0 (https://creativecommons.org/licenses/by-nc-sa/4.0/)`;
 
 /** @type {Awaited<ReturnType<typeof startService>>} */
 let service;
@@ -42,7 +50,9 @@ before(async () => {
   const { tmpdir } = await import('node:os');
   const file = join(mkdtempSync(join(tmpdir(), 'vitrine-box-')), 'box.ply');
   writeBox(file, SIZE);
-  service = await startService({ models: [{ slug: 'box', title: 'Box', description: 'A 40 × 30 × 20 box.', kind: 'file', file, quality: true }] });
+  service = await startService({
+    models: [{ slug: 'box', title: 'Box', description: 'A 40 × 30 × 20 box.', kind: 'file', file, quality: true, ingestArgs: ['--credit', CREDIT, '--licence', 'CC-BY-NC-SA-4.0'] }],
+  });
   browser = await launch({ width: WIDTH, height: HEIGHT });
   manifest = await (await fetch(`${service.url}/api/models/box`)).json();
   const base = new Uint8Array(await (await fetch(new URL(manifest.levels[0].url, `${service.url}/api/models/box`))).arrayBuffer());
@@ -412,6 +422,10 @@ test('raking light changes the shading; the section hides the cut half; the snap
   assert.deepEqual([...png.subarray(0, 8)], [137, 80, 78, 71, 13, 10, 26, 10], 'PNG signature');
   assert.equal(png.subarray(12, 16).toString('latin1'), 'IHDR');
   assert.deepEqual([png.readUInt32BE(16), png.readUInt32BE(20)], [cut.width, cut.height], 'the canvas\'s size');
+  assert.deepEqual(
+    readTextChunks(new Uint8Array(png)).map((c) => [c.keyword, c.text]),
+    [['Title', 'Box'], ['Copyright', NOTICE], ['Comment', `Snapshot from ${service.url}/m/box`]],
+  );
   assert.deepEqual(problems, []);
   await page.close();
 });
@@ -428,18 +442,20 @@ test('on the main thread (?offscreen=off) the snapshot is a PNG of the canvas to
   });
   assert.deepEqual([...png.subarray(0, 8)], [137, 80, 78, 71, 13, 10, 26, 10], 'PNG signature');
   assert.deepEqual([png.readUInt32BE(16), png.readUInt32BE(20)], size);
+  assert.equal(readTextChunks(new Uint8Array(png)).find((c) => c.keyword === 'Copyright')?.text, NOTICE);
   assert.deepEqual(problems, []);
   await page.close();
 });
 
-test('nothing overlaps from 320 px to 1920 px, portrait and landscape', async () => {
+test('nothing overlaps from 320 px to 1920 px, portrait and landscape, with a long credit line', async () => {
   // One page, resized: the layout follows the window (and the load is paid once).
   const { page, problems, go } = await open('/m/box', { width: 320, height: 568 });
   await page.route('**/api/models/box/annotations', (route) => route.fulfill({ json: NOTES }));
   await go();
   await until(page, `s.shownLevel >= 0 && v.annotations.list.length === 3`);
   await tool(page, 'measure').click();
-  for (const [width, height] of [[320, 568], [390, 844], [768, 1024], [1920, 1080], [844, 390]]) {
+  const sizes = [[320, 568], [568, 320], [390, 844], [844, 390], [768, 1024], [1024, 768], [1920, 1080], [1080, 1920]];
+  for (const [width, height] of sizes) {
     await page.setViewportSize({ width, height });
     await page.waitForFunction((w) => document.querySelector('vitrine-viewer')?.getBoundingClientRect().width === w, width);
     const boxes = await page.evaluate(() => {
@@ -447,7 +463,7 @@ test('nothing overlaps from 320 px to 1920 px, portrait and landscape', async ()
       const root = /** @type {ShadowRoot} */ (host.shadowRoot);
       const shown = (/** @type {Element} */ e) => /** @type {HTMLElement} */ (e).offsetParent !== null;
       const parts = [
-        ...[...root.querySelectorAll('.panel, .tools button, .panes > *, .status > *')].filter(shown),
+        ...[...root.querySelectorAll('.panel, .tools button, .panes > *, .status > *, .credit')].filter(shown),
       ];
       const box = (/** @type {Element} */ e) => {
         const r = e.getBoundingClientRect();
@@ -456,7 +472,8 @@ test('nothing overlaps from 320 px to 1920 px, portrait and landscape', async ()
       return { host: box(host), parts: parts.map(box) };
     });
     const where = `${width}×${height}`;
-    assert.ok(boxes.parts.length >= 12, `${where}: ${boxes.parts.length} parts`);
+    assert.ok(boxes.parts.length >= 13, `${where}: ${boxes.parts.length} parts`);
+    assert.ok(boxes.parts.some((p) => p.name.startsWith('credit Scan: Museo')), `${where}: the credit line is shown`);
     for (const p of boxes.parts) {
       const inside = p.left >= boxes.host.left - 0.5 && p.right <= boxes.host.right + 0.5 && p.top >= boxes.host.top - 0.5 && p.bottom <= boxes.host.bottom + 0.5;
       assert.ok(inside, `${where}: ${p.name} ${JSON.stringify(p)} inside ${JSON.stringify(boxes.host)}`);

@@ -12,6 +12,8 @@
 import { STUDIO, discLight, discPosition, rakingLight } from './light.js';
 import { diagonal, formatReading, levelHausdorff, measurement } from './measure.js';
 import { pixelSize, projectPoint, viewRay } from './pick.js';
+import { addTextChunks } from './png-text.js';
+import { modelPageUrl, snapshotText } from './rights.js';
 import { lightPane, measurePane, sectionPane } from './tools-ui.js';
 
 /** @typedef {[number, number, number]} Vec3 */
@@ -277,11 +279,15 @@ export class Inspection {
     this.viewer.setLook({ section: plane });
   }
 
-  /** Saves the view as `{slug}.png` (the browser's PNG encoder, on the canvas that draws it). */
+  /**
+   * Saves the view as `{slug}.png` (the browser's PNG encoder, on the canvas
+   * that draws it), with the title, the credit and licence, and the model's
+   * page in text chunks, so the picture keeps its attribution.
+   */
   async saveSnapshot() {
     const renderer = this.viewer.renderer;
     if (!renderer) return null;
-    const blob = await renderer.snapshot();
+    const blob = await this.#labelled(await renderer.snapshot());
     const link = document.createElement('a');
     link.href = URL.createObjectURL(blob);
     link.download = `${this.viewer.manifest?.slug ?? 'vitrine'}.png`;
@@ -290,5 +296,20 @@ export class Inspection {
     link.remove();
     setTimeout(() => URL.revokeObjectURL(link.href), 10_000);
     return blob;
+  }
+
+  /** @param {Blob} blob the encoder's PNG */
+  async #labelled(blob) {
+    const manifest = this.viewer.manifest;
+    if (!manifest) return blob;
+    const entries = snapshotText(manifest, modelPageUrl(this.viewer.options.manifestUrl));
+    try {
+      const bytes = addTextChunks(new Uint8Array(await blob.arrayBuffer()), entries);
+      return new Blob([/** @type {Uint8Array<ArrayBuffer>} */ (bytes)], { type: 'image/png' });
+    } catch (error) {
+      // An encoder's PNG this file cannot read: the picture without its text rather than none.
+      console.warn('snapshot: text chunks not written', error);
+      return blob;
+    }
   }
 }

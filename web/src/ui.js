@@ -4,13 +4,14 @@
  * reach it): canvas sized to device pixels, progress line, cap notice, error
  * overlay with retry, title panel (with the quality chart when the model's
  * curve was measured), the reset / wireframe / relief / fullscreen buttons,
- * and the relief view's legend.
+ * the relief view's legend, and the credit line (who made the scan, its licence).
  */
 
 import { describeLevel, describeStudyLevel, renderQualityChart } from './quality-chart.js';
 import { NOTES_STYLE } from './annotations.js';
 import { TOOLS_STYLE } from './tools-ui.js';
 import { SCALE_PERCENTILE, formatDegrees, rampGradient, reliefTicks } from './relief.js';
+import { creditLine } from './rights.js';
 
 /** Device pixels per CSS pixel, capped: beyond 2 a tablet pays 2.25× the fill for little gain. */
 const MAX_PIXEL_RATIO = 2;
@@ -48,8 +49,28 @@ button[aria-pressed="true"] { background: #5e81ac; border-color: #81a1c1; }
 .spacer { flex: 1 1 0; min-height: 0; pointer-events: none; }
 .live { position: absolute; width: 1px; height: 1px; overflow: hidden; clip-path: inset(50%); white-space: nowrap; }
 .markers { position: absolute; inset: 0; overflow: hidden; pointer-events: none; }
-.status { display: flex; flex-direction: column; align-items: flex-start; gap: 6px; pointer-events: none; flex: none; }
+/* The status pills and the credit line share the bottom: side by side where the credit has
+   14rem beside them, else the credit under them. */
+.foot { display: flex; flex-wrap: wrap; align-items: flex-end; gap: 6px 8px; pointer-events: none; flex: none; }
+.status { display: flex; flex-direction: column; align-items: flex-start; gap: 6px; pointer-events: none; flex: 0 1 auto;
+  min-width: 0; max-width: 100%; }
 .status > * { max-width: 100%; }
+.credit { flex: 1 1 14rem; min-width: 0; max-width: 100%; display: flex; justify-content: flex-end; pointer-events: none; }
+/* Attribution: small, but 4.5:1 or better (the link 5.6:1) on its backing even over white. */
+.credit-line { display: flex; flex-wrap: wrap; align-items: baseline; gap: 0 0.4em; min-width: 0; max-width: 36rem;
+  padding: 2px 8px; border-radius: 4px; background: rgba(20, 22, 26, 0.85); color: #d8dee9; font-size: 12px;
+  line-height: 1.4; pointer-events: auto; }
+/* The licence beside the credit where the credit keeps 12rem, else on a line of its own. */
+.credit-text { flex: 1 1 12rem; min-width: 0; overflow-wrap: anywhere; }
+.credit-licence { flex: 0 1 auto; min-width: 0; overflow-wrap: anywhere; }
+.credit a { color: #8fbcbb; text-underline-offset: 2px; }
+.credit a:focus-visible { outline: 2px solid #88c0d0; outline-offset: 1px; }
+/* Small views: a long credit keeps to two lines (all of it on hover, in its title, and while
+   the licence link has focus; a screen reader reads it all); the licence stays whole. */
+@media (max-width: 480px), (max-height: 480px) {
+  .credit:not(:focus-within) .credit-text { display: -webkit-box; -webkit-box-orient: vertical; -webkit-line-clamp: 2;
+    line-clamp: 2; overflow: hidden; }
+}
 .notice { background: rgba(94, 72, 20, 0.88); border: 1px solid #ebcb8b; }
 .colour { font-size: 12px; color: #cfd5de; }
 .colour::before { content: ""; display: inline-block; width: 8px; height: 8px; border-radius: 50%;
@@ -131,6 +152,7 @@ export class ViewerUi {
   </div>
   <div class="panes"></div>
   <div class="spacer"></div>
+  <div class="foot">
   <div class="status">
     <div class="legend pill" role="group" aria-label="Relief legend" hidden>
       <div class="legend-title"></div>
@@ -140,6 +162,8 @@ export class ViewerUi {
     <div class="notice pill" role="status" hidden></div>
     <div class="colour pill" hidden></div>
     <div class="progress pill" aria-live="polite">Loading…</div>
+  </div>
+  <div class="credit" part="credit" role="group" aria-label="Credit and licence" hidden></div>
   </div>
   </div>
   <div class="live" aria-live="polite"></div>
@@ -159,6 +183,8 @@ export class ViewerUi {
     this.reliefButton = $('[data-action="relief"]');
     this.splatsButton = $('[data-action="splats"]');
     this.legend = $('.legend');
+    /** The credit line: who made the scan, the licence (manifest `rights`). */
+    this.credit = $('.credit');
     /** Tool panes (annotations list, measurement, light, section), under the toolbar. */
     this.panes = $('.panes');
     /** Annotation markers over the canvas. */
@@ -232,6 +258,45 @@ export class ViewerUi {
       this.panel.append(p);
     }
     this.panel.append(this.quality);
+  }
+
+  /**
+   * The credit line: the credit as typed and the licence's name linked to
+   * its deed; hidden when the manifest records neither. Curators type
+   * these, so they go in as text nodes, never markup.
+   * @param {Partial<import('./rights.js').Rights> | null | undefined} rights
+   */
+  setRights(rights) {
+    const line = creditLine(rights);
+    this.credit.replaceChildren();
+    this.credit.hidden = line === null;
+    if (!line) return;
+    const box = document.createElement('span');
+    box.className = 'credit-line';
+    if (line.credit) {
+      const text = document.createElement('span');
+      text.className = 'credit-text';
+      text.textContent = line.credit;
+      text.title = line.credit;
+      box.append(text);
+    }
+    if (line.licence) {
+      const licence = document.createElement('span');
+      licence.className = 'credit-licence';
+      if (line.credit) licence.append(' · ');
+      if (line.licence.href) {
+        const link = document.createElement('a');
+        link.href = line.licence.href;
+        link.rel = 'license noopener';
+        link.target = '_blank';
+        link.textContent = line.licence.name;
+        licence.append(link);
+      } else {
+        licence.append(line.licence.name);
+      }
+      box.append(licence);
+    }
+    this.credit.append(box);
   }
 
   /**

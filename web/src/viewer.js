@@ -60,6 +60,7 @@ import { PointModel } from './splats/point-model.js';
  * @property {import('./geometry.js').Bounds} [bounds] every level's extent, model coordinates
  * @property {'mesh' | 'points'} [kind] a point cloud's levels are prefixes of a point stream (splats/point-model.js)
  * @property {number} [stream_format] 5: a charted stream, whose charts a pool of workers refines
+ * @property {import('./rights.js').Rights} [rights] credit line and licence (absent from older servers)
  */
 
 /**
@@ -560,6 +561,7 @@ export class Viewer {
     this.points?.destroy();
     this.points = null;
     this.ui.setDetails(manifest.title, manifest.description);
+    this.ui.setRights(manifest.rights);
     this.ui.setQuality(manifest.quality ?? null);
     this.#look = { ...this.#look, model: upRotation(manifest.up), bounds: validBounds(manifest.bounds, null) };
     this.annotations.load();
@@ -652,6 +654,7 @@ export class Viewer {
   #beginPoints(manifest, module) {
     this.manifest = manifest;
     this.ui.setDetails(manifest.title, manifest.description);
+    this.ui.setRights(manifest.rights);
     this.#look = { ...this.#look, model: upRotation(manifest.up), bounds: validBounds(manifest.bounds, null) };
     this.#cap = { level: manifest.cap.level, reason: manifest.cap.reason, retryAfterS: manifest.cap.retry_after_s };
     const target = this.#target(manifest.cap.level);

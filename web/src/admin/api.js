@@ -23,7 +23,11 @@ export function saveToken(token) {
  *   error: string | null, model_version: number | null, model_url: string | null,
  *   created_at: number, updated_at: number }} Job
  * @typedef {{ version: number, title: string, status: string, policy: string,
- *   good_enough_level: number | null, levels: number, created_at: number }} Version
+ *   good_enough_level: number | null, levels: number, created_at: number,
+ *   credit?: string | null, licence?: string | null }} Version
+ * @typedef {import('../rights.js').Licence} Licence
+ * @typedef {{ status?: string, good_enough_level?: number | null,
+ *   credit?: string | null, licence?: string | null }} VersionChange
  */
 
 /** An answer that is not 2xx, with the server's message. */
@@ -79,10 +83,15 @@ export async function versions(slug) {
   return (await call(`/api/admin/models/${slug}/versions`)).versions;
 }
 
+/** The licences and rights statements a version may name (public). @returns {Promise<Licence[]>} */
+export async function licences() {
+  return (await call('/api/licences')).licences;
+}
+
 /**
  * @param {string} slug
  * @param {number} version
- * @param {{ status?: string, good_enough_level?: number | null }} change
+ * @param {VersionChange} change (credit or licence `""`: clear it)
  * @returns {Promise<Version>}
  */
 export function changeVersion(slug, version, change) {

@@ -2,10 +2,11 @@
 /**
  * `/admin`: curators publish from the browser. Paste the curator token
  * (kept in sessionStorage, sent as a Bearer header), upload a scan with its
- * title, description, audience policy and colour mode, follow the ingest
- * jobs (polled from /api/jobs, so they resume after a reload; failures show
- * the importer's message), and per model list versions, withdraw or restore
- * one and set its good-enough level. Plain HTML controls with labels; the
+ * title, description, audience policy, colour mode, unit, up axis, credit
+ * line and licence, follow the ingest jobs (polled from /api/jobs, so they
+ * resume after a reload; failures show the importer's message), and per
+ * model list versions, withdraw or restore one, set its good-enough level
+ * and change its credit and licence. Plain HTML controls with labels; the
  * status lines are live regions.
  */
 
@@ -13,6 +14,12 @@ import * as api from './api.js';
 
 const POLICIES = ['exhibition', 'open', 'researchers', 'open-download', 'exhibition-download'];
 const COLOURS = [['', 'default (ccc for a textured scan)'], ['ccc', 'ccc'], ['vertex', 'vertex'], ['vertex-metric', 'vertex-metric'], ['none', 'none']];
+const UNITS = [['', 'unknown'], ['mm', 'mm'], ['cm', 'cm'], ['m', 'm'], ['in', 'in']];
+const UP_AXES = [['', 'detect'], ...['x', 'y', 'z', '-x', '-y', '-z'].map((a) => [a, a])];
+/** The server's limit on a credit line, in bytes (maxlength counts characters: the server has the last word). */
+const CREDIT_MAX = 300;
+/** Form fields sent only when set: the server's defaults apply otherwise. */
+const OPTIONAL_FIELDS = ['colour', 'unit', 'up', 'credit', 'licence'];
 const STYLE = `
 .admin { max-width: 60rem; margin: 0 auto; padding: 1rem; line-height: 1.5; }
 .admin section { margin: 1.5rem 0; }
@@ -23,6 +30,7 @@ const STYLE = `
 .admin .jobs li, .admin .versions li { margin: 0.4rem 0; }
 .admin .error { color: #b00020; }
 .admin progress { width: 10rem; vertical-align: middle; }
+.admin .rights { margin: 0.3rem 0 0 1rem; }
 `;
 
 /**
@@ -41,6 +49,24 @@ function el(tag, attributes = {}, children = []) {
 function field(id, text, control) {
   control.id = id;
   return el('div', {}, [el('label', { for: id }, [text]), control]);
+}
+
+/**
+ * A select of the licences, first "— not stated —" (empty).
+ * @param {Record<string, string>} attributes
+ * @param {api.Licence[]} licences
+ * @param {string | null} [selected] a licence id
+ */
+function licenceSelect(attributes, licences, selected = null) {
+  const select = /** @type {HTMLSelectElement} */ (el('select', attributes, [el('option', { value: '' }, ['— not stated —'])]));
+  addLicences(select, licences);
+  select.value = selected ?? '';
+  return select;
+}
+
+/** @param {HTMLSelectElement} select @param {api.Licence[]} licences */
+function addLicences(select, licences) {
+  select.append(...licences.map((l) => el('option', { value: l.id }, [l.name])));
 }
 
 /** @param {unknown} e */
@@ -67,6 +93,13 @@ export class AdminPage {
     this.modelList = el('ul', { class: 'models-admin' });
     /** @type {ReturnType<typeof setTimeout> | undefined} */
     this.timer = undefined;
+    /** The models listed last (slugs and titles), so a refresh that finds the same leaves the list alone. */
+    this.modelsKey = '';
+    /** `GET /api/licences` (public), asked once; an empty list when it fails (the upload says why). */
+    this.licences = api.licences().catch((e) => {
+      this.uploadStatus.textContent = `Licences: ${messageOf(e)}`;
+      return /** @type {api.Licence[]} */ ([]);
+    });
     this.form = this.uploadForm();
     main.replaceChildren(
       el('div', { class: 'admin' }, [
@@ -97,6 +130,10 @@ export class AdminPage {
     const form = /** @type {HTMLFormElement} */ (el('form', { 'aria-label': 'Upload a scan' }));
     const policy = el('select', { name: 'policy' }, POLICIES.map((p) => el('option', { value: p }, [p])));
     const colour = el('select', { name: 'colour' }, COLOURS.map(([v, t]) => el('option', { value: v }, [t])));
+    const unit = el('select', { name: 'unit' }, UNITS.map(([v, t]) => el('option', { value: v }, [t])));
+    const up = el('select', { name: 'up' }, UP_AXES.map(([v, t]) => el('option', { value: v }, [t])));
+    const licence = licenceSelect({ name: 'licence' }, []);
+    void this.licences.then((list) => addLicences(licence, list));
     form.append(
       field('file', 'Scan (PLY, OBJ, OFF, GLB, glTF, MD2)', el('input', { type: 'file', name: 'file', required: '', accept: '.ply,.obj,.off,.glb,.gltf,.md2' })),
       field('slug', 'Slug (a-z, 0-9, -)', el('input', { type: 'text', name: 'slug', required: '', pattern: '[a-z0-9]([a-z0-9-]{0,62}[a-z0-9])?' })),
@@ -104,6 +141,10 @@ export class AdminPage {
       field('description', 'Description', el('textarea', { name: 'description', rows: '3' })),
       field('policy', 'Audience policy', policy),
       field('colour', 'Colour mode', colour),
+      field('unit', 'Unit of the coordinates', unit),
+      field('up', 'Up axis', up),
+      field('credit', 'Credit line (shown under the model)', el('input', { type: 'text', name: 'credit', maxlength: String(CREDIT_MAX) })),
+      field('licence', 'Licence', licence),
       this.button('Upload', () => {}, 'submit'),
     );
     form.addEventListener('submit', (event) => {
@@ -116,7 +157,7 @@ export class AdminPage {
   /** @param {HTMLFormElement} form */
   async submit(form) {
     const data = new FormData(form);
-    if (data.get('colour') === '') data.delete('colour');
+    for (const name of OPTIONAL_FIELDS) if (String(data.get(name) ?? '').trim() === '') data.delete(name);
     this.uploadStatus.textContent = 'Uploading…';
     try {
       const { job } = await api.upload(data);
@@ -182,6 +223,16 @@ export class AdminPage {
   async showModels() {
     try {
       const models = await api.models();
+      // The same models: only the open version lists are read again (a new version, a status).
+      const key = JSON.stringify(models.map((m) => [m.slug, m.title]));
+      if (key === this.modelsKey) {
+        for (const item of this.modelList.querySelectorAll('li[data-open]')) {
+          const list = /** @type {HTMLElement} */ (item.querySelector('ul.versions'));
+          void this.showVersions(/** @type {HTMLElement} */ (item), String(item.getAttribute('data-slug')), list, { poll: true });
+        }
+        return;
+      }
+      this.modelsKey = key;
       const open = new Set(
         [...this.modelList.querySelectorAll('li[data-open]')].map((li) => li.getAttribute('data-slug')),
       );
@@ -199,29 +250,37 @@ export class AdminPage {
         }),
       );
     } catch (e) {
+      this.modelsKey = '';
       this.modelList.replaceChildren(el('li', { class: 'error' }, [`Models: ${messageOf(e)}`]));
     }
   }
 
-  /** @param {HTMLElement} item @param {string} slug @param {HTMLElement} list */
-  async showVersions(item, slug, list) {
+  /**
+   * @param {HTMLElement} item @param {string} slug @param {HTMLElement} list
+   * @param {{ poll?: boolean }} [options] `poll`: the page's own refresh, which leaves a version a curator is editing alone
+   */
+  async showVersions(item, slug, list, { poll = false } = {}) {
     item.setAttribute('data-open', '');
     try {
-      const versions = await api.versions(slug);
-      list.replaceChildren(...versions.map((v) => this.versionItem(slug, v, list, item)));
+      const [versions, licences] = await Promise.all([api.versions(slug), this.licences]);
+      if (poll && list.querySelector('[data-editing]')) return;
+      list.replaceChildren(...versions.map((v) => this.versionItem(slug, v, list, item, licences)));
     } catch (e) {
       list.replaceChildren(el('li', { class: 'error' }, [messageOf(e)]));
     }
   }
 
-  /** @param {string} slug @param {api.Version} v @param {HTMLElement} list @param {HTMLElement} item */
-  versionItem(slug, v, list, item) {
+  /**
+   * @param {string} slug @param {api.Version} v @param {HTMLElement} list @param {HTMLElement} item
+   * @param {api.Licence[]} licences
+   */
+  versionItem(slug, v, list, item, licences) {
     const id = `level-${slug}-${v.version}`;
     const level = /** @type {HTMLInputElement} */ (
       el('input', { type: 'number', id, min: '0', max: String(v.levels - 1), value: v.good_enough_level === null ? '' : String(v.good_enough_level) })
     );
     const status = el('span', { role: 'status' });
-    /** @param {{ status?: string, good_enough_level?: number | null }} change */
+    /** @param {api.VersionChange} change */
     const apply = async (change) => {
       try {
         await api.changeVersion(slug, v.version, change);
@@ -231,13 +290,48 @@ export class AdminPage {
       }
     };
     const withdraw = v.status === 'ready' ? 'Withdraw' : 'Restore';
-    return el('li', { 'data-version': String(v.version) }, [
+    const entry = el('li', { 'data-version': String(v.version) }, [
       `Version ${v.version} (${v.status}, ${v.levels} levels, ${v.policy}) `,
       this.button(`${withdraw} version ${v.version}`, () => apply({ status: v.status === 'ready' ? 'withdrawn' : 'ready' })),
       el('label', { for: id }, [`Good-enough level (empty: the 20 % rule)`]),
       level,
       this.button('Set level', () => apply({ good_enough_level: level.value === '' ? null : Number(level.value) })),
       status,
+      this.rightsForm(slug, v, licences, apply),
     ]);
+    const editing = () => entry.setAttribute('data-editing', '');
+    entry.addEventListener('input', editing);
+    entry.addEventListener('change', editing);
+    return entry;
+  }
+
+  /**
+   * A version's credit and licence as recorded, and a form to change them
+   * (empty clears). The server's message shows in the version's status line.
+   * @param {string} slug @param {api.Version} v @param {api.Licence[]} licences
+   * @param {(change: api.VersionChange) => Promise<void>} apply
+   */
+  rightsForm(slug, v, licences, apply) {
+    const name = licences.find((l) => l.id === v.licence)?.name ?? v.licence;
+    const credit = /** @type {HTMLInputElement} */ (
+      el('input', { type: 'text', id: `credit-${slug}-${v.version}`, maxlength: String(CREDIT_MAX) })
+    );
+    credit.value = v.credit ?? '';
+    const licence = licenceSelect({ id: `licence-${slug}-${v.version}` }, licences, v.licence ?? null);
+    const form = /** @type {HTMLFormElement} */ (
+      el('form', { class: 'rights', 'aria-label': `Credit and licence of version ${v.version}` }, [
+        el('p', { class: 'rights-now' }, [`Credit: ${v.credit ?? 'not stated'} · Licence: ${name ?? 'not stated'}`]),
+        el('label', { for: credit.id }, [`Credit line of version ${v.version}`]),
+        credit,
+        el('label', { for: licence.id }, [`Licence of version ${v.version}`]),
+        licence,
+        this.button(`Save credit and licence of version ${v.version}`, () => {}, 'submit'),
+      ])
+    );
+    form.addEventListener('submit', (event) => {
+      event.preventDefault();
+      void apply({ credit: credit.value.trim(), licence: licence.value });
+    });
+    return form;
   }
 }
