@@ -57,12 +57,13 @@ button[aria-pressed="true"] { background: #5e81ac; border-color: #81a1c1; }
 .status > * { max-width: 100%; }
 .credit { flex: 1 1 14rem; min-width: 0; max-width: 100%; display: flex; justify-content: flex-end; pointer-events: none; }
 /* Attribution: small, but 4.5:1 or better (the link 5.6:1) on its backing even over white. */
-.credit-line { display: flex; flex-wrap: wrap; align-items: baseline; gap: 0 0.4em; min-width: 0; max-width: 36rem;
+.credit-line { display: inline-block; min-width: 0; max-width: 36rem;
   padding: 2px 8px; border-radius: 4px; background: rgba(20, 22, 26, 0.85); color: #d8dee9; font-size: 12px;
   line-height: 1.4; pointer-events: auto; }
-/* The licence beside the credit where the credit keeps 12rem, else on a line of its own. */
-.credit-text { flex: 1 1 12rem; min-width: 0; overflow-wrap: anywhere; }
-.credit-licence { flex: 0 1 auto; min-width: 0; overflow-wrap: anywhere; }
+/* One line of running text where it fits ("Scan: … · CC BY 4.0"); a long credit wraps, and
+   the licence (with its separator) moves whole to the next line. */
+.credit-text { overflow-wrap: anywhere; }
+.credit-licence { white-space: nowrap; }
 .credit a { color: #8fbcbb; text-underline-offset: 2px; }
 .credit a:focus-visible { outline: 2px solid #88c0d0; outline-offset: 1px; }
 /* Small views: a long credit keeps to two lines (all of it on hover, in its title, and while
@@ -70,6 +71,7 @@ button[aria-pressed="true"] { background: #5e81ac; border-color: #81a1c1; }
 @media (max-width: 480px), (max-height: 480px) {
   .credit:not(:focus-within) .credit-text { display: -webkit-box; -webkit-box-orient: vertical; -webkit-line-clamp: 2;
     line-clamp: 2; overflow: hidden; }
+  .credit:not(:focus-within) .credit-separator { display: none; }
 }
 .notice { background: rgba(94, 72, 20, 0.88); border: 1px solid #ebcb8b; }
 .colour { font-size: 12px; color: #cfd5de; }
@@ -283,7 +285,14 @@ export class ViewerUi {
     if (line.licence) {
       const licence = document.createElement('span');
       licence.className = 'credit-licence';
-      if (line.credit) licence.append(' · ');
+      if (line.credit) {
+        // Its own span: where the credit is clamped to lines of its own (small views), the
+        // licence starts a line, and no separator leads it.
+        const separator = document.createElement('span');
+        separator.className = 'credit-separator';
+        separator.textContent = ' · ';
+        licence.append(separator);
+      }
       if (line.licence.href) {
         const link = document.createElement('a');
         link.href = line.licence.href;
