@@ -34,6 +34,30 @@ fn glb_json(glb: &[u8]) -> Value {
     serde_json::from_slice(&glb[20..20 + len]).unwrap()
 }
 
+/// The body of `GET url` as text.
+async fn text(http: &reqwest::Client, url: &str) -> String {
+    http.get(url).send().await.unwrap().text().await.unwrap()
+}
+
+/// The body of `GET url` as JSON, with a token when given.
+async fn json_of(http: &reqwest::Client, url: &str, token: Option<&str>) -> Value {
+    let mut request = http.get(url);
+    if let Some(token) = token {
+        request = request.bearer_auth(token);
+    }
+    request.send().await.unwrap().json().await.unwrap()
+}
+
+/// `PUT url` with a curator's JSON body.
+async fn put(http: &reqwest::Client, url: &str, token: &str, body: &Value) -> reqwest::Response {
+    http.put(url)
+        .bearer_auth(token)
+        .json(body)
+        .send()
+        .await
+        .unwrap()
+}
+
 fn extent(mesh: &vitrine_codec::IndexedMesh, axis: usize) -> f64 {
     let values = mesh.positions.iter().map(|p| f64::from(p[axis]));
     values.clone().fold(f64::MIN, f64::max) - values.fold(f64::MAX, f64::min)
@@ -82,14 +106,7 @@ pub async fn rights_served_and_carried(db: TestDb) {
 
     // The model page: a license link and schema.org JSON-LD whose strings
     // cannot close the script element.
-    let page = http
-        .get(server.url("/m/stele"))
-        .send()
-        .await
-        .unwrap()
-        .text()
-        .await
-        .unwrap();
+    let page = text(&http, &server.url("/m/stele")).await;
     assert!(
         page.contains(&format!("<link rel=\"license\" href=\"{CC_BY}\">")),
         "{page}"
@@ -108,14 +125,7 @@ pub async fn rights_served_and_carried(db: TestDb) {
         .as_str()
         .unwrap()
         .ends_with("/api/models/stele/download.glb"));
-    let plain_page = http
-        .get(server.url("/m/plain"))
-        .send()
-        .await
-        .unwrap()
-        .text()
-        .await
-        .unwrap();
+    let plain_page = text(&http, &server.url("/m/plain")).await;
     assert!(!plain_page.contains("rel=\"license\""));
     assert!(
         !plain_page.contains("\"encoding\""),
@@ -180,13 +190,8 @@ pub async fn rights_served_and_carried(db: TestDb) {
     // A curator changes the licence only: the credit stays, the manifest
     // and the download follow, and the download's ETag changes.
     let version = server.url("/api/admin/models/stele/versions/1");
-    let changed: Value = http
-        .put(&version)
-        .bearer_auth(&curator)
-        .json(&json!({ "licence": "CC0-1.0" }))
-        .send()
+    let changed: Value = put(&http, &version, &curator, &json!({ "licence": "CC0-1.0" }))
         .await
-        .unwrap()
         .json()
         .await
         .unwrap();
@@ -208,16 +213,16 @@ pub async fn rights_served_and_carried(db: TestDb) {
         .unwrap()
         .contains("publicdomain/zero/1.0"));
     // Clearing both: no copyright at all.
-    let cleared: Value = http
-        .put(&version)
-        .bearer_auth(&curator)
-        .json(&json!({ "licence": null, "credit": "" }))
-        .send()
-        .await
-        .unwrap()
-        .json()
-        .await
-        .unwrap();
+    let cleared: Value = put(
+        &http,
+        &version,
+        &curator,
+        &json!({ "licence": null, "credit": "" }),
+    )
+    .await
+    .json()
+    .await
+    .unwrap();
     assert_eq!(cleared["licence"], Value::Null);
     assert_eq!(cleared["credit"], Value::Null);
     let doc = glb_json(&http.get(&url).send().await.unwrap().bytes().await.unwrap());
@@ -238,22 +243,11 @@ pub async fn rights_served_and_carried(db: TestDb) {
             StatusCode::UNPROCESSABLE_ENTITY,
         ),
     ] {
-        let reply = http
-            .put(&version)
-            .bearer_auth(&curator)
-            .json(&body)
-            .send()
-            .await
-            .unwrap();
+        let reply = put(&http, &version, &curator, &body).await;
         assert_eq!(reply.status(), status, "{body}");
     }
-    let unknown: Value = http
-        .put(&version)
-        .bearer_auth(&curator)
-        .json(&json!({ "licence": "CC-BY" }))
-        .send()
+    let unknown: Value = put(&http, &version, &curator, &json!({ "licence": "CC-BY" }))
         .await
-        .unwrap()
         .json()
         .await
         .unwrap();
@@ -262,13 +256,7 @@ pub async fn rights_served_and_carried(db: TestDb) {
         "{unknown}"
     );
     let researcher = token(&db, TokenScope::Researcher, None).await;
-    let refused = http
-        .put(&version)
-        .bearer_auth(&researcher)
-        .json(&json!({ "licence": "InC" }))
-        .send()
-        .await
-        .unwrap();
+    let refused = put(&http, &version, &researcher, &json!({ "licence": "InC" })).await;
     assert_eq!(refused.status(), StatusCode::FORBIDDEN);
     let manifest = get_json("/api/models/stele").await;
     assert_eq!(
@@ -314,15 +302,7 @@ pub async fn rights_and_placement_through_uploads(db: TestDb) {
         let body: Value = reply.json().await.unwrap();
         assert!(body["message"].as_str().unwrap().contains(says), "{body}");
     }
-    let jobs: Value = http
-        .get(server.url("/api/jobs"))
-        .bearer_auth(&curator)
-        .send()
-        .await
-        .unwrap()
-        .json()
-        .await
-        .unwrap();
+    let jobs: Value = json_of(&http, &server.url("/api/jobs"), Some(&curator)).await;
     assert_eq!(jobs["jobs"], json!([]), "refused forms start no job");
 
     let reply = with(&[
@@ -338,14 +318,7 @@ pub async fn rights_and_placement_through_uploads(db: TestDb) {
     let status = server.url(accepted["status_url"].as_str().unwrap());
     let done = job_until_finished(&http, &status, &curator).await;
     assert_eq!(done["state"], "done", "{done}");
-    let manifest: Value = http
-        .get(server.url("/api/models/vase"))
-        .send()
-        .await
-        .unwrap()
-        .json()
-        .await
-        .unwrap();
+    let manifest: Value = json_of(&http, &server.url("/api/models/vase"), None).await;
     assert_eq!(manifest["unit"], "cm");
     assert_eq!(manifest["up"], "-z");
     assert_eq!(
@@ -378,14 +351,7 @@ pub async fn oembed_for_pasted_links(db: TestDb) {
     let ask = |query: &[(&str, &str)]| http.get(server.url("/api/oembed")).query(query).send();
 
     // Discovery: the page's link, followed as a CMS would.
-    let page = http
-        .get(server.url("/m/stele"))
-        .send()
-        .await
-        .unwrap()
-        .text()
-        .await
-        .unwrap();
+    let page = text(&http, &server.url("/m/stele")).await;
     let marker = "type=\"application/json+oembed\" href=\"";
     let href = &page[page.find(marker).unwrap() + marker.len()..];
     let href = href[..href.find('"').unwrap()].replace("&amp;", "&");
@@ -506,14 +472,7 @@ pub async fn crawlers_find_public_models(db: TestDb) {
         2,
         "{xml}"
     );
-    let robots = http
-        .get(server.url("/robots.txt"))
-        .send()
-        .await
-        .unwrap()
-        .text()
-        .await
-        .unwrap();
+    let robots = text(&http, &server.url("/robots.txt")).await;
     for line in [
         "Disallow: /admin",
         "Disallow: /study/",
