@@ -31,6 +31,7 @@ before(async () => {
       torus('credited', 'Credited torus', ['--credit', 'Scan: Test Museum', '--licence', 'CC-BY-4.0']),
       torus('plain', 'Plain torus'),
       torus('markup', 'Markup torus', ['--credit', MARKUP]),
+      { ...torus('shared', 'Shared torus', ['--licence', 'CC0-1.0']), policy: 'open-download' },
     ],
   });
   browser = await launch({ width: 640, height: 480 });
@@ -175,4 +176,33 @@ test('a snapshot carries the title, the credit and licence, and the model page i
   );
   assert.deepEqual([...problems, ...plain.problems], []);
   await plain.page.close();
+});
+
+test('where the policy offers downloads, the line offers the GLB of the level the visitor may take', async () => {
+  const { page, problems } = await open(`${service.url}/m/shared`);
+  const seen = await page.evaluate(() => {
+    const credit = /** @type {HTMLElement} */ (document.querySelector('vitrine-viewer')?.shadowRoot?.querySelector('.credit'));
+    const link = /** @type {HTMLAnchorElement | null} */ (credit.querySelector('.credit-download a'));
+    return { text: credit.textContent, href: link?.href ?? null, download: link?.hasAttribute('download') ?? false };
+  });
+  const manifest = await (await fetch(`${service.url}/api/models/shared`)).json();
+  assert.equal(manifest.download.level, manifest.cap.level);
+  assert.match(seen.text ?? '', /^CC0 1\.0 Universal · Download GLB, [\d.]+ (KB|MB)$/);
+  assert.ok(seen.download, 'a download link');
+  assert.equal(seen.href, new URL(manifest.download.url, service.url).href);
+  // What the link fetches is the GLB the line announced, of about that size.
+  const file = await page.evaluate(async (href) => {
+    const response = await fetch(/** @type {string} */ (href));
+    const bytes = new Uint8Array(await response.arrayBuffer());
+    return { status: response.status, magic: String.fromCharCode(...bytes.subarray(0, 4)), length: bytes.length };
+  }, seen.href);
+  assert.equal(file.status, 200);
+  assert.equal(file.magic, 'glTF');
+  assert.ok(manifest.download.bytes >= file.length && manifest.download.bytes - file.length < 2048, `${manifest.download.bytes} for ${file.length}`);
+  // No policy, no link: the credited model's line has none.
+  const other = await open(`${service.url}/m/credited`);
+  assert.equal(await other.page.evaluate(() => document.querySelector('vitrine-viewer')?.shadowRoot?.querySelector('.credit-download') ?? null), null);
+  assert.deepEqual(problems, []);
+  await page.close();
+  await other.page.close();
 });

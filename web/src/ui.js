@@ -63,7 +63,7 @@ button[aria-pressed="true"] { background: #5e81ac; border-color: #81a1c1; }
 /* One line of running text where it fits ("Scan: … · CC BY 4.0"); a long credit wraps, and
    the licence (with its separator) moves whole to the next line. */
 .credit-text { overflow-wrap: anywhere; }
-.credit-licence { white-space: nowrap; }
+.credit-licence, .credit-download { white-space: nowrap; }
 .credit a { color: #8fbcbb; text-underline-offset: 2px; }
 .credit a:focus-visible { outline: 2px solid #88c0d0; outline-offset: 1px; }
 /* Small views: a long credit keeps to two lines (all of it on hover, in its title, and while
@@ -71,7 +71,7 @@ button[aria-pressed="true"] { background: #5e81ac; border-color: #81a1c1; }
 @media (max-width: 480px), (max-height: 480px) {
   .credit:not(:focus-within) .credit-text { display: -webkit-box; -webkit-box-orient: vertical; -webkit-line-clamp: 2;
     line-clamp: 2; overflow: hidden; }
-  .credit:not(:focus-within) .credit-separator { display: none; }
+  .credit:not(:focus-within) .credit-text + * > .credit-separator { display: none; }
 }
 .notice { background: rgba(94, 72, 20, 0.88); border: 1px solid #ebcb8b; }
 .colour { font-size: 12px; color: #cfd5de; }
@@ -263,36 +263,42 @@ export class ViewerUi {
   }
 
   /**
-   * The credit line: the credit as typed and the licence's name linked to
-   * its deed; hidden when the manifest records neither. Curators type
-   * these, so they go in as text nodes, never markup.
+   * The credit line: the credit as typed, the licence's name linked to its
+   * deed, and the GLB download where the policy offers one; hidden when
+   * there is none of them. Curators type the credit and the licence comes
+   * from the server, so they go in as text nodes, never markup.
    * @param {Partial<import('./rights.js').Rights> | null | undefined} rights
+   * @param {{ href: string, bytes: number } | null} [download] the level this visitor may take
    */
-  setRights(rights) {
+  setRights(rights, download = null) {
     const line = creditLine(rights);
     this.credit.replaceChildren();
-    this.credit.hidden = line === null;
-    if (!line) return;
+    this.credit.hidden = line === null && !download;
+    if (this.credit.hidden) return;
     const box = document.createElement('span');
     box.className = 'credit-line';
-    if (line.credit) {
-      const text = document.createElement('span');
-      text.className = 'credit-text';
-      text.textContent = line.credit;
-      text.title = line.credit;
-      box.append(text);
-    }
-    if (line.licence) {
-      const licence = document.createElement('span');
-      licence.className = 'credit-licence';
-      if (line.credit) {
-        // Its own span: where the credit is clamped to lines of its own (small views), the
-        // licence starts a line, and no separator leads it.
+    /** A part after the first, led by a separator in a span of its own: where the credit is
+     * clamped to lines of its own (small views), the next part starts a line, and no
+     * separator leads it. @param {string} className */
+    const part = (className) => {
+      const span = document.createElement('span');
+      span.className = className;
+      if (box.childElementCount > 0) {
         const separator = document.createElement('span');
         separator.className = 'credit-separator';
         separator.textContent = ' · ';
-        licence.append(separator);
+        span.append(separator);
       }
+      box.append(span);
+      return span;
+    };
+    if (line?.credit) {
+      const text = part('credit-text');
+      text.textContent = line.credit;
+      text.title = line.credit;
+    }
+    if (line?.licence) {
+      const licence = part('credit-licence');
       if (line.licence.href) {
         const link = document.createElement('a');
         link.href = line.licence.href;
@@ -303,7 +309,14 @@ export class ViewerUi {
       } else {
         licence.append(line.licence.name);
       }
-      box.append(licence);
+    }
+    if (download) {
+      const link = document.createElement('a');
+      link.href = download.href;
+      link.download = '';
+      link.textContent = `Download GLB, ${formatBytes(download.bytes)}`;
+      link.title = 'This level as one glTF file, for AR viewers and 3D tools';
+      part('credit-download').append(link);
     }
     this.credit.append(box);
   }

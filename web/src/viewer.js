@@ -61,6 +61,7 @@ import { PointModel } from './splats/point-model.js';
  * @property {'mesh' | 'points'} [kind] a point cloud's levels are prefixes of a point stream (splats/point-model.js)
  * @property {number} [stream_format] 5: a charted stream, whose charts a pool of workers refines
  * @property {import('./rights.js').Rights} [rights] credit line and licence (absent from older servers)
+ * @property {{ url: string, level: number, bytes: number } | null} [download] a GLB of the level this visitor may take, where the policy offers one
  */
 
 /**
@@ -561,7 +562,7 @@ export class Viewer {
     this.points?.destroy();
     this.points = null;
     this.ui.setDetails(manifest.title, manifest.description);
-    this.ui.setRights(manifest.rights);
+    this.ui.setRights(manifest.rights, this.#download(manifest));
     this.ui.setQuality(manifest.quality ?? null);
     this.#look = { ...this.#look, model: upRotation(manifest.up), bounds: validBounds(manifest.bounds, null) };
     this.annotations.load();
@@ -945,6 +946,18 @@ export class Viewer {
       const detail = body?.message ?? body?.error ?? response.statusText;
       throw new Error(`the server answered ${response.status} for this model (${detail})`);
     }
+  }
+
+  /**
+   * The GLB the manifest offers this visitor, with the visitor's `token`
+   * and `device` as every API request has them; null when none is offered.
+   * @param {Manifest} manifest
+   * @returns {{ href: string, bytes: number } | null}
+   */
+  #download(manifest) {
+    const d = manifest.download;
+    if (!d || typeof d.url !== 'string' || !Number.isFinite(d.bytes)) return null;
+    return { href: this.#apiUrl(d.url), bytes: d.bytes };
   }
 
   /** @param {string} path relative to the manifest's URL */

@@ -58,6 +58,21 @@ pub struct Manifest<'a> {
     /// Who made the scan and on what terms it may be reused: the viewer
     /// shows them under the model.
     rights: ManifestRights<'a>,
+    /// Where the policy lets this visitor download a mesh level as GLB:
+    /// the level the cap allows now. Null otherwise (no downloads under the
+    /// policy, or a point cloud).
+    download: Option<ManifestDownload>,
+}
+
+#[derive(Serialize, ToSchema)]
+struct ManifestDownload {
+    /// `/api/models/{slug}/download.glb?level={level}`; add the viewer's
+    /// `token` and `device` as for every API request.
+    url: String,
+    /// The level the file holds (this visitor's cap now).
+    level: u32,
+    /// Size of the file within a few kilobytes (its binary chunk exactly).
+    bytes: u64,
 }
 
 #[derive(Serialize, ToSchema)]
@@ -276,8 +291,30 @@ pub fn build<'a>(
             credit: record.curation.rights.credit.as_deref(),
             licence: record.curation.rights.licence,
         },
+        download: download(record, cap.level),
     }
 }
+
+/// The GLB a visitor may take: the capped level, sized as
+/// `vitrine_mesh::export::write_glb` lays it out (12 bytes a position, a
+/// triangle and a colour) plus its JSON chunk's allowance.
+fn download(record: &ModelRecord, level: u32) -> Option<ManifestDownload> {
+    if !record.policy.downloads || record.kind != ModelKind::Mesh {
+        return None;
+    }
+    let l = record.levels.get(level as usize)?;
+    let vertices = u64::from(l.vertices);
+    let colour = if record.has_colour { 12 * vertices } else { 0 };
+    Some(ManifestDownload {
+        url: format!("/api/models/{}/download.glb?level={level}", record.slug),
+        level,
+        bytes: 12 * vertices + 12 * u64::from(l.faces) + colour + GLB_JSON_ALLOWANCE,
+    })
+}
+
+/// About what a download's JSON chunk and headers take (the accessors,
+/// names, rights and the XMP packet): 1–2 KB.
+const GLB_JSON_ALLOWANCE: u64 = 2048;
 
 fn levels(record: &ModelRecord, cap: LevelCap) -> Vec<ManifestLevel> {
     let id = record.compression_id;

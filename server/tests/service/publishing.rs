@@ -40,8 +40,8 @@ async fn text(http: &reqwest::Client, url: &str) -> String {
 }
 
 /// The body of `GET url` as JSON, with a token when given.
-async fn json_of(http: &reqwest::Client, url: &str, token: Option<&str>) -> Value {
-    let mut request = http.get(url);
+async fn json_of(http: &reqwest::Client, url: impl AsRef<str>, token: Option<&str>) -> Value {
+    let mut request = http.get(url.as_ref());
     if let Some(token) = token {
         request = request.bearer_auth(token);
     }
@@ -81,10 +81,7 @@ pub async fn rights_served_and_carried(db: TestDb) {
     let curator = token(&db, TokenScope::Curator, None).await;
     let server = TestServer::start(db.storage.clone(), test_config()).await;
     let http = reqwest::Client::new();
-    let get_json = |path: &str| {
-        let request = http.get(server.url(path));
-        async move { request.send().await.unwrap().json::<Value>().await.unwrap() }
-    };
+    let get_json = |path: &str| json_of(&http, server.url(path), None);
 
     // The manifest.
     let manifest = get_json("/api/models/stele").await;
@@ -95,6 +92,7 @@ pub async fn rights_served_and_carried(db: TestDb) {
     );
     let plain = get_json("/api/models/plain").await;
     assert_eq!(plain["rights"], json!({ "credit": null, "licence": null }));
+    assert_eq!(plain["download"], Value::Null, "no downloads under `open`");
     let licences = get_json("/api/licences").await;
     let ids: Vec<&str> = licences["licences"]
         .as_array()
@@ -134,12 +132,18 @@ pub async fn rights_served_and_carried(db: TestDb) {
 
     // The download: credit and deed in `asset.copyright` and the XMP
     // packet; a node that stands the stele up (+Y) in metres.
+    // The manifest offers it: this visitor's cap, the last level here.
     let last = report.levels - 1;
-    let url = server.url(&format!("/api/models/stele/download.glb?level={last}"));
+    let offered = &manifest["download"];
+    assert_eq!(offered["level"], last);
+    let url = server.url(offered["url"].as_str().unwrap());
+    assert_eq!(url, server.url(&format!("/api/models/stele/download.glb?level={last}")));
     let reply = http.get(&url).send().await.unwrap();
     assert_eq!(reply.status(), StatusCode::OK);
     let etag = reply.headers()["etag"].to_str().unwrap().to_owned();
     let glb = reply.bytes().await.unwrap();
+    let said = offered["bytes"].as_u64().unwrap();
+    assert!(said >= glb.len() as u64 && said - (glb.len() as u64) < 2048, "{said} for {}", glb.len());
     let doc = glb_json(&glb);
     let copyright = doc["asset"]["copyright"].as_str().unwrap();
     assert!(
