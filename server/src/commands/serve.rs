@@ -61,6 +61,10 @@ pub struct ServeArgs {
     /// `https://museum.example`; default: the request's Host.
     #[arg(long, env = "VITRINE_PUBLIC_BASE_URL")]
     pub public_base_url: Option<String>,
+    /// The museum's name where other sites show its links (oEmbed's
+    /// `provider_name`, `og:site_name`), e.g. "Museo Nacional".
+    #[arg(long, env = "VITRINE_SITE_NAME", default_value = "Vitrine")]
+    pub site_name: String,
 
     #[arg(long, env = "VITRINE_DB_MAX_CONNECTIONS", default_value_t = 16)]
     pub db_max_connections: u32,
@@ -213,6 +217,7 @@ impl ServeArgs {
                 public_base_url: self.public_base_url.clone(),
             },
             trusted_proxies: self.trusted_proxies.clone(),
+            site_name: self.site_name.clone(),
         }
     }
 

@@ -65,6 +65,9 @@ pub struct ServiceConfig {
     /// Proxies whose `X-Forwarded-For` / `Forwarded` names the visitor
     /// ([`client_address`]); empty: none is believed.
     pub trusted_proxies: Vec<ipnet::IpNet>,
+    /// The museum's name as sites that show its links give it: oEmbed's
+    /// `provider_name`, the model page's `og:site_name`.
+    pub site_name: String,
 }
 
 impl Default for ServiceConfig {
@@ -79,6 +82,7 @@ impl Default for ServiceConfig {
             cors_origins: Vec::new(),
             uploads: curator::UploadConfig::default(),
             trusted_proxies: Vec::new(),
+            site_name: "Vitrine".into(),
         }
     }
 }

@@ -47,7 +47,8 @@ pub struct Oembed {
     /// The version's credit line, when recorded.
     #[serde(skip_serializing_if = "Option::is_none")]
     author_name: Option<String>,
-    provider_name: &'static str,
+    /// `--site-name`.
+    provider_name: String,
     provider_url: String,
     /// Seconds a consumer may keep this answer.
     cache_age: u32,
@@ -95,7 +96,8 @@ pub async fn oembed(
     let model = ServableModel::decide(&state, record, &public).await?;
     let base = public_base(&state, &headers);
     let (width, height) = fit(query.maxwidth, query.maxheight);
-    let mut response = Json(answer(&model.record, &base, width, height)).into_response();
+    let site = state.config().site_name.clone();
+    let mut response = Json(answer(&model.record, &base, site, width, height)).into_response();
     response.headers_mut().insert(
         header::CACHE_CONTROL,
         HeaderValue::from_static("public, max-age=300"),
@@ -103,7 +105,7 @@ pub async fn oembed(
     Ok(response)
 }
 
-fn answer(record: &ModelRecord, base: &str, width: u32, height: u32) -> Oembed {
+fn answer(record: &ModelRecord, base: &str, site: String, width: u32, height: u32) -> Oembed {
     let src = format!("{base}/embed/{}", record.slug);
     let has_thumbnail = record.curation.thumbnail_sha256.is_some();
     Oembed {
@@ -111,7 +113,7 @@ fn answer(record: &ModelRecord, base: &str, width: u32, height: u32) -> Oembed {
         version: "1.0",
         title: record.title.clone(),
         author_name: record.curation.rights.credit.clone(),
-        provider_name: "Vitrine",
+        provider_name: site,
         provider_url: format!("{base}/"),
         cache_age: 300,
         html: format!(

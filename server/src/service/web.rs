@@ -188,10 +188,12 @@ pub(super) fn public_base(state: &AppState, headers: &HeaderMap) -> String {
 fn open_graph(state: &AppState, headers: &HeaderMap, record: &ModelRecord) -> String {
     let base = public_base(state, headers);
     let mut tags = format!(
-        "<meta property=\"og:type\" content=\"website\">\n\
+        "<meta property=\"og:site_name\" content=\"{}\">\n\
+         <meta property=\"og:type\" content=\"website\">\n\
          <meta property=\"og:title\" content=\"{}\">\n\
          <meta property=\"og:description\" content=\"{}\">\n\
          <meta property=\"og:url\" content=\"{}\">\n",
+        escape(&state.config().site_name),
         escape(&record.title),
         escape(&record.description),
         escape(&format!("{base}/m/{}", record.slug)),

@@ -137,13 +137,20 @@ pub async fn rights_served_and_carried(db: TestDb) {
     let offered = &manifest["download"];
     assert_eq!(offered["level"], last);
     let url = server.url(offered["url"].as_str().unwrap());
-    assert_eq!(url, server.url(&format!("/api/models/stele/download.glb?level={last}")));
+    assert_eq!(
+        url,
+        server.url(&format!("/api/models/stele/download.glb?level={last}"))
+    );
     let reply = http.get(&url).send().await.unwrap();
     assert_eq!(reply.status(), StatusCode::OK);
     let etag = reply.headers()["etag"].to_str().unwrap().to_owned();
     let glb = reply.bytes().await.unwrap();
     let said = offered["bytes"].as_u64().unwrap();
-    assert!(said >= glb.len() as u64 && said - (glb.len() as u64) < 2048, "{said} for {}", glb.len());
+    assert!(
+        said >= glb.len() as u64 && said - (glb.len() as u64) < 2048,
+        "{said} for {}",
+        glb.len()
+    );
     let doc = glb_json(&glb);
     let copyright = doc["asset"]["copyright"].as_str().unwrap();
     assert!(
@@ -350,7 +357,9 @@ pub async fn oembed_for_pasted_links(db: TestDb) {
     ingest_mesh(&*db.storage, stele(), hidden, &IngestOptions::default())
         .await
         .unwrap();
-    let server = TestServer::start(db.storage.clone(), test_config()).await;
+    let mut config = test_config();
+    config.site_name = "Museo de Prueba".into();
+    let server = TestServer::start(db.storage.clone(), config).await;
     let http = reqwest::Client::new();
     let ask = |query: &[(&str, &str)]| http.get(server.url("/api/oembed")).query(query).send();
 
@@ -368,6 +377,8 @@ pub async fn oembed_for_pasted_links(db: TestDb) {
     assert_eq!(embed["version"], "1.0");
     assert_eq!(embed["title"], "Stele \"A\" <1>");
     assert_eq!(embed["author_name"], CREDIT);
+    assert_eq!(embed["provider_name"], "Museo de Prueba", "--site-name");
+    assert!(page.contains("<meta property=\"og:site_name\" content=\"Museo de Prueba\">"));
     assert_eq!(
         (embed["width"].as_u64(), embed["height"].as_u64()),
         (Some(800), Some(600))
