@@ -1,5 +1,7 @@
 //! `vitrine models`: what a database holds, and whether this build serves
-//! it — the check to run after upgrading Vitrine, before `serve`.
+//! it — the check to run after upgrading Vitrine, before `serve` — and
+//! under which licence each model is published (a rights audit: the public
+//! models that state none are counted).
 
 use crate::database::open_storage;
 use crate::storage::{ConnectOptions, ModelSummary};
@@ -25,10 +27,11 @@ pub fn models_table(models: &[ModelSummary]) -> (String, usize) {
         .unwrap_or(4)
         .max(4);
     let mut out = format!(
-        "{:width$}  version    kind  levels  public  stream format\n",
-        "slug"
+        "{:width$}  version    kind  levels  public  {:15}  stream format\n",
+        "slug", "licence"
     );
     let mut stale = 0;
+    let mut unlicensed = 0;
     for m in models {
         let format = if m.servable() {
             m.stream_format.to_string()
@@ -41,18 +44,23 @@ pub fn models_table(models: &[ModelSummary]) -> (String, usize) {
             )
         };
         let public = if m.public_access { "yes" } else { "no" };
+        if m.public_access && m.licence.is_none() {
+            unlicensed += 1;
+        }
         let _ = writeln!(
             out,
-            "{:width$}  {:>7}  {:>6}  {:>6}  {public:>6}  {format}",
+            "{:width$}  {:>7}  {:>6}  {:>6}  {public:>6}  {:15}  {format}",
             m.slug,
             m.version,
             m.kind.name(),
-            m.batch_count + 1
+            m.batch_count + 1,
+            m.licence.as_deref().unwrap_or("-"),
         );
     }
     let _ = write!(
         out,
-        "{} model(s); {stale} stored in a stream format this build cannot serve",
+        "{} model(s); {stale} stored in a stream format this build cannot serve; \
+         {unlicensed} public without a stated licence",
         models.len()
     );
     (out, stale)

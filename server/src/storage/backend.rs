@@ -237,6 +237,7 @@ macro_rules! sql_storage {
                                 "codec_version",
                             )?,
                             has_thumbnail: row.try_get("has_thumbnail").map_err(c)?,
+                            licence: row.try_get("licence").map_err(c)?,
                         })
                     })
                     .collect()

@@ -209,6 +209,10 @@ pub struct ModelSummary {
     pub stream_format: u8,
     #[serde(skip)]
     pub has_thumbnail: bool,
+    /// The visible version's licence identifier, when stated (as stored:
+    /// `vitrine models` lists it for a rights audit).
+    #[serde(skip)]
+    pub licence: Option<String>,
 }
 
 impl ModelSummary {

@@ -78,6 +78,18 @@ pub async fn rights_served_and_carried(db: TestDb) {
     ingest_mesh(&*db.storage, stele(), plain, &IngestOptions::default())
         .await
         .unwrap();
+    // `vitrine models`: the licence of each, and the public ones without.
+    let (table, _) = vitrine::models_table(&db.storage.list_models().await.unwrap());
+    let licence_of = |slug: &str| {
+        let line = table.lines().find(|l| l.starts_with(slug)).unwrap();
+        line.split_whitespace().nth(5).unwrap().to_owned()
+    };
+    assert_eq!(licence_of("stele"), "CC-BY-4.0", "{table}");
+    assert_eq!(licence_of("plain"), "-", "{table}");
+    assert!(
+        table.ends_with("1 public without a stated licence"),
+        "{table}"
+    );
     let curator = token(&db, TokenScope::Curator, None).await;
     let server = TestServer::start(db.storage.clone(), test_config()).await;
     let http = reqwest::Client::new();
