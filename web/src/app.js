@@ -115,7 +115,9 @@ function modelPage(slug) {
     .catch(() => {});
   viewer.addEventListener('vitrine-level', () => {
     const title = /** @type {any} */ (viewer).viewer?.manifest?.title;
-    if (title) document.title = `${title} · Vitrine`;
+    // The site's name as the server states it (`--site-name`).
+    const site = document.querySelector('meta[name="application-name"]')?.getAttribute('content') || 'Vitrine';
+    if (title) document.title = `${title} · ${site}`;
   });
 }
 

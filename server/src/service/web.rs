@@ -144,6 +144,23 @@ pub async fn model_page(
     match (viewer, model) {
         (Some(html), Ok(model)) => {
             let tags = open_graph(&state, &headers, &model.record);
+            // The page's own title, as search results and tabs show it
+            // before any script runs.
+            let title = format!(
+                "<title>{} · {}</title>",
+                escape(&model.record.title),
+                escape(&state.config().site_name)
+            );
+            let html = match (html.find("<title>"), html.find("</title>")) {
+                (Some(start), Some(end)) if start < end => {
+                    format!(
+                        "{}{title}{}",
+                        &html[..start],
+                        &html[end + "</title>".len()..]
+                    )
+                }
+                _ => html,
+            };
             let html = match html.find("</head>") {
                 Some(at) => format!("{}{tags}{}", &html[..at], &html[at..]),
                 None => format!("{tags}{html}"),
@@ -188,7 +205,10 @@ pub(super) fn public_base(state: &AppState, headers: &HeaderMap) -> String {
 fn open_graph(state: &AppState, headers: &HeaderMap, record: &ModelRecord) -> String {
     let base = public_base(state, headers);
     let mut tags = format!(
-        "<meta property=\"og:site_name\" content=\"{}\">\n\
+        "<meta name=\"application-name\" content=\"{site}\">\n\
+         <meta name=\"description\" content=\"{description}\">\n\
+         <link rel=\"canonical\" href=\"{page}\">\n\
+         <meta property=\"og:site_name\" content=\"{}\">\n\
          <meta property=\"og:type\" content=\"website\">\n\
          <meta property=\"og:title\" content=\"{}\">\n\
          <meta property=\"og:description\" content=\"{}\">\n\
@@ -197,6 +217,9 @@ fn open_graph(state: &AppState, headers: &HeaderMap, record: &ModelRecord) -> St
         escape(&record.title),
         escape(&record.description),
         escape(&format!("{base}/m/{}", record.slug)),
+        site = escape(&state.config().site_name),
+        description = escape(record.description.trim()),
+        page = escape(&format!("{base}/m/{}", record.slug)),
     );
     if record.curation.thumbnail_sha256.is_some() {
         tags.push_str(&format!(

@@ -369,8 +369,16 @@ pub async fn oembed_for_pasted_links(db: TestDb) {
     ingest_mesh(&*db.storage, stele(), hidden, &IngestOptions::default())
         .await
         .unwrap();
+    // A viewer build whose page the model route fills in.
+    let web = tempfile::tempdir().unwrap();
+    std::fs::write(
+        web.path().join("index.html"),
+        "<!doctype html><html><head><title>Vitrine</title></head><body></body></html>",
+    )
+    .unwrap();
     let mut config = test_config();
     config.site_name = "Museo de Prueba".into();
+    config.web_dir = web.path().to_owned();
     let server = TestServer::start(db.storage.clone(), config).await;
     let http = reqwest::Client::new();
     let ask = |query: &[(&str, &str)]| http.get(server.url("/api/oembed")).query(query).send();
@@ -391,6 +399,17 @@ pub async fn oembed_for_pasted_links(db: TestDb) {
     assert_eq!(embed["author_name"], CREDIT);
     assert_eq!(embed["provider_name"], "Museo de Prueba", "--site-name");
     assert!(page.contains("<meta property=\"og:site_name\" content=\"Museo de Prueba\">"));
+    // The page's title, description and canonical link before any script runs.
+    assert!(
+        page.contains("<title>Stele &quot;A&quot; &lt;1&gt; · Museo de Prueba</title>")
+            && page.matches("<title>").count() == 1,
+        "{page}"
+    );
+    assert!(page.contains(&format!(
+        "<link rel=\"canonical\" href=\"{}\">",
+        server.url("/m/stele")
+    )));
+    assert!(page.contains("<meta name=\"application-name\" content=\"Museo de Prueba\">"));
     assert_eq!(
         (embed["width"].as_u64(), embed["height"].as_u64()),
         (Some(800), Some(600))
@@ -458,8 +477,14 @@ pub async fn oembed_for_pasted_links(db: TestDb) {
         let reply = ask(&query).await.unwrap();
         assert_eq!(reply.status(), status, "{query:?}");
     }
-    let hidden_page = http.get(server.url("/m/hidden")).send().await.unwrap();
-    assert_eq!(hidden_page.status(), StatusCode::NOT_FOUND);
+    // A restricted model's page is the bare viewer (which says it cannot
+    // open it): no title, tags or oEmbed link of the model.
+    let hidden_page = text(&http, &server.url("/m/hidden")).await;
+    assert!(
+        hidden_page.contains("<title>Vitrine</title>"),
+        "{hidden_page}"
+    );
+    assert!(!hidden_page.contains("oembed") && !hidden_page.contains("Hidden"));
 }
 
 /// The sitemap lists public models' pages and nothing else; robots.txt
