@@ -7,7 +7,7 @@
 use super::api::visible_models;
 use super::error::ErrorBody;
 use super::visitor::VisitorHints;
-use super::web::public_base;
+use super::web::{escape, page_url, public_base};
 use super::AppState;
 use crate::service::error::AppError;
 use axum::extract::State;
@@ -38,7 +38,7 @@ pub async fn sitemap(
     for model in visible_models(&state, &public).await? {
         xml.push_str(&format!(
             "  <url><loc>{}</loc>",
-            xml_text(&format!("{base}/m/{}", model.slug))
+            escape(&page_url(&base, &model.slug))
         ));
         if let Some(day) = chrono::DateTime::from_timestamp_millis(model.created_at_ms) {
             xml.push_str(&format!("<lastmod>{}</lastmod>", day.format("%Y-%m-%d")));
@@ -76,11 +76,4 @@ fn text(body: String, media_type: &'static str) -> Response {
         HeaderValue::from_static("public, max-age=300"),
     );
     response
-}
-
-/// Text for XML character data.
-fn xml_text(text: &str) -> String {
-    text.replace('&', "&amp;")
-        .replace('<', "&lt;")
-        .replace('>', "&gt;")
 }

@@ -15,7 +15,7 @@ use super::error::{AppError, ErrorBody, LevelCappedBody};
 use super::payload::{cache_control, level_bytes, not_modified, not_modified_response, within_cap};
 use super::servable::{ServableModel, SlugParam};
 use super::visitor::HintQuery;
-use super::web::public_base;
+use super::web::{page_url, public_base};
 use super::AppState;
 use crate::ingest::curation::metres_per_unit;
 use crate::storage::{ModelKind, ModelRecord, UpAxis};
@@ -172,19 +172,20 @@ fn document(record: &ModelRecord, base: &str) -> GlbDocument {
         },
         "dc:title": alt(&record.title),
         "dc:format": "model/gltf-binary",
-        "dc:source": format!("{base}/m/{}", record.slug),
+        "dc:source": page_url(base, &record.slug),
     });
     if !record.description.trim().is_empty() {
         xmp["dc:description"] = alt(record.description.trim());
     }
-    if let Some(notice) = rights.notice() {
-        xmp["dc:rights"] = alt(&notice);
+    let notice = rights.notice();
+    if let Some(notice) = &notice {
+        xmp["dc:rights"] = alt(notice);
     }
     if let Some(licence) = rights.licence {
         xmp["xmpRights:WebStatement"] = licence.url.into();
     }
     GlbDocument {
-        copyright: rights.notice(),
+        copyright: notice,
         name: Some(record.title.clone()),
         matrix: (!identity).then_some(matrix),
         xmp: Some(xmp),

@@ -8,7 +8,7 @@
 use super::error::{AppError, ErrorBody};
 use super::servable::ServableModel;
 use super::visitor::VisitorHints;
-use super::web::public_base;
+use super::web::{escape, public_base};
 use super::AppState;
 use crate::storage::{valid_slug, ModelRecord};
 use axum::extract::{RawQuery, State};
@@ -120,8 +120,8 @@ fn answer(record: &ModelRecord, base: &str, site: String, width: u32, height: u3
             "<iframe src=\"{}\" width=\"{width}\" height=\"{height}\" title=\"{}\" \
              style=\"border:0\" loading=\"lazy\" allow=\"fullscreen; xr-spatial-tracking\" \
              allowfullscreen></iframe>",
-            attribute(&src),
-            attribute(&record.title)
+            escape(&src),
+            escape(&record.title)
         ),
         width,
         height,
@@ -161,14 +161,6 @@ fn fit(max_width: Option<u32>, max_height: Option<u32>) -> (u32, u32) {
     }
     let width = width.max(MIN_SIDE);
     (width, (width * 3 / 4).max(MIN_SIDE))
-}
-
-/// Text for a double-quoted HTML attribute.
-fn attribute(text: &str) -> String {
-    text.replace('&', "&amp;")
-        .replace('"', "&quot;")
-        .replace('<', "&lt;")
-        .replace('>', "&gt;")
 }
 
 #[cfg(test)]

@@ -201,9 +201,15 @@ pub(super) fn public_base(state: &AppState, headers: &HeaderMap) -> String {
     format!("{scheme}://{host}")
 }
 
+/// The absolute URL of a model's page.
+pub(super) fn page_url(base: &str, slug: &str) -> String {
+    format!("{base}/m/{slug}")
+}
+
 /// `og:` meta tags of a model.
 fn open_graph(state: &AppState, headers: &HeaderMap, record: &ModelRecord) -> String {
     let base = public_base(state, headers);
+    let page = page_url(&base, &record.slug);
     let mut tags = format!(
         "<meta name=\"application-name\" content=\"{site}\">\n\
          <meta name=\"description\" content=\"{description}\">\n\
@@ -216,10 +222,10 @@ fn open_graph(state: &AppState, headers: &HeaderMap, record: &ModelRecord) -> St
         escape(&state.config().site_name),
         escape(&record.title),
         escape(&record.description),
-        escape(&format!("{base}/m/{}", record.slug)),
+        escape(&page),
         site = escape(&state.config().site_name),
         description = escape(record.description.trim()),
-        page = escape(&format!("{base}/m/{}", record.slug)),
+        page = escape(&page),
     );
     if record.curation.thumbnail_sha256.is_some() {
         tags.push_str(&format!(
@@ -234,7 +240,6 @@ fn open_graph(state: &AppState, headers: &HeaderMap, record: &ModelRecord) -> St
     // oEmbed discovery: a CMS given this page's link embeds the viewer
     // (public models only: a CMS asks without a token).
     if record.policy.public_access {
-        let page = format!("{base}/m/{}", record.slug);
         tags.push_str(&format!(
             "<link rel=\"alternate\" type=\"application/json+oembed\" href=\"{}\" title=\"{}\">\n",
             escape(&format!(
@@ -258,12 +263,11 @@ fn open_graph(state: &AppState, headers: &HeaderMap, record: &ModelRecord) -> St
 /// licence, so search engines can show them (and the GLB download, where
 /// every visitor may take it).
 fn structured_data(record: &ModelRecord, base: &str) -> String {
-    let page = format!("{base}/m/{}", record.slug);
     let mut model = json!({
         "@context": "https://schema.org",
         "@type": "3DModel",
         "name": record.title,
-        "url": page,
+        "url": page_url(base, &record.slug),
     });
     if !record.description.trim().is_empty() {
         model["description"] = record.description.trim().into();
@@ -398,7 +402,8 @@ fn page_with_head(title: &str, head: &str, body: &str) -> Response {
     response
 }
 
-fn escape(text: &str) -> String {
+/// Text for HTML (and XML) content and double- or single-quoted attributes.
+pub(super) fn escape(text: &str) -> String {
     let mut out = String::with_capacity(text.len());
     for c in text.chars() {
         match c {
