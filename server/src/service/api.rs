@@ -144,9 +144,6 @@ pub async fn licences() -> Response {
         licences: &LICENCES,
     })
     .into_response();
-    response.headers_mut().insert(
-        axum::http::header::CACHE_CONTROL,
-        axum::http::HeaderValue::from_static("public, max-age=3600"),
-    );
+    cache_headers::anonymous(&mut response, cache_headers::RELEASE);
     response
 }

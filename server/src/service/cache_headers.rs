@@ -20,6 +20,10 @@
 //! - A download (`download.glb`): named by slug, so it changes with each new
 //!   version: short-lived like a manifest, and `private, no-cache` when the
 //!   level is this visitor's cap (no `?level=`) or a token was sent.
+//! - What is the same for every visitor, token or not, because it is
+//!   answered as an anonymous visitor sees it (oEmbed, the sitemap,
+//!   robots.txt): `public, max-age=300` ([`anonymous`]); the licence list,
+//!   which changes with a release: `public, max-age=3600`.
 //! - Errors: `no-store` (`error.rs`); pages: `no-cache` (`web.rs`).
 //!
 //! Several layers (CORS, compression, these rules) name `Vary` headers; they
@@ -32,6 +36,10 @@ use axum::response::Response;
 /// A public manifest or model list: two seconds in a shared cache.
 const PUBLIC_SHORT: &str = "public, max-age=2, stale-while-revalidate=10, stale-if-error=60";
 const PERSONAL: &str = "private, no-store";
+/// What an anonymous visitor gets, whoever asks: five minutes anywhere.
+pub const ANONYMOUS: &str = "public, max-age=300";
+/// What changes only with a release of Vitrine (the licence list).
+pub const RELEASE: &str = "public, max-age=3600";
 const PERSONAL_REVALIDATE: &str = "private, no-cache";
 
 /// Whether the answer depends on who the visitor is beyond the URL.
@@ -59,6 +67,14 @@ pub fn visitor_json(response: &mut Response, hints: &VisitorHints) {
     let headers = response.headers_mut();
     headers.insert(header::CACHE_CONTROL, HeaderValue::from_static(control));
     headers.append(header::VARY, vary(hints));
+}
+
+/// An answer that is the same for every visitor (see the module's rules):
+/// `control` is [`ANONYMOUS`] or [`RELEASE`].
+pub fn anonymous(response: &mut Response, control: &'static str) {
+    response
+        .headers_mut()
+        .insert(header::CACHE_CONTROL, HeaderValue::from_static(control));
 }
 
 /// A download: `level_given` is whether `?level=` chose it (else it is the

@@ -5,6 +5,7 @@
 //! (`web.rs`), a museum's scans are found as its collection pages are.
 
 use super::api::visible_models;
+use super::cache_headers;
 use super::error::ErrorBody;
 use super::visitor::VisitorHints;
 use super::web::{escape, page_url, public_base};
@@ -69,11 +70,9 @@ pub async fn robots(State(state): State<AppState>, headers: HeaderMap) -> Respon
 
 fn text(body: String, media_type: &'static str) -> Response {
     let mut response = body.into_response();
-    let headers = response.headers_mut();
-    headers.insert(header::CONTENT_TYPE, HeaderValue::from_static(media_type));
-    headers.insert(
-        header::CACHE_CONTROL,
-        HeaderValue::from_static("public, max-age=300"),
-    );
+    response
+        .headers_mut()
+        .insert(header::CONTENT_TYPE, HeaderValue::from_static(media_type));
+    cache_headers::anonymous(&mut response, cache_headers::ANONYMOUS);
     response
 }

@@ -5,6 +5,7 @@
 //! visitor may see are embedded: a CMS asks without a token, and what it
 //! gets is published on pages everyone reads.
 
+use super::cache_headers;
 use super::error::{AppError, ErrorBody};
 use super::servable::ServableModel;
 use super::visitor::VisitorHints;
@@ -12,7 +13,7 @@ use super::web::{escape, public_base};
 use super::AppState;
 use crate::storage::{valid_slug, ModelRecord};
 use axum::extract::{RawQuery, State};
-use axum::http::{header, HeaderMap, HeaderValue};
+use axum::http::HeaderMap;
 use axum::response::{IntoResponse, Response};
 use axum::Json;
 use serde::{Deserialize, Serialize};
@@ -98,10 +99,7 @@ pub async fn oembed(
     let (width, height) = fit(query.maxwidth, query.maxheight);
     let site = state.config().site_name.clone();
     let mut response = Json(answer(&model.record, &base, site, width, height)).into_response();
-    response.headers_mut().insert(
-        header::CACHE_CONTROL,
-        HeaderValue::from_static("public, max-age=300"),
-    );
+    cache_headers::anonymous(&mut response, cache_headers::ANONYMOUS);
     Ok(response)
 }
 

@@ -143,6 +143,28 @@ async fn every_route_says_what_may_be_cached() {
     .await;
     assert_eq!(d.cache_control, "private, no-cache");
 
+    // What every visitor gets alike, token or not: shared for minutes; the
+    // licence list for an hour.
+    for token in [None, Some(token.as_str())] {
+        for p in [
+            "/api/oembed?url=http://example.org/m/vase",
+            "/sitemap.xml",
+            "/robots.txt",
+        ] {
+            let a = get(&c, &url(p), token).await;
+            assert_eq!(
+                (a.status, a.cache_control.as_str()),
+                (200, "public, max-age=300"),
+                "{p}"
+            );
+        }
+        let licences = get(&c, &url("/api/licences"), token).await;
+        assert_eq!(
+            (licences.status, licences.cache_control.as_str()),
+            (200, "public, max-age=3600")
+        );
+    }
+
     // Errors and health are never cached.
     let missing = get(&c, &url("/api/models/nothing"), None).await;
     assert_eq!(
