@@ -7,6 +7,7 @@ use super::{AppState, Visitor};
 use crate::storage::{Licence, ModelKind, ModelRecord, TextureRef};
 use serde::Serialize;
 use utoipa::ToSchema;
+use vitrine_mesh::export::glb_bin_bytes;
 
 #[derive(Serialize, ToSchema)]
 pub struct Manifest<'a> {
@@ -295,20 +296,18 @@ pub fn build<'a>(
     }
 }
 
-/// The GLB a visitor may take: the capped level, sized as
-/// `vitrine_mesh::export::write_glb` lays it out (12 bytes a position, a
-/// triangle and a colour) plus its JSON chunk's allowance.
+/// The GLB a visitor may take: the capped level, sized as the writer lays
+/// it out plus its JSON chunk's allowance.
 fn download(record: &ModelRecord, level: u32) -> Option<ManifestDownload> {
     if !record.policy.downloads || record.kind != ModelKind::Mesh {
         return None;
     }
     let l = record.levels.get(level as usize)?;
-    let vertices = u64::from(l.vertices);
-    let colour = if record.has_colour { 12 * vertices } else { 0 };
+    let bin = glb_bin_bytes(l.vertices as usize, l.faces as usize, record.has_colour);
     Some(ManifestDownload {
         url: format!("/api/models/{}/download.glb?level={level}", record.slug),
         level,
-        bytes: 12 * vertices + 12 * u64::from(l.faces) + colour + GLB_JSON_ALLOWANCE,
+        bytes: bin as u64 + GLB_JSON_ALLOWANCE,
     })
 }
 

@@ -190,6 +190,13 @@ pub fn write_glb_document(mesh: &IndexedMesh, doc: &GlbDocument, w: &mut impl Wr
     write_glb_bin(mesh, buf, w)
 }
 
+/// The length of the BIN chunk [`write_glb`] writes for a mesh of these
+/// counts (the file adds its headers and JSON chunk), to tell a visitor a
+/// download's size before it is decoded.
+pub fn glb_bin_bytes(vertices: usize, triangles: usize, coloured: bool) -> usize {
+    BinLayout::for_counts(vertices, triangles, coloured).len()
+}
+
 /// Byte lengths of the GLB's BIN chunk parts, in order: positions, indices,
 /// colours (0 without).
 struct BinLayout {
@@ -200,11 +207,18 @@ struct BinLayout {
 
 impl BinLayout {
     fn of(mesh: &IndexedMesh) -> Self {
-        let n = mesh.positions.len();
+        Self::for_counts(
+            mesh.positions.len(),
+            mesh.triangles.len(),
+            mesh.colors.is_some(),
+        )
+    }
+
+    fn for_counts(vertices: usize, triangles: usize, coloured: bool) -> Self {
         BinLayout {
-            pos_len: 12 * n,
-            idx_len: 12 * mesh.triangles.len(),
-            col_len: if mesh.colors.is_some() { 12 * n } else { 0 },
+            pos_len: 12 * vertices,
+            idx_len: 12 * triangles,
+            col_len: if coloured { 12 * vertices } else { 0 },
         }
     }
 

@@ -10,6 +10,7 @@
 
 use super::jobs::{self, JobInput};
 use super::Curator;
+use crate::ingest::curation::UNITS;
 use crate::ingest::{IngestOptions, ModelMeta};
 use crate::service::error::{AppError, ErrorBody};
 use crate::service::AppState;
@@ -274,8 +275,13 @@ impl Fields {
         meta.on_existing = OnExisting::NewVersion;
         meta.unit = match self.unit.as_deref() {
             None | Some("") => None,
-            Some(unit @ ("mm" | "cm" | "m" | "in")) => Some(unit.to_owned()),
-            Some(unit) => return Err(bad(format!("unit {unit:?} must be mm, cm, m or in"))),
+            Some(unit) if UNITS.contains(&unit) => Some(unit.to_owned()),
+            Some(unit) => {
+                return Err(bad(format!(
+                    "unit {unit:?} must be one of {}",
+                    UNITS.join(", ")
+                )))
+            }
         };
         meta.up = match self.up.as_deref() {
             None | Some("") => None,
