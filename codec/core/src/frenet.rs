@@ -119,6 +119,22 @@ impl Frame {
         (x, y)
     }
 
+    /// Coordinates of a world vector in the frame before
+    /// [`Frame::align_tangent`] (tangent, bitangent, normal), in f64.
+    pub(crate) fn local_f64(&self, v: [f64; 3]) -> [f64; 3] {
+        let (x, y) = self.xy.apply_f64(v[0], v[1]);
+        let (z, x) = self.zx.apply_f64(v[2], x);
+        [x, y, z]
+    }
+
+    /// Coordinates of a world vector in the frame as [`Frame::to_local`]
+    /// turns residuals (first tangent along the aligned axis), in f64.
+    pub(crate) fn aligned_f64(&self, v: [f64; 3]) -> [f64; 3] {
+        let [x, y, z] = self.local_f64(v);
+        let (x, y) = self.plane.apply_f64(x, y);
+        [x, y, z]
+    }
+
     /// Turns the first tangent onto the direction `(x, y)` of the tangent plane.
     pub(crate) fn align_tangent(&mut self, x: f64, y: f64) {
         self.plane = Givens::aligning(x, y);

@@ -15,6 +15,7 @@
 #![forbid(unsafe_code)]
 
 mod base_mesh;
+mod bits;
 mod charts;
 mod contexts;
 mod decoder;
@@ -35,6 +36,7 @@ mod quantize;
 mod room;
 mod training;
 
+pub use bits::{bit_budget, PassBits};
 pub use charts::MAX_CHARTS;
 pub use decoder::{decode, ChartLevel, Decoder, Limits};
 pub use encoder::{

@@ -55,9 +55,9 @@ fn bit_length(x: f64) -> usize {
 /// Prediction and local frame of one patch (AD01 §4, refined).
 pub(crate) struct PatchPrediction {
     pub position: [i64; 3],
-    frame: Frame,
+    pub(crate) frame: Frame,
     /// Model classes of the (major tangent, minor tangent, normal) components.
-    classes: [usize; 3],
+    pub(crate) classes: [usize; 3],
 }
 
 /// Umbrella vectors of every vertex of the coarse mesh: the sum of

@@ -22,6 +22,8 @@ pub mod token;
 #[cfg(feature = "dev-tools")]
 pub mod bench;
 #[cfg(feature = "dev-tools")]
+pub mod bit_budget;
+#[cfg(feature = "dev-tools")]
 pub mod colour_bench;
 #[cfg(feature = "dev-tools")]
 pub mod dump_levels;
@@ -83,6 +85,9 @@ pub enum DevCommand {
     ColourBench(colour_bench::ColourBenchArgs),
     /// Write the native decoder's buffers at every level (for cross-checks).
     DumpLevels(dump_levels::DumpArgs),
+    /// Where a stream's bits go, layer by layer (connectivity, tangential
+    /// and normal geometry), and what trial predictors would spend.
+    Bits(bit_budget::BitsArgs),
     /// One mesh of `bench`, in its own process so peak memory is its own.
     #[command(hide = true)]
     BenchOne(bench::BenchOneArgs),
@@ -94,6 +99,7 @@ impl DevCommand {
         match self {
             DevCommand::Bench(args) => bench::run(args),
             DevCommand::ColourBench(args) => colour_bench::run(args),
+            DevCommand::Bits(args) => bit_budget::run(args),
             DevCommand::DumpLevels(args) => dump_levels::run(args),
             DevCommand::BenchOne(args) => bench::run_one(args),
         }

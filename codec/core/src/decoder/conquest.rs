@@ -21,6 +21,8 @@ pub(crate) struct Scratch {
     umbrellas: Vec<[i32; 4]>,
     valences: Vec<u8>,
     predictions: Vec<PatchPrediction>,
+    /// Measures where the bits go ([`crate::bits`]); `None` when decoding.
+    pub meter: Option<Box<crate::bits::Meter>>,
 }
 
 impl Scratch {
@@ -199,6 +201,21 @@ impl Level {
             self.push_vertex(position, colour);
         }
         scratch.decoded = decoded;
+        if let Some(meter) = scratch.meter.as_mut() {
+            meter.record(&crate::bits::PassView {
+                kind: pass.kind,
+                sections: [
+                    pass.connectivity.len(),
+                    pass.geometry.len(),
+                    pass.colour.len(),
+                ],
+                borders: &scratch.traversal.borders,
+                positions: &self.positions_q,
+                coarse: n,
+                umbrellas: &scratch.umbrellas,
+                conn: &self.conn,
+            });
+        }
         s.geom.check_overrun()?;
         s.colour.check_overrun()
     }

@@ -185,6 +185,22 @@ impl Decoder {
         self.scratch.traversal.statistics.take()
     }
 
+    /// Starts (`Some`) or stops (`None`) measuring where the bits go;
+    /// returns the meter that was running.
+    pub(crate) fn meter(
+        &mut self,
+        meter: Option<Box<crate::bits::Meter>>,
+    ) -> Option<Box<crate::bits::Meter>> {
+        std::mem::replace(&mut self.scratch.meter, meter)
+    }
+
+    /// The batch the meter attributes the next passes to.
+    pub(crate) fn meter_batch(&mut self, batch: u32) {
+        if let Some(m) = self.scratch.meter.as_mut() {
+            m.batch = batch;
+        }
+    }
+
     pub fn header(&self) -> &Header {
         &self.header
     }

@@ -53,6 +53,14 @@ impl BitModel {
         u32::from(PROB_ONE - self.p0)
     }
 
+    /// What coding `bit` costs now, in bits, and the model updated as
+    /// coding it would (for measurements: nothing is written).
+    pub fn meter(&mut self, bit: bool) -> f64 {
+        let p = if bit { PROB_ONE - self.p0 } else { self.p0 };
+        self.update(bit);
+        -(f64::from(p) / f64::from(PROB_ONE)).log2()
+    }
+
     #[inline(always)]
     fn update(&mut self, bit: bool) {
         if bit {

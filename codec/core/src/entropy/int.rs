@@ -38,6 +38,31 @@ impl IntModel {
     }
 }
 
+impl IntModel {
+    /// What [`RangeEncoder::encode_int`] of `v` costs now, in bits, and the
+    /// model updated as coding it would (for measurements: nothing is
+    /// written).
+    pub fn meter(&mut self, v: i32) -> f64 {
+        let u = u64::from(zigzag(v)) + 1;
+        let k = 64 - u.leading_zeros();
+        let bucket = (k - 1) as usize;
+        let mut bits = self.buckets.meter(bucket);
+        let nb = k - 1;
+        if nb == 0 {
+            return bits;
+        }
+        let ctx = &mut self.top_bits[bucket];
+        let b1 = (u >> (nb - 1)) & 1 != 0;
+        bits += ctx[0].meter(b1);
+        if nb == 1 {
+            return bits;
+        }
+        let b2 = (u >> (nb - 2)) & 1 != 0;
+        bits += ctx[1 + usize::from(b1)].meter(b2);
+        bits + f64::from(nb.saturating_sub(2))
+    }
+}
+
 #[inline(always)]
 fn zigzag(v: i32) -> u32 {
     ((v << 1) ^ (v >> 31)) as u32

@@ -73,6 +73,14 @@ impl<const N: usize> FrequencyModel<N> {
         self.n
     }
 
+    /// What coding `sym` costs now, in bits, and the model updated as
+    /// coding it would (for measurements: nothing is written).
+    pub fn meter(&mut self, sym: usize) -> f64 {
+        let cost = (f64::from(self.total) / f64::from(self.freq[sym])).log2();
+        self.update(sym);
+        cost
+    }
+
     #[inline]
     fn update(&mut self, sym: usize) {
         self.freq[sym] += INCREMENT;
