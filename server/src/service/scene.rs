@@ -55,7 +55,7 @@ impl SceneFrame {
     }
 
     /// A point in model coordinates, in the scene's.
-    pub fn to_scene(&self, p: [f64; 3]) -> [f64; 3] {
+    pub fn to_scene(self, p: [f64; 3]) -> [f64; 3] {
         let scale = self.decimal_scale;
         self.rows.map(|row| {
             scale
@@ -69,7 +69,7 @@ impl SceneFrame {
 
     /// A point in scene coordinates, in the model's (the inverse of
     /// [`SceneFrame::to_scene`]: the rotation's transpose, then the unit).
-    pub fn to_model(&self, p: [f64; 3]) -> [f64; 3] {
+    pub fn to_model(self, p: [f64; 3]) -> [f64; 3] {
         let scale = self.decimal_scale;
         let mut out = [0.0; 3];
         for (c, value) in out.iter_mut().enumerate() {

@@ -355,8 +355,9 @@ mod tests {
 
     #[test]
     fn what_cannot_be_kept_is_refused_with_the_reason() {
-        let cases: [(&str, fn(&mut Value)); 7] = [
-            ("another model", |a| {
+        type Spoil = fn(&mut Value);
+        let cases: [(&str, Spoil); 7] = [
+            ("not this model's Scene", |a| {
                 a["target"]["source"] = "https://m.example/iiif/other/scene".into()
             }),
             (
