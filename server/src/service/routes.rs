@@ -34,7 +34,7 @@ use utoipa_axum::routes;
             the model's good-enough level as server load rises, rises again when it falls). A \
             batch above the cap is refused with 403 (reason `audience` or `device`) or 429 with \
             `Retry-After` (reason `load`).\n\nEvery route may also answer 413 \
-            (`payload_too_large`: a body over 64 KiB, or an upload over `--upload-limit-mb`), 431 (request headers over the limit), \
+            (`payload_too_large`: a body over 64 KiB, an annotation import over 4 MiB, or an upload over `--upload-limit-mb`), 431 (request headers over the limit), \
             500 (`internal`), 503 (`overloaded`: the concurrency limit is full; `Retry-After`) \
             and 504 (`timeout`). Any other path under `/api/` answers 404 (`not_found`)."
     ),

@@ -313,6 +313,7 @@ pub async fn manifests_for_public_models(db: TestDb) {
         "the Model downloads anonymously"
     );
     let glb = glb.bytes().await.unwrap();
+    super::download::assert_valid_glb(&glb);
 
     // The annotation's point is where the GLB's node puts the model point:
     // Z up in millimetres becomes +Y up in metres.
@@ -470,6 +471,11 @@ pub async fn annotations_round_trip(db: TestDb) {
     assert_eq!(headers["content-type"], MEDIA_TYPE);
     assert_eq!(headers["access-control-allow-origin"], "*");
     assert_eq!(page["@context"], CONTEXT);
+    // The same page the Manifest holds.
+    let (_, _, manifest) = get(&http, &server.url("/iiif/stele/manifest")).await;
+    let mut held = manifest["annotations"][0].clone();
+    held["@context"] = CONTEXT.into();
+    assert_eq!(held, page);
     let scene = page["items"][0]["target"]["source"]["id"]
         .as_str()
         .unwrap()
