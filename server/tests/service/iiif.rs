@@ -639,6 +639,20 @@ pub async fn annotations_round_trip(db: TestDb) {
         .collect();
     // 6 cm up the Scene's +Y is 60 mm along the model's +Z.
     assert!(close([p[0], p[1], p[2]], [0.0, 0.0, 60.0], 1e-9), "{p:?}");
+
+    // Editing an annotation without naming its language keeps it; null clears it.
+    let french = &added.as_array().unwrap()[0];
+    assert_eq!(french["language"], "fr");
+    let url = format!("{list_url}/{}", french["id"]);
+    let edit = |body: Value| http.put(&url).bearer_auth(&curator).json(&body).send();
+    let mut body = json!({
+        "title": "Marque", "text": "", "position": [0, 0, 0], "normal": [0, 1, 0]
+    });
+    let kept: Value = edit(body.clone()).await.unwrap().json().await.unwrap();
+    assert_eq!(kept["language"], "fr");
+    body["language"] = Value::Null;
+    let cleared: Value = edit(body).await.unwrap().json().await.unwrap();
+    assert_eq!(cleared["language"], Value::Null);
     server.shut_down().await;
 }
 
