@@ -22,8 +22,10 @@
 //!   level is this visitor's cap (no `?level=`) or a token was sent.
 //! - What is the same for every visitor, token or not, because it is
 //!   answered as an anonymous visitor sees it (oEmbed, the sitemap,
-//!   robots.txt): `public, max-age=300` ([`anonymous`]); the licence list,
-//!   which changes with a release: `public, max-age=3600`.
+//!   robots.txt, the IIIF Manifests, Collection and annotation pages of
+//!   `iiif/`, which also carry a strong ETag of their bytes): `public,
+//!   max-age=300` ([`anonymous`]); the licence list, which changes with a
+//!   release: `public, max-age=3600`.
 //! - Errors: `no-store` (`error.rs`); pages: `no-cache` (`web.rs`).
 //!
 //! Several layers (CORS, compression, these rules) name `Vary` headers; they

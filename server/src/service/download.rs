@@ -11,14 +11,15 @@
 //! Dublin Core `KHR_xmp_json_ld` packet with the licence's deed and the
 //! model page), so a scan that leaves the site keeps its credit.
 
+use super::cap::{audience_cap, device_cap, good_enough_level, Audience, CapRules, DeviceClass};
 use super::error::{AppError, ErrorBody, LevelCappedBody};
 use super::payload::{cache_control, level_bytes, not_modified, not_modified_response, within_cap};
+use super::scene::SceneFrame;
 use super::servable::{ServableModel, SlugParam};
 use super::visitor::HintQuery;
 use super::web::{page_url, public_base};
 use super::AppState;
-use crate::ingest::curation::metres_per_unit;
-use crate::storage::{ModelKind, ModelRecord, UpAxis};
+use crate::storage::{ModelKind, ModelRecord};
 use axum::extract::{RawQuery, State};
 use axum::http::{header, HeaderMap, HeaderValue};
 use axum::response::{IntoResponse, Response};
@@ -147,21 +148,7 @@ pub async fn download(
 /// What the GLB says beside the mesh: see the module's comment.
 fn document(record: &ModelRecord, base: &str) -> GlbDocument {
     let curation = &record.curation;
-    let rows = curation.up_axis.unwrap_or(UpAxis::Y).to_y_up();
-    let scale = curation
-        .unit
-        .as_deref()
-        .and_then(metres_per_unit)
-        .unwrap_or(1.0);
-    let mut matrix = [0.0f32; 16];
-    for (r, row) in rows.iter().enumerate() {
-        for (c, &value) in row.iter().enumerate() {
-            matrix[4 * c + r] = value * scale;
-        }
-    }
-    matrix[15] = 1.0;
-    // Y up in metres (or in no stated unit) needs no node transform.
-    let identity = rows == UpAxis::Y.to_y_up() && scale == 1.0;
+    let frame = SceneFrame::of(curation);
     let rights = &curation.rights;
     let alt = |text: &str| json!({ "@type": "rdf:Alt", "rdf:_1": { "@language": "x-default", "@value": text } });
     let mut xmp = json!({
@@ -187,7 +174,8 @@ fn document(record: &ModelRecord, base: &str) -> GlbDocument {
     GlbDocument {
         copyright: notice,
         name: Some(record.title.clone()),
-        matrix: (!identity).then_some(matrix),
+        // Y up in metres (or in no stated unit) needs no node transform.
+        matrix: (!frame.is_identity()).then(|| frame.matrix()),
         xmp: Some(xmp),
     }
 }
@@ -213,4 +201,27 @@ fn glb_of(payloads: &[Bytes], doc: &GlbDocument) -> Result<Vec<u8>, AppError> {
     vitrine_mesh::export::write_glb_document(&decoder.to_mesh(), doc, &mut out)
         .map_err(|e| AppError::Internal(format!("writing GLB: {e}")))?;
     Ok(out)
+}
+
+/// `download.glb` of level `level`.
+pub fn url(slug: &str, level: u32) -> String {
+    format!("/api/models/{slug}/download.glb?level={level}")
+}
+
+/// The level every anonymous visitor may download, on any device and at
+/// any load: within the public audience's cap, the phone's vertex budget and
+/// the good-enough level (which load caps never go below), so a link that
+/// names it (a IIIF manifest's Model) is never refused for the level and
+/// never names a level kept for researchers. `None` when the model offers
+/// no download to the public: its policy allows none, it is not public, or
+/// it is a point cloud.
+pub fn anonymous_level(record: &ModelRecord, rules: &CapRules) -> Option<u32> {
+    if record.kind == ModelKind::Points || !record.policy.downloads || !record.policy.public_access
+    {
+        return None;
+    }
+    let level = audience_cap(record, Audience::Public)
+        .min(device_cap(record, DeviceClass::Phone, rules))
+        .min(good_enough_level(record, rules));
+    Some(level)
 }

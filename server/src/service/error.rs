@@ -36,6 +36,10 @@ pub enum AppError {
     Storage(Arc<StorageError>),
     #[error("request body too large")]
     PayloadTooLarge,
+    /// A body within the size limit that holds more than a route takes
+    /// (an annotation import's items); the message says which limit.
+    #[error("{0}")]
+    OverLimit(String),
     #[error("service overloaded")]
     Overloaded { retry_after: Duration },
     /// Too many new visitors at once ([`super::admission`]): come back later.
@@ -101,7 +105,7 @@ impl AppError {
             AppError::LevelCapped { .. } => StatusCode::FORBIDDEN,
             AppError::Storage(e) if e.is_unavailable() => StatusCode::SERVICE_UNAVAILABLE,
             AppError::Storage(_) | AppError::Internal(_) => StatusCode::INTERNAL_SERVER_ERROR,
-            AppError::PayloadTooLarge => StatusCode::PAYLOAD_TOO_LARGE,
+            AppError::PayloadTooLarge | AppError::OverLimit(_) => StatusCode::PAYLOAD_TOO_LARGE,
             AppError::Overloaded { .. } | AppError::Busy { .. } => StatusCode::SERVICE_UNAVAILABLE,
             AppError::Timeout => StatusCode::GATEWAY_TIMEOUT,
             // The stored state conflicts with this build; nothing a client can retry.
@@ -124,7 +128,7 @@ impl AppError {
             AppError::LevelCapped { .. } => ErrorCode::LevelCapped,
             AppError::Storage(e) if e.is_unavailable() => ErrorCode::DatabaseUnavailable,
             AppError::Storage(_) | AppError::Internal(_) => ErrorCode::Internal,
-            AppError::PayloadTooLarge => ErrorCode::PayloadTooLarge,
+            AppError::PayloadTooLarge | AppError::OverLimit(_) => ErrorCode::PayloadTooLarge,
             AppError::Overloaded { .. } => ErrorCode::Overloaded,
             AppError::Busy { .. } => ErrorCode::Busy,
             AppError::Timeout => ErrorCode::Timeout,

@@ -45,6 +45,12 @@ pub async fn admit(State(state): State<AppState>, request: Request, next: Next) 
     let upload = route == "/api/models" && request.method() == Method::POST;
     // The multipart framing around the file is allowed beside the limit.
     let upload_limit = state.config().uploads.limit_bytes + UPLOAD_FRAMING_BYTES;
+    // A IIIF annotation import is the one other body over the usual limit.
+    let body_limit = if route == super::iiif::import::PATH && request.method() == Method::POST {
+        super::iiif::import::MAX_IMPORT_BYTES
+    } else {
+        limits.max_body_bytes
+    };
     // A new visit during a surge: refused before anything else is spent on it.
     let admit = if route == "/api/models/{slug}" && request.method() == Method::GET {
         state.admission().admit()
@@ -59,7 +65,7 @@ pub async fn admit(State(state): State<AppState>, request: Request, next: Next) 
                 retry_after: limits.shed_retry_after,
             }
             .into_response(),
-            Ok(_permit) if !upload && body_too_large(&request, limits.max_body_bytes) => {
+            Ok(_permit) if !upload && body_too_large(&request, body_limit) => {
                 AppError::PayloadTooLarge.into_response()
             }
             // An upload is counted as it streams (413 past the limit); a

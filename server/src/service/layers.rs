@@ -58,8 +58,9 @@ pub fn apply(router: Router<AppState>, state: &AppState) -> Router<AppState> {
                     .on_failure(DefaultOnFailure::new().level(Level::DEBUG)),
             )
             .layer(from_fn_with_state(state.clone(), guard::admit))
-            // The guard limits bodies (64 KiB; an upload's own limit, counted
-            // as it streams), so axum's extractors need no limit of their own.
+            // The guard limits bodies (64 KiB; 4 MiB for a IIIF annotation
+            // import; an upload's own limit, counted as it streams), so axum's
+            // extractors need no limit of their own.
             .layer(axum::extract::DefaultBodyLimit::disable())
             .layer(cors(&state.config().cors_origins))
             // Payloads are entropy-coded already: compress JSON and HTML only.

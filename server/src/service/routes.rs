@@ -5,7 +5,9 @@
 use super::curator::{admin, annotations, jobs, thumbnail, upload};
 use super::error::AppError;
 use super::web::{self, Viewer};
-use super::{api, crawl, download, guard, oembed, ops, payload, study, AppState, ServiceConfig};
+use super::{
+    api, crawl, download, guard, iiif, oembed, ops, payload, study, AppState, ServiceConfig,
+};
 use axum::http::{header, HeaderValue};
 use axum::response::{IntoResponse, Response};
 use axum::routing::any;
@@ -32,7 +34,7 @@ use utoipa_axum::routes;
             the model's good-enough level as server load rises, rises again when it falls). A \
             batch above the cap is refused with 403 (reason `audience` or `device`) or 429 with \
             `Retry-After` (reason `load`).\n\nEvery route may also answer 413 \
-            (`payload_too_large`: a body over 64 KiB, or an upload over `--upload-limit-mb`), 431 (request headers over the limit), \
+            (`payload_too_large`: a body over 64 KiB, an annotation import over 4 MiB, or an upload over `--upload-limit-mb`), 431 (request headers over the limit), \
             500 (`internal`), 503 (`overloaded`: the concurrency limit is full; `Retry-After`) \
             and 504 (`timeout`). Any other path under `/api/` answers 404 (`not_found`)."
     ),
@@ -93,6 +95,7 @@ fn list(viewer: Option<&Viewer>) -> OpenApiRouter<AppState> {
         .routes(routes!(payload::batch))
         .routes(routes!(payload::texture))
         .routes(routes!(download::download))
+        .routes(routes!(iiif::import::import))
         .routes(routes!(study::info))
         .routes(routes!(study::start, study::plan))
         .routes(routes!(study::answer))
@@ -110,6 +113,9 @@ fn list(viewer: Option<&Viewer>) -> OpenApiRouter<AppState> {
             routes!(web::gallery),
             viewer.map(Viewer::files),
         ))
+        .routes(routes!(iiif::manifest))
+        .routes(routes!(iiif::annotations))
+        .routes(routes!(iiif::collection))
         .routes(routes!(crawl::sitemap))
         .routes(routes!(crawl::robots))
         // The model page is always this handler: it adds the Open Graph

@@ -10,6 +10,7 @@ mod curators;
 mod download;
 mod harness;
 mod http;
+mod iiif;
 mod kill;
 mod points;
 mod proxy;
@@ -84,6 +85,8 @@ on_both_backends!(
     publishing::oembed_for_pasted_links,
     publishing::crawlers_find_public_models,
     curators::annotations_and_scopes,
+    iiif::manifests_for_public_models,
+    iiif::annotations_round_trip,
     uploads::uploads_as_jobs,
     curation::curation_in_manifest_and_thumbnail,
     points::points_streamed_under_caps,

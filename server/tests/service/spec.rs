@@ -5,6 +5,7 @@
 //! object carries no property the description does not name.
 
 mod curators;
+mod iiif;
 
 use super::broken::{BrokenStorage, Failure};
 use super::colour::tiny_mapping;
@@ -387,6 +388,7 @@ pub async fn responses_match_openapi(db: TestDb) {
     study_calls(&mut spec, &server, &db).await;
     download_calls(&mut spec, &server, &db).await;
     curators::curator_calls(&mut spec, &server, &db).await;
+    iiif::iiif_calls(&mut spec, &server, &db).await;
     refusals(&mut spec, &db, &m).await;
     spec.assert_every_route_called();
 }

@@ -12,6 +12,8 @@ struct Answer {
     status: u16,
     cache_control: String,
     vary: Vec<String>,
+    etag: String,
+    allow_origin: String,
     body: String,
 }
 
@@ -33,8 +35,17 @@ async fn get(client: &Client, url: &str, token: Option<&str>) -> Answer {
             .iter()
             .map(|v| v.to_str().unwrap().to_owned())
             .collect(),
+        etag: header(&h, "etag"),
+        allow_origin: header(&h, "access-control-allow-origin"),
         body: response.text().await.unwrap(),
     }
+}
+
+fn header(headers: &reqwest::header::HeaderMap, name: &str) -> String {
+    headers
+        .get(name)
+        .map(|v| v.to_str().unwrap().to_owned())
+        .unwrap_or_default()
 }
 
 fn varies_on(a: &Answer, name: &str) -> bool {
@@ -157,6 +168,26 @@ async fn every_route_says_what_may_be_cached() {
                 (200, "public, max-age=300"),
                 "{p}"
             );
+        }
+        // IIIF: answered as to an anonymous visitor, with a strong ETag and
+        // CORS for any origin.
+        for p in [
+            "/iiif/vase/manifest",
+            "/iiif/vase/annotations",
+            "/iiif/collection",
+        ] {
+            let a = get(&c, &url(p), token).await;
+            assert_eq!(
+                (a.status, a.cache_control.as_str()),
+                (200, "public, max-age=300"),
+                "{p}"
+            );
+            assert!(
+                a.etag.starts_with('"'),
+                "{p}: a strong ETag, not {:?}",
+                a.etag
+            );
+            assert_eq!(a.allow_origin, "*", "{p}");
         }
         let licences = get(&c, &url("/api/licences"), token).await;
         assert_eq!(

@@ -92,7 +92,7 @@ pub struct VersionChange {
 }
 
 /// Tells an explicit null (`Some(None)`) from an absent field (`None`).
-fn present<'de, D, T>(d: D) -> Result<Option<Option<T>>, D::Error>
+pub(super) fn present<'de, D, T>(d: D) -> Result<Option<Option<T>>, D::Error>
 where
     D: serde::Deserializer<'de>,
     T: Deserialize<'de>,

@@ -41,6 +41,8 @@ pub struct Annotation {
     /// The saved camera, as the viewer sent it.
     #[schema(value_type = Option<Object>)]
     view: Option<serde_json::Value>,
+    /// BCP 47 tag of the title and text (`en`, `pt-BR`), or null when not stated.
+    language: Option<String>,
     /// Unix milliseconds.
     created_at: i64,
     updated_at: i64,
@@ -56,6 +58,7 @@ impl From<AnnotationRecord> for Annotation {
             position: a.position,
             normal: a.normal,
             view: a.view,
+            language: a.language,
             created_at: a.created_at_ms,
             updated_at: a.updated_at_ms,
         }
@@ -78,12 +81,40 @@ pub struct AnnotationInput {
     #[serde(default)]
     #[schema(value_type = Option<Object>)]
     view: Option<serde_json::Value>,
+    /// BCP 47 tag of the title and text (`en`, `pt-BR`), or null. Absent
+    /// from a replacement: the annotation keeps the language it had.
+    #[serde(default, deserialize_with = "super::admin::present")]
+    #[schema(value_type = Option<String>)]
+    language: Option<Option<String>>,
 }
 
 impl AnnotationInput {
+    /// An annotation from elsewhere (a IIIF import), without a saved view.
+    pub fn new(
+        title: String,
+        text: String,
+        position: [f64; 3],
+        normal: [f64; 3],
+        language: Option<String>,
+    ) -> AnnotationInput {
+        AnnotationInput {
+            title,
+            text,
+            position,
+            normal,
+            view: None,
+            language: Some(language),
+        }
+    }
+
     /// Checks limits and numbers; renders the text.
     fn validate(self) -> Result<NewAnnotation, AppError> {
-        let bad = |m: String| Err(AppError::Unprocessable(m));
+        self.checked().map_err(AppError::Unprocessable)
+    }
+
+    /// [`AnnotationInput::validate`], the reason as text.
+    pub fn checked(self) -> Result<NewAnnotation, String> {
+        let bad = |m: String| Err(m);
         let title = self.title.trim().to_owned();
         if title.is_empty() {
             return bad("title must not be empty".into());
@@ -117,6 +148,10 @@ impl AnnotationInput {
             }
             Some(_) => return bad("view must be an object or null".into()),
         };
+        let language = match self.language.flatten().as_deref().map(str::trim) {
+            None | Some("") => None,
+            Some(tag) => Some(parse_language(tag)?),
+        };
         Ok(NewAnnotation {
             html: markdown::render(&self.text),
             title,
@@ -124,7 +159,30 @@ impl AnnotationInput {
             position: self.position,
             normal,
             view,
+            language,
         })
+    }
+}
+
+/// Longest language tag accepted (RFC 5646 §4.4.1 asks for at least 35).
+pub const MAX_LANGUAGE_BYTES: usize = 35;
+
+/// A BCP 47 language tag in its well-formed shape (RFC 5646 §2.1: subtags of
+/// 1–8 letters or digits joined by `-`, the first of letters); the registry
+/// itself is not consulted.
+pub fn parse_language(tag: &str) -> Result<String, String> {
+    let mut subtags = tag.split('-');
+    let primary_ok = subtags
+        .next()
+        .is_some_and(|p| (1..=8).contains(&p.len()) && p.bytes().all(|b| b.is_ascii_alphabetic()));
+    let rest_ok =
+        subtags.all(|s| (1..=8).contains(&s.len()) && s.bytes().all(|b| b.is_ascii_alphanumeric()));
+    if tag.len() <= MAX_LANGUAGE_BYTES && primary_ok && rest_ok {
+        Ok(tag.to_owned())
+    } else {
+        Err(format!(
+            "language {tag:?} is not a BCP 47 tag such as \"en\" or \"pt-BR\""
+        ))
     }
 }
 
@@ -227,7 +285,15 @@ pub async fn update(
 ) -> Result<Json<Annotation>, AppError> {
     curator.check_model(&slug)?;
     existing(&state, &slug).await?;
-    let new = body(input)?;
+    let keep_language = matches!(&input, Ok(Json(i)) if i.language.is_none());
+    let mut new = body(input)?;
+    if keep_language {
+        let stored = state.storage().annotations(&slug).await?;
+        new.language = stored
+            .into_iter()
+            .find(|a| a.id == id)
+            .and_then(|a| a.language);
+    }
     let stored = state.storage().update_annotation(&slug, id, &new).await?;
     Ok(Json(stored.ok_or(AppError::NotFound("annotation"))?.into()))
 }

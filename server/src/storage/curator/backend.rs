@@ -36,6 +36,7 @@ macro_rules! curator_storage {
                         })?),
                         None => None,
                     },
+                    language: row.try_get("language").map_err(get)?,
                     created_at_ms: row.try_get("created_at").map_err(get)?,
                     updated_at_ms: row.try_get("updated_at").map_err(get)?,
                 })
@@ -113,6 +114,7 @@ macro_rules! curator_storage {
                     .bind(serde_json::json!(a.position).to_string())
                     .bind(serde_json::json!(a.normal).to_string())
                     .bind(a.view.as_ref().map(|v| v.to_string()))
+                    .bind(a.language.clone())
                     .bind($crate::storage::now_ms())
                     .fetch_one(&self.pool)
                     .await
@@ -137,6 +139,7 @@ macro_rules! curator_storage {
                     .bind(serde_json::json!(a.position).to_string())
                     .bind(serde_json::json!(a.normal).to_string())
                     .bind(a.view.as_ref().map(|v| v.to_string()))
+                    .bind(a.language.clone())
                     .bind($crate::storage::now_ms())
                     .execute(&self.pool)
                     .await
@@ -145,6 +148,32 @@ macro_rules! curator_storage {
                     return Ok(None);
                 }
                 self.annotation_by_id(slug, id).await
+            }
+
+            async fn insert_annotations(
+                &self,
+                slug: &str,
+                annotations: &[$crate::storage::NewAnnotation],
+            ) -> $crate::storage::Result<usize> {
+                let mut tx = self.begin_write().await?;
+                let now = $crate::storage::now_ms();
+                for a in annotations {
+                    sqlx::query($crate::storage::curator::sql::INSERT_ANNOTATION)
+                        .bind(slug.to_owned())
+                        .bind(a.title.clone())
+                        .bind(a.text.clone())
+                        .bind(a.html.clone())
+                        .bind(serde_json::json!(a.position).to_string())
+                        .bind(serde_json::json!(a.normal).to_string())
+                        .bind(a.view.as_ref().map(|v| v.to_string()))
+                        .bind(a.language.clone())
+                        .bind(now)
+                        .fetch_one(&mut *tx)
+                        .await
+                        .map_err(Self::classify)?;
+                }
+                tx.commit().await.map_err(Self::classify)?;
+                Ok(annotations.len())
             }
 
             async fn delete_annotation(

@@ -130,6 +130,8 @@ pub struct AnnotationRecord {
     /// Unit length.
     pub normal: [f64; 3],
     pub view: Option<serde_json::Value>,
+    /// BCP 47 tag of the title and text, when stated.
+    pub language: Option<String>,
     pub created_at_ms: i64,
     pub updated_at_ms: i64,
 }
@@ -143,6 +145,8 @@ pub struct NewAnnotation {
     pub position: [f64; 3],
     pub normal: [f64; 3],
     pub view: Option<serde_json::Value>,
+    /// BCP 47 tag of the title and text, when stated.
+    pub language: Option<String>,
 }
 
 /// Where an upload's ingest stands.
@@ -249,6 +253,12 @@ pub trait CuratorStorage: Send + Sync {
         id: i64,
         a: &NewAnnotation,
     ) -> Result<Option<AnnotationRecord>> {
+        no_curators()
+    }
+
+    /// Adds every one of `annotations` in one transaction, or none of them;
+    /// answers how many were added.
+    async fn insert_annotations(&self, slug: &str, annotations: &[NewAnnotation]) -> Result<usize> {
         no_curators()
     }
 
