@@ -3,6 +3,7 @@
 //! round trip makes. Not a dependency of the shipped codec.
 #![forbid(unsafe_code)]
 
+pub mod golden;
 mod lossless;
 mod shapes;
 
