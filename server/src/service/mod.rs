@@ -16,6 +16,7 @@ pub mod curator;
 mod download;
 mod error;
 mod guard;
+mod language;
 mod layers;
 pub mod load;
 mod manifest;
