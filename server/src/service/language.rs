@@ -45,9 +45,7 @@ impl PageLanguage {
             };
         }
         PageLanguage {
-            code: accept_language
-                .and_then(best_accepted)
-                .unwrap_or(DEFAULT),
+            code: accept_language.and_then(best_accepted).unwrap_or(DEFAULT),
             negotiated: true,
         }
     }
@@ -63,7 +61,7 @@ impl PageLanguage {
     }
 
     /// `index.html` with its `<html …>` tag replaced by one that states this
-    /// language and direction (the page as built says `<html lang="en">`).
+    /// language and direction (the page as built names none).
     pub fn apply(self, html: &str) -> String {
         let tag = format!("<html lang=\"{}\" dir=\"{}\">", self.code, self.dir());
         match html.find("<html").and_then(|start| {
@@ -174,6 +172,9 @@ mod tests {
     fn the_html_tag_is_replaced() {
         let page = "<!doctype html>\n<html lang=\"en\">\n<head></head></html>";
         let ar = PageLanguage::choose(Some("ar"), None).apply(page);
-        assert_eq!(ar, "<!doctype html>\n<html lang=\"ar\" dir=\"rtl\">\n<head></head></html>");
+        assert_eq!(
+            ar,
+            "<!doctype html>\n<html lang=\"ar\" dir=\"rtl\">\n<head></head></html>"
+        );
     }
 }

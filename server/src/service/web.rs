@@ -4,8 +4,8 @@
 //! gallery so a fresh install shows something.
 
 use super::api::visible_models;
-use super::curator::thumbnail;
 use super::cache_headers;
+use super::curator::thumbnail;
 use super::error::{AppError, ErrorBody};
 use super::language::PageLanguage;
 use super::servable::{PathParams, ServableModel, SlugParam};
@@ -53,9 +53,9 @@ impl Viewer {
         get(move |language: PageLanguage| {
             let index = index.clone();
             async move {
-                let html = read_index(&index).await?.ok_or_else(|| {
-                    AppError::Internal(format!("{} is gone", index.display()))
-                })?;
+                let html = read_index(&index)
+                    .await?
+                    .ok_or_else(|| AppError::Internal(format!("{} is gone", index.display())))?;
                 Ok::<_, AppError>(html_response(&html, language))
             }
         })

@@ -14,7 +14,9 @@ let started = false;
 
 /**
  * Picks the page's language once: `?lang=`, the visitor's earlier choice,
- * `navigator.languages`, English.
+ * the page's own `<html lang>` (on this server's pages its answer to the
+ * browser's `Accept-Language`; on a museum's site, the language of the page
+ * around the element), `navigator.languages`, English.
  */
 export function startLanguage() {
   if (started) return;
@@ -23,7 +25,7 @@ export function startLanguage() {
     chooseLanguage({
       query: new URLSearchParams(location.search).get('lang'),
       stored: storedChoice(),
-      preferred: navigator.languages ?? [navigator.language],
+      preferred: [document.documentElement.lang, ...(navigator.languages ?? [navigator.language])],
     }),
   );
 }
