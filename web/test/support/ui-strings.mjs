@@ -91,7 +91,10 @@ function withoutCalls(args) {
   let before;
   do {
     before = args;
-    args = args.replace(/(?:\bnew\s+)?[a-zA-Z_$][\w$.]*\((?:[^()'"`]|'[^'\n]*'|"[^"\n]*"|`[^`]*`)*\)/g, ' ');
+    args = args
+      // Groups without literals (arrow parameters, `() => …`), then calls with what they hold.
+      .replace(/\([^()'"`]*\)/g, ' ')
+      .replace(/(?:\bnew\s+)?[a-zA-Z_$][\w$.]*\s*\((?:[^()'"`]|'[^'\n]*'|"[^"\n]*"|`[^`]*`)*\)/g, ' ');
   } while (args !== before);
   return args;
 }
