@@ -42,7 +42,9 @@ async function newPage(headers) {
   page.on('pageerror', (e) => problems.push(`error: ${e.message}`));
   page.on('requestfailed', (r) => problems.push(`failed: ${r.url()} ${r.failure()?.errorText}`));
   page.on('response', (r) => {
-    if (r.status() >= 400) problems.push(`${r.status()}: ${r.url()}`);
+    // A model without a quality study answers its results with 404 (app.js shows nothing then).
+    const noStudy = r.status() === 404 && r.url().endsWith('/results');
+    if (r.status() >= 400 && !noStudy) problems.push(`${r.status()}: ${r.url()}`);
   });
   return { page, problems };
 }
@@ -104,7 +106,7 @@ test('?lang=pt: the server says lang="pt", the controls are in Portuguese', asyn
   assert.equal(seen.reset, 'Redefinir');
   assert.equal(seen.resetTitle, 'Redefinir a visualização (R)');
   assert.match(String(seen.canvas), /^Visualização 3D/);
-  assert.match(String(seen.progress), /^Nível \d+ de \d+ · [\d.]+ vértices · [\d,]+ kB recebidos$/);
+  assert.match(String(seen.progress), /^Nível \d+ de \d+ · [\d.]+ vértices · [\d.,]+ (bytes|kB|MB) recebidos$/);
   assert.equal(seen.switchValue, 'pt');
   assert.equal(seen.switchLabel, 'Idioma');
   assert.equal(seen.back, '← Todos os modelos');
@@ -205,12 +207,14 @@ test('the switch changes the language in place, keeps it and puts it in the addr
   // Back to Arabic: the direction follows.
   await select.selectOption('ar');
   assert.deepEqual(await page.evaluate(() => [document.documentElement.lang, document.documentElement.dir]), ['ar', 'rtl']);
-  // The choice is kept: the same page without ?lang= opens in it.
   await select.selectOption('de');
+  assert.deepEqual(problems, [], 'nothing failed while switching');
+  // The choice is kept: the same page without ?lang= opens in it (leaving
+  // the page may cut short what it still had in flight).
   await page.goto(`${service.url}/m/torus`);
   await untilDrawn(page);
   assert.equal((await chrome(page)).reset, 'Zurücksetzen');
   await page.evaluate(() => localStorage.removeItem('vitrine-lang'));
-  assert.deepEqual(problems, []);
+  assert.deepEqual(problems.filter((p) => !p.endsWith('net::ERR_ABORTED')), []);
   await page.close();
 });
