@@ -187,7 +187,7 @@ test('where the policy offers downloads, the line offers the GLB of the level th
   });
   const manifest = await (await fetch(`${service.url}/api/models/shared`)).json();
   assert.equal(manifest.download.level, manifest.cap.level);
-  assert.match(seen.text ?? '', /^CC0 1\.0 Universal · Download GLB, [\d.]+ (KB|MB)$/);
+  assert.match(seen.text ?? '', /^CC0 1\.0 Universal · Download GLB, [\d.,]+ (kB|MB)$/);
   assert.ok(seen.download, 'a download link');
   assert.equal(seen.href, new URL(manifest.download.url, service.url).href);
   // What the link fetches is the GLB the line announced, of about that size.

@@ -11,6 +11,7 @@
  * notes, and the viewer shows none of this.
  */
 
+import { formatCount, localise, onLanguageChange, t } from './i18n/index.js';
 import { rotate } from './frame.js';
 import { diagonal, levelHausdorff } from './measure.js';
 import { projectPoint } from './pick.js';
@@ -82,10 +83,14 @@ export class Annotations {
     const ui = viewer.ui;
     this.pane = document.createElement('section');
     this.pane.className = 'notes pill';
-    this.pane.setAttribute('aria-label', 'Notes');
+    this.pane.dataset.i18nLabel = 'notes.pane';
     this.pane.hidden = true;
-    this.pane.innerHTML = '<h2>Notes</h2><ol class="note-list"></ol><div class="note-detail" hidden><h3></h3><div class="note-body"></div></div>';
+    this.pane.innerHTML =
+      '<h2 data-i18n="notes.heading"></h2><ol class="note-list"></ol><div class="note-detail" hidden><h3></h3><div class="note-body"></div></div>';
+    localise(this.pane);
     ui.panes.append(this.pane);
+    // The pane's fixed texts follow with the chrome (ui.js); the notes' labels are written here.
+    onLanguageChange(() => this.#label());
     this.button = ui.button('notes');
     this.button.onclick = () => this.toggle(this.pane.hidden === true);
   }
@@ -120,27 +125,36 @@ export class Annotations {
     for (const m of this.#markers) m.remove();
     this.#markers = [];
     list.forEach((a, k) => {
-      const label = `Note ${k + 1}: ${a.title}`;
       const li = document.createElement('li');
       const item = document.createElement('button');
       item.type = 'button';
       item.className = 'note-item';
-      item.textContent = a.title || `Note ${k + 1}`;
       item.onclick = () => this.select(a);
       li.append(item);
       items.append(li);
       const marker = document.createElement('button');
       marker.type = 'button';
       marker.className = 'marker';
-      marker.textContent = String(k + 1);
-      marker.setAttribute('aria-label', label);
+      marker.textContent = formatCount(k + 1);
       marker.title = a.title;
       marker.hidden = true;
       marker.onclick = () => this.select(a);
       this.viewer.ui.markers.append(marker);
       this.#markers.push(marker);
     });
+    this.#label();
     this.place();
+  }
+
+  /** The list's and the markers' names in the page's language ("Note 2: Front"). */
+  #label() {
+    const items = this.pane.querySelectorAll('.note-item');
+    this.list.forEach((a, k) => {
+      const n = k + 1;
+      items[k].textContent = a.title || t('notes.untitled', { n });
+      this.#markers[k].textContent = formatCount(n);
+      this.#markers[k].setAttribute('aria-label', t('notes.label', { n, title: a.title }));
+    });
   }
 
   /**

@@ -8,9 +8,12 @@
  */
 
 import './element.js';
+import { onLanguageChange, t } from './i18n/index.js';
+import { startLanguage } from './i18n/switch.js';
 import { fetchResults } from './study/api.js';
 import { StudyPage } from './study/page.js';
 
+startLanguage();
 const main = /** @type {HTMLElement} */ (document.getElementById('app'));
 const params = new URLSearchParams(location.search);
 const route = location.pathname.match(/^\/(m|embed|study)\/([a-z0-9-]+)\/?$/);
@@ -42,29 +45,43 @@ function viewerElement(slug) {
   return viewer;
 }
 
+/**
+ * The model list, written again in the visitor's language when it changes.
+ * @typedef {{ slug: string, title: string, levels: number, page_url: string, thumbnail?: string | null }} ListedModel
+ */
 async function gallery() {
   document.body.classList.add('gallery');
-  const list = el('ul', { class: 'models' });
-  main.replaceChildren(
-    el('header', {}, [
-      el('h1', {}, ['Vitrine']),
-      el('p', {}, ['3D scans from the collection: each appears at once in coarse form and sharpens as you look.']),
-    ]),
-    list,
-  );
+  /** @type {{ models: ListedModel[] } | { error: string } | null} */
+  let answer = null;
+  const draw = () => {
+    const list = el('ul', { class: 'models' });
+    main.replaceChildren(el('header', {}, [el('h1', {}, [siteName()]), el('p', {}, [t('gallery.intro')])]), list);
+    if (answer === null) return;
+    if ('error' in answer) {
+      list.append(el('li', { class: 'error', role: 'alert' }, [t('gallery.failed', { reason: answer.error })]));
+      return;
+    }
+    if (answer.models.length === 0) list.append(el('li', {}, [t('gallery.empty')]));
+    for (const m of answer.models) {
+      const levels = el('small', {}, [t('gallery.levels', { count: m.levels })]);
+      list.append(el('li', {}, [el('a', { href: m.page_url }, [thumbnail(m), el('strong', {}, [m.title]), levels])]));
+    }
+  };
+  draw();
+  onLanguageChange(draw);
   try {
     const response = await fetch('/api/models', { cache: 'no-store' });
-    if (!response.ok) throw new Error(`the server answered ${response.status}`);
-    /** @type {{ models: Array<{ slug: string, title: string, levels: number, page_url: string, thumbnail?: string | null }> }} */
-    const { models } = await response.json();
-    if (models.length === 0) list.append(el('li', {}, ['No models yet: `vitrine ingest` adds one.']));
-    for (const m of models) {
-      const link = el('a', { href: m.page_url }, [thumbnail(m), el('strong', {}, [m.title]), el('small', {}, [`${m.levels} levels`])]);
-      list.append(el('li', {}, [link]));
-    }
+    if (!response.ok) throw new Error(t('gallery.status', { status: String(response.status) }));
+    answer = await response.json();
   } catch (error) {
-    list.append(el('li', { class: 'error', role: 'alert' }, [`Could not load the models: ${error}`]));
+    answer = { error: error instanceof Error ? error.message : String(error) };
   }
+  draw();
+}
+
+/** The site's name as the server states it (`--site-name`). */
+function siteName() {
+  return document.querySelector('meta[name="application-name"]')?.getAttribute('content') || 'Vitrine';
 }
 
 /**
@@ -76,7 +93,7 @@ async function gallery() {
 function thumbnail(m) {
   const box = el('span', { class: 'thumb' });
   if (typeof m.thumbnail === 'string' && m.thumbnail) {
-    const img = el('img', { src: m.thumbnail, alt: `${m.title}: preview`, loading: 'lazy', decoding: 'async', width: '320', height: '240' });
+    const img = el('img', { src: m.thumbnail, alt: t('gallery.preview', { title: m.title }), loading: 'lazy', decoding: 'async', width: '320', height: '240' });
     img.addEventListener('error', () => img.replaceWith(el('span', { class: 'thumb-none', 'aria-hidden': 'true' })));
     box.append(img);
   } else {
@@ -92,21 +109,27 @@ function modelPage(slug) {
   const viewer = viewerElement(slug);
   viewer.setAttribute('chrome', 'full');
   const origin = location.origin;
-  const iframe =
-    `<iframe src="${origin}/embed/${slug}" width="800" height="600" style="border:0" ` +
-    `allow="fullscreen" allowfullscreen title="3D model"></iframe>`;
-  const element =
-    `<script type="module" src="${origin}/vitrine.js"></script>\n` +
-    `<vitrine-viewer src="${origin}/m/${slug}" style="width:800px;height:600px"></vitrine-viewer>`;
-  main.replaceChildren(
-    el('header', {}, [el('a', { href: '/' }, ['← All models'])]),
-    viewer,
-    el('section', { class: 'embed' }, [
-      el('h2', {}, ['Embed this model']),
-      snippet('An iframe, for any site:', iframe),
-      snippet('Or the viewer element, styled by your page:', element),
-    ]),
-  );
+  // The page around the viewer, in the visitor's language; the viewer stays
+  // where it is (moving it would start it again).
+  const header = el('header');
+  const embed = el('section', { class: 'embed' });
+  main.replaceChildren(header, viewer, embed);
+  const draw = () => {
+    const iframe =
+      `<iframe src="${origin}/embed/${slug}" width="800" height="600" style="border:0" ` +
+      `allow="fullscreen" allowfullscreen title="${t('page.iframeTitle').replace(/"/g, '&quot;')}"></iframe>`;
+    const element =
+      `<script type="module" src="${origin}/vitrine.js"></script>\n` +
+      `<vitrine-viewer src="${origin}/m/${slug}" style="width:800px;height:600px"></vitrine-viewer>`;
+    header.replaceChildren(el('a', { href: '/' }, [t('page.allModels')]));
+    embed.replaceChildren(
+      el('h2', {}, [t('page.embed')]),
+      snippet(t('page.embedIframe'), iframe),
+      snippet(t('page.embedElement'), element),
+    );
+  };
+  draw();
+  onLanguageChange(draw);
   // The quality study's answers, when the model has a study (404: none, nothing shown).
   void fetchResults(slug)
     .then((results) => {
@@ -115,9 +138,7 @@ function modelPage(slug) {
     .catch(() => {});
   viewer.addEventListener('vitrine-level', () => {
     const title = /** @type {any} */ (viewer).viewer?.manifest?.title;
-    // The site's name as the server states it (`--site-name`).
-    const site = document.querySelector('meta[name="application-name"]')?.getAttribute('content') || 'Vitrine';
-    if (title) document.title = `${title} · ${site}`;
+    if (title) document.title = `${title} · ${siteName()}`;
   });
 }
 
@@ -134,7 +155,7 @@ function embedPage(slug) {
  * @param {string} code
  */
 function snippet(label, code) {
-  const button = el('button', { type: 'button' }, ['Copy']);
-  button.onclick = () => void navigator.clipboard?.writeText(code).then(() => (button.textContent = 'Copied'));
+  const button = el('button', { type: 'button' }, [t('page.copy')]);
+  button.onclick = () => void navigator.clipboard?.writeText(code).then(() => (button.textContent = t('page.copied')));
   return el('div', { class: 'snippet' }, [el('p', {}, [label, ' ', button]), el('pre', {}, [el('code', {}, [code])])]);
 }

@@ -20,6 +20,8 @@
  * works on another origin (the service answers CORS).
  */
 
+import { t } from './i18n/index.js';
+import { startLanguage } from './i18n/switch.js';
 import { motionMode } from './motion.js';
 import { ViewerUi } from './ui.js';
 import { Viewer } from './viewer.js';
@@ -60,7 +62,7 @@ export class VitrineViewerElement extends HTMLElement {
     const ui = new ViewerUi(this, shadow);
     const src = this.getAttribute('src');
     if (!src) {
-      ui.showError('the element has no src attribute');
+      ui.showError(() => t('element.noSrc'));
       return;
     }
     const query = new URLSearchParams();
@@ -88,11 +90,16 @@ export class VitrineViewerElement extends HTMLElement {
   }
 
   disconnectedCallback() {
+    this.viewer?.ui.dispose();
     this.viewer?.stopTurntable();
     this.viewer?.stop();
     this.viewer = null;
   }
 }
+
+// The page's language, before the first viewer writes its chrome (pages of
+// this server and other sites alike).
+startLanguage();
 
 if (!customElements.get('vitrine-viewer')) customElements.define('vitrine-viewer', VitrineViewerElement);
 

@@ -9,6 +9,7 @@
  * measure.js, light.js and frame.js.
  */
 
+import { onLanguageChange, t } from './i18n/index.js';
 import { STUDIO, discLight, discPosition, rakingLight } from './light.js';
 import { diagonal, formatReading, levelHausdorff, measurement } from './measure.js';
 import { pixelSize, projectPoint, viewRay } from './pick.js';
@@ -61,6 +62,8 @@ export class Inspection {
     ui.button('snapshot').onclick = () => void this.saveSnapshot();
     this.measure.clear.onclick = () => this.clear();
     this.measure.refine.onclick = () => this.viewer.refine();
+    // The panes' fixed texts follow with the chrome (ui.js); the readings are written here.
+    onLanguageChange(() => this.#show());
     this.light.studio.onclick = () => this.setLight(STUDIO);
     for (const [from, button] of Object.entries(this.light.raking)) {
       button.onclick = () => this.setLight(rakingLight(/** @type {'left' | 'right' | 'top' | 'bottom'} */ (from)));
@@ -126,7 +129,7 @@ export class Inspection {
     const { hit, vertex, level, ms } = await renderer.pick(ray, SNAP_PX * pixelSize(camera, 1, height));
     this.pickMs = ms;
     if (!hit || level === null) {
-      this.measure.status.textContent = 'No surface there: click on the model.';
+      this.measure.status.textContent = t('measure.noSurface');
       return null;
     }
     const point = vertex ?? hit.point;
@@ -155,7 +158,9 @@ export class Inspection {
       if (this.reading !== reading) return;
       reading.surface = distance;
     } catch (error) {
-      if (this.reading === reading) this.measure.surface.textContent = `Along the surface: ${error instanceof Error ? error.message : error}`;
+      if (this.reading === reading) {
+        this.measure.surface.textContent = t('measure.surfaceFailed', { reason: error instanceof Error ? error.message : String(error) });
+      }
       return;
     }
     this.#show();
@@ -167,20 +172,20 @@ export class Inspection {
     const reading = this.reading;
     const manifest = this.viewer.manifest;
     m.status.textContent =
-      this.points.length === 0 ? 'Click a point on the surface.' : this.points.length === 1 ? 'Click a second point.' : '';
+      this.points.length === 0 ? t('measure.first') : this.points.length === 1 ? t('measure.second') : '';
+    if (reading) reading.text = formatReading(reading.value, reading.error, manifest?.unit);
     m.reading.textContent = reading ? reading.text : '';
     m.surface.textContent =
       reading && reading.surface !== null && Number.isFinite(reading.surface)
-        ? `Along the surface: ${formatReading(reading.surface, reading.error, manifest?.unit)}`
+        ? t('measure.surface', { reading: formatReading(reading.surface, reading.error, manifest?.unit) })
         : reading?.surface === Infinity
-          ? 'Along the surface: the points are on separate parts.'
+          ? t('measure.separate')
           : '';
     const state = this.viewer.state;
     const finer = reading !== null && reading.level < state.lastLevel;
     m.refine.hidden = !finer;
     m.refine.disabled = (reading !== null && state.targetLevel > reading.level) || state.status === 'capped';
-    if (finer && state.status === 'capped') m.refine.textContent = 'Finer levels are not sent to this device';
-    else m.refine.textContent = 'Refine to measure more precisely';
+    m.refine.textContent = finer && state.status === 'capped' ? t('measure.capped') : t('measure.refine');
     this.place();
   }
 

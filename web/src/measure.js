@@ -8,6 +8,7 @@
  * within 2 h × diagonal of the distance between the two nearest points of
  * the original. No DOM (unit-tested in Node).
  */
+import { formatNumber, t } from './i18n/index.js';
 
 /** @typedef {[number, number, number]} Vec3 */
 
@@ -61,11 +62,12 @@ function decimals(value, error) {
  * @param {string | null | undefined} unit
  */
 export function formatReading(value, error, unit) {
-  const u = /** @type {readonly string[]} */ (UNITS).includes(unit ?? '') ? ` ${unit}` : ' units';
   const places = decimals(value, error);
-  const main = `${value.toFixed(places)}${u}`;
-  if (error === null) return `${main} (the error of this level was not measured)`;
-  return `${main} ± ${error.toFixed(places)}${u} at this level`;
+  const number = (/** @type {number} */ x) => formatNumber(x, { minimumFractionDigits: places, maximumFractionDigits: places });
+  const known = /** @type {readonly string[]} */ (UNITS).includes(unit ?? '');
+  const length = (/** @type {number} */ x) => (known ? `${number(x)} ${unit}` : t('measure.units', { value: number(x) }));
+  if (error === null) return t('measure.unmeasured', { length: length(value) });
+  return t('measure.reading', { length: length(value), error: length(error) });
 }
 
 /**

@@ -16,6 +16,7 @@
  * panel inserts the string into its shadow root. Every number is formatted
  * here; no text from the manifest reaches the markup.
  */
+import { formatNumber, t } from './i18n/index.js';
 
 /**
  * One level's quality against the original.
@@ -62,8 +63,8 @@
 
 /** @type {ReadonlyArray<{ key: SeriesKey, label: string, colour: string }>} */
 export const SERIES = [
-  { key: 'image_rmse', label: 'image RMSE', colour: '#88c0d0' },
-  { key: 'roy_rmse', label: 'colour RMSE (Roy)', colour: '#ebcb8b' },
+  { key: 'image_rmse', label: 'quality.series.image', colour: '#88c0d0' },
+  { key: 'roy_rmse', label: 'quality.series.colour', colour: '#ebcb8b' },
 ];
 
 const MARGIN = { left: 26, right: 16, top: 16, bottom: 16 };
@@ -176,7 +177,7 @@ export function layoutQualityChart(quality, level, options = {}) {
 export function describeStudyLevel(study, level) {
   const l = study?.find((s) => s.level === level);
   if (!l || !(l.answers > 0)) return '';
-  return `sufficient for ${l.sufficient} of ${l.answers} (${Math.round((100 * l.sufficient) / l.answers)} %) in the quality study`;
+  return t('quality.study', { count: l.answers, sufficient: l.sufficient, share: formatNumber(l.sufficient / l.answers, { style: 'percent' }) });
 }
 
 /** @param {number} v */
@@ -194,8 +195,8 @@ export function renderQualityChart(quality, level, options = {}) {
   const { width, height, plot, series, marker, xTicks, yTicks, study } = layout;
   const parts = [
     `<svg xmlns="http://www.w3.org/2000/svg" class="quality-chart" viewBox="0 0 ${width} ${height}" ` +
-      `width="${width}" height="${height}" role="img" aria-label="${describeChart(quality)}${
-        study.length > 0 ? '; bars: share of study participants who found each level sufficient' : ''
+      `width="${width}" height="${height}" role="img" aria-label="${escapeAttribute(describeChart(quality))}${
+        study.length > 0 ? escapeAttribute(t('quality.chart.bars')) : ''
       }" ` +
       `font-family="system-ui, sans-serif" font-size="10">`,
     `<g class="axes" stroke="#4c566a" stroke-width="1">` +
@@ -213,7 +214,7 @@ export function renderQualityChart(quality, level, options = {}) {
     }
     parts.push(
       `</g><g class="legend"><rect x="${plot.right - 62}" y="2" width="6" height="8" fill="#a3be8c" fill-opacity="0.6"/>` +
-        `<text x="${plot.right - 53}" y="10" fill="#cfd5de">sufficient %</text></g>`,
+        `<text x="${plot.right - 53}" y="10" fill="#cfd5de">${escapeAttribute(t('quality.chart.sufficient'))}</text></g>`,
     );
   }
   for (const t of xTicks) {
@@ -241,7 +242,7 @@ export function renderQualityChart(quality, level, options = {}) {
     const lx = plot.left + 4 + k * 100;
     parts.push(
       `<g class="legend"><line x1="${lx}" y1="7" x2="${lx + 10}" y2="7" stroke="${s.colour}" stroke-width="2"/>` +
-        `<text x="${lx + 13}" y="10" fill="#cfd5de">${s.label}</text></g>`,
+        `<text x="${lx + 13}" y="10" fill="#cfd5de">${escapeAttribute(t(s.label))}</text></g>`,
     );
   });
   if (marker) {
@@ -268,17 +269,29 @@ export function renderQualityChart(quality, level, options = {}) {
 export function describeLevel(quality, level) {
   const p = cleanPoints(quality).find((q) => q.level === level);
   if (!p) return '';
-  const roy = finite(p.roy_rmse) ? ` · colour RMSE ${p.roy_rmse.toFixed(1)}` : '';
-  const hausdorff = finite(p.hausdorff) ? ` · Hausdorff ${(100 * p.hausdorff).toFixed(2)} % of the diagonal` : '';
-  return `Level ${p.level}: image RMSE ${p.image_rmse.toFixed(1)}${roy}${hausdorff}`;
+  const fixed = (/** @type {number} */ v, /** @type {number} */ digits) =>
+    formatNumber(v, { minimumFractionDigits: digits, maximumFractionDigits: digits });
+  const roy = finite(p.roy_rmse) ? t('quality.level.colour', { rmse: fixed(p.roy_rmse, 1) }) : '';
+  const hausdorff = finite(p.hausdorff)
+    ? t('quality.level.hausdorff', { share: formatNumber(p.hausdorff, { style: 'percent', minimumFractionDigits: 2 }) })
+    : '';
+  return t('quality.level', { level: p.level, rmse: fixed(p.image_rmse, 1) }) + roy + hausdorff;
 }
 
 /** @param {ReadonlyArray<QualityPoint> | null | undefined} quality */
 function describeChart(quality) {
   const points = cleanPoints(quality);
   const [first, last] = [points[0], points[points.length - 1]];
-  return (
-    `Error against the original per level (log scales): image RMSE from ${first.image_rmse.toFixed(1)} ` +
-    `at ${first.vertices} vertices to ${last.image_rmse.toFixed(1)} at ${last.vertices} vertices`
-  );
+  const rmse = (/** @type {number} */ v) => formatNumber(v, { minimumFractionDigits: 1, maximumFractionDigits: 1 });
+  return t('quality.chart', {
+    from: rmse(first.image_rmse),
+    firstVertices: first.vertices,
+    to: rmse(last.image_rmse),
+    lastVertices: last.vertices,
+  });
+}
+
+/** Catalogue text inside the chart's markup. @param {string} text */
+function escapeAttribute(text) {
+  return text.replace(/&/g, '&amp;').replace(/</g, '&lt;').replace(/"/g, '&quot;');
 }

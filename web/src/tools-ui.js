@@ -4,17 +4,20 @@
  * section) and their styles; inspection.js gives them their behaviour.
  */
 
+import { localise } from './i18n/index.js';
+
 /**
  * @param {string} className
- * @param {string} label
- * @param {string} html
+ * @param {string} label the catalogue key of its name
+ * @param {string} html its markup, texts as `data-i18n*` keys (i18n/index.js)
  */
 function pane(className, label, html) {
   const section = document.createElement('section');
   section.className = `${className} pill`;
-  section.setAttribute('aria-label', label);
+  section.dataset.i18nLabel = label;
   section.hidden = true;
   section.innerHTML = html;
+  localise(section);
   return section;
 }
 
@@ -26,10 +29,10 @@ function $(root, selector) {
 export function measurePane() {
   const p = pane(
     'measure',
-    'Measurement',
-    `<h2>Measure</h2><p class="measure-status" role="status"></p><p class="measure-reading"></p>
+    'measure.pane',
+    `<h2 data-i18n="measure.heading"></h2><p class="measure-status" role="status"></p><p class="measure-reading"></p>
 <p class="measure-surface"></p><div class="row"><button type="button" class="refine" hidden></button>
-<button type="button" class="clear">Clear</button></div>`,
+<button type="button" class="clear" data-i18n="measure.clear"></button></div>`,
   );
   return {
     pane: p,
@@ -44,12 +47,12 @@ export function measurePane() {
 export function lightPane() {
   const p = pane(
     'light',
-    'Light',
-    `<h2>Light</h2><div class="disc" tabindex="0" role="slider" aria-label="Light direction: drag, or arrow keys"
-  aria-valuetext="light direction"><span class="handle"></span></div>
-<div class="row"><button type="button" data-raking="left">Raking ←</button><button type="button" data-raking="right">Raking →</button>
-<button type="button" data-raking="top">Raking ↑</button><button type="button" data-raking="bottom">Raking ↓</button>
-<button type="button" class="studio">Studio</button></div>`,
+    'light.pane',
+    `<h2 data-i18n="light.heading"></h2><div class="disc" tabindex="0" role="slider" data-i18n-label="light.disc"
+  data-i18n-valuetext="light.direction"><span class="handle"></span></div>
+<div class="row"><button type="button" data-raking="left" data-i18n="light.left"></button><button type="button" data-raking="right" data-i18n="light.right"></button>
+<button type="button" data-raking="top" data-i18n="light.top"></button><button type="button" data-raking="bottom" data-i18n="light.bottom"></button>
+<button type="button" class="studio" data-i18n="light.studio"></button></div>`,
   );
   /** @type {Record<string, HTMLButtonElement>} */
   const raking = {};
@@ -60,12 +63,12 @@ export function lightPane() {
 export function sectionPane() {
   const p = pane(
     'section',
-    'Section',
-    `<h2>Section</h2><div class="row" role="group" aria-label="Plane perpendicular to">
+    'section.pane',
+    `<h2 data-i18n="section.heading"></h2><div class="row" role="group" data-i18n-label="section.axis">
 <button type="button" data-axis="x" aria-pressed="true">X</button><button type="button" data-axis="y" aria-pressed="false">Y</button>
 <button type="button" data-axis="z" aria-pressed="false">Z</button>
-<button type="button" class="flip" aria-pressed="false">Other side</button></div>
-<label class="offset">Position <input type="range" min="0" max="1000" value="500"></label>`,
+<button type="button" class="flip" aria-pressed="false" data-i18n="section.flip"></button></div>
+<label class="offset"><span data-i18n="section.position"></span> <input type="range" min="0" max="1000" value="500"></label>`,
   );
   return {
     pane: p,

@@ -12,6 +12,8 @@ import { NOTES_STYLE } from './annotations.js';
 import { TOOLS_STYLE } from './tools-ui.js';
 import { SCALE_PERCENTILE, formatDegrees, rampGradient, reliefTicks } from './relief.js';
 import { creditLine } from './rights.js';
+import { formatBytes, language, localise, onLanguageChange, t } from './i18n/index.js';
+import { languageSwitch } from './i18n/switch.js';
 
 /** Device pixels per CSS pixel, capped: beyond 2 a tablet pays 2.25× the fill for little gain. */
 const MAX_PIXEL_RATIO = 2;
@@ -41,6 +43,10 @@ button { font: inherit; color: inherit; background: rgba(20, 22, 26, 0.72); bord
   border-radius: 6px; min-height: 36px; padding: 4px 12px; cursor: pointer; }
 button:hover { background: rgba(59, 66, 82, 0.9); }
 button:focus-visible { outline: 2px solid #88c0d0; outline-offset: 1px; }
+select.language { font: inherit; color: inherit; background: rgba(20, 22, 26, 0.72); border: 1px solid #4c566a;
+  border-radius: 6px; min-height: 36px; min-width: 36px; padding: 4px 6px; cursor: pointer; }
+select.language:focus-visible { outline: 2px solid #88c0d0; outline-offset: 1px; }
+select.language option { background: #212329; color: #eceff4; }
 button[aria-pressed="true"] { background: #5e81ac; border-color: #81a1c1; }
 .panes { display: flex; flex-wrap: wrap; justify-content: flex-end; align-items: flex-start; gap: 8px;
   min-height: 0; flex: 0 1 auto; overflow: auto; pointer-events: none; }
@@ -132,45 +138,44 @@ export class ViewerUi {
     this.root = host;
     shadow.innerHTML = `<style>${STYLE}${TOOLS_STYLE}${NOTES_STYLE}</style>
 <div class="stage" part="stage">
-  <canvas aria-label="3D view: drag to turn, pinch or scroll to zoom, two fingers or right-drag to pan"></canvas>
+  <canvas data-i18n-label="view.canvas"></canvas>
   <div class="markers"></div>
   <div class="chrome">
   <div class="top">
   <div class="panel pill" part="panel"></div>
-  <div class="tools" role="toolbar" aria-label="View tools">
-    <button data-action="reset" title="Reset view (R)">Reset</button>
-    <button data-action="wireframe" title="Wireframe (W)" aria-pressed="false" class="optional">Wireframe</button>
-    <button data-action="relief" title="Relief: colour by average normal deviation θ (erosion, tool marks)"
-      aria-pressed="false" class="optional">Relief</button>
-    <button data-action="splats" title="Splats: draw the level's vertices as surface splats" aria-pressed="false" class="optional">Splats</button>
-    <button data-action="notes" title="The curators' notes on this object" aria-pressed="false" hidden>Notes</button>
-    <button data-action="measure" title="Measure: click two points on the surface" aria-pressed="false" class="optional">Measure</button>
-    <button data-action="light" title="Light: move the light, raking light for inscriptions" aria-pressed="false" class="optional">Light</button>
-    <button data-action="section" title="Section: cut the model with a plane" aria-pressed="false" class="optional">Section</button>
-    <button data-action="clay" title="Clay: hide the colour to see the shape" aria-pressed="false" class="optional">Clay</button>
-    <button data-action="snapshot" title="Save the view as a PNG image" class="optional">Snapshot</button>
-    <button data-action="fullscreen" title="Fullscreen (F)">Fullscreen</button>
+  <div class="tools" role="toolbar" data-i18n-label="tools.label">
+    <button data-action="reset" data-i18n="tools.reset" data-i18n-title="tools.reset.title"></button>
+    <button data-action="wireframe" data-i18n="tools.wireframe" data-i18n-title="tools.wireframe.title" aria-pressed="false" class="optional"></button>
+    <button data-action="relief" data-i18n="tools.relief" data-i18n-title="tools.relief.title" aria-pressed="false" class="optional"></button>
+    <button data-action="splats" data-i18n="tools.splats" data-i18n-title="tools.splats.title" aria-pressed="false" class="optional"></button>
+    <button data-action="notes" data-i18n="tools.notes" data-i18n-title="tools.notes.title" aria-pressed="false" hidden></button>
+    <button data-action="measure" data-i18n="tools.measure" data-i18n-title="tools.measure.title" aria-pressed="false" class="optional"></button>
+    <button data-action="light" data-i18n="tools.light" data-i18n-title="tools.light.title" aria-pressed="false" class="optional"></button>
+    <button data-action="section" data-i18n="tools.section" data-i18n-title="tools.section.title" aria-pressed="false" class="optional"></button>
+    <button data-action="clay" data-i18n="tools.clay" data-i18n-title="tools.clay.title" aria-pressed="false" class="optional"></button>
+    <button data-action="snapshot" data-i18n="tools.snapshot" data-i18n-title="tools.snapshot.title" class="optional"></button>
+    <button data-action="fullscreen" data-i18n="tools.fullscreen" data-i18n-title="tools.fullscreen.title"></button>
   </div>
   </div>
   <div class="panes"></div>
   <div class="spacer"></div>
   <div class="foot">
   <div class="status">
-    <div class="legend pill" role="group" aria-label="Relief legend" hidden>
+    <div class="legend pill" role="group" data-i18n-label="legend.label" hidden>
       <div class="legend-title"></div>
       <div class="legend-ramp" aria-hidden="true"></div>
       <div class="legend-ticks"></div>
     </div>
     <div class="notice pill" role="status" hidden></div>
     <div class="colour pill" hidden></div>
-    <div class="progress pill" aria-live="polite">Loading…</div>
+    <div class="progress pill" aria-live="polite" data-i18n="progress.loading"></div>
   </div>
-  <div class="credit" part="credit" role="group" aria-label="Credit and licence" hidden></div>
+  <div class="credit" part="credit" role="group" data-i18n-label="credit.label" hidden></div>
   </div>
   </div>
   <div class="live" aria-live="polite"></div>
   <div class="bar" style="width: 0"></div>
-  <div class="error" role="alert" hidden><div><p></p><button data-action="retry">Try again</button></div></div>
+  <div class="error" role="alert" hidden><div><p></p><button data-action="retry" data-i18n="error.retry"></button></div></div>
 </div>`;
     const $ = (/** @type {string} */ selector) => /** @type {HTMLElement} */ (shadow.querySelector(selector));
     this.canvas = /** @type {HTMLCanvasElement} */ ($('canvas'));
@@ -198,15 +203,51 @@ export class ViewerUi {
     this.quality.className = 'quality';
     this.quality.open = true;
     this.quality.hidden = true;
-    this.quality.innerHTML = '<summary>Quality per level</summary><div class="chart"></div><p></p>';
+    this.quality.innerHTML = '<summary data-i18n="quality.summary"></summary><div class="chart"></div><p></p>';
     $('[data-action="reset"]').onclick = () => this.onReset();
     this.wireButton.onclick = () => this.onWireframe();
     this.reliefButton.onclick = () => this.onRelief();
     this.splatsButton.onclick = () => this.onSplats();
     $('[data-action="fullscreen"]').onclick = () => this.toggleFullscreen();
     $('[data-action="retry"]').onclick = () => this.onRetry();
+    /** The language switch, last in the toolbar. */
+    this.languages = languageSwitch();
+    $('.tools').append(this.languages);
+    this.#localise();
+    this.#stopListening = onLanguageChange(() => this.#localise());
     this.#watchSize();
   }
+
+  #stopListening = () => {};
+
+  /** Writes every text of the chrome in the page's language (again, after a switch). */
+  #localise() {
+    localise(this.shadow);
+    localise(this.quality);
+    /** @type {HTMLSelectElement} */ (this.languages).value = language();
+    this.#texts = new WeakMap();
+    this.#chartLevel = null;
+    this.#legendKey = '';
+    this.#colourKey = '';
+    if (this.#state) this.setProgress(this.#state);
+    if (this.#rights) this.setRights(...this.#rights);
+    this.showNotice(this.#notice);
+    this.showError(this.#error);
+  }
+
+  /** Stops following the page's language (the element left the page). */
+  dispose() {
+    this.#stopListening();
+  }
+
+  /** What the chrome last showed, to write it again in another language. @type {import('./viewer.js').ViewerState | null} */
+  #state = null;
+  /** @type {[Partial<import('./rights.js').Rights> | null | undefined, { href: string, bytes: number } | null] | null} */
+  #rights = null;
+  /** @type {ChromeText} */
+  #notice = null;
+  /** @type {ChromeText} */
+  #error = null;
 
   /**
    * A toolbar button by its action.
@@ -271,6 +312,7 @@ export class ViewerUi {
    * @param {{ href: string, bytes: number } | null} [download] the level this visitor may take
    */
   setRights(rights, download = null) {
+    this.#rights = [rights, download];
     const line = creditLine(rights);
     this.credit.replaceChildren();
     this.credit.hidden = line === null && !download;
@@ -314,8 +356,8 @@ export class ViewerUi {
       const link = document.createElement('a');
       link.href = download.href;
       link.download = '';
-      link.textContent = `Download GLB, ${formatBytes(download.bytes)}`;
-      link.title = 'This level as one glTF file, for AR viewers and 3D tools';
+      link.textContent = t('credit.download', { size: formatBytes(download.bytes) });
+      link.title = t('credit.download.title');
       part('credit-download').append(link);
     }
     this.credit.append(box);
@@ -365,14 +407,19 @@ export class ViewerUi {
     this.#setColour(state);
     this.#setLegend(state);
     this.#drawQuality(state.shownLevel);
+    this.#state = state;
     if (state.shownLevel < 0) {
-      this.#write(this.progress, `Loading… ${formatBytes(state.received)} received`);
+      this.#write(this.progress, t('progress.received', { size: formatBytes(state.received) }));
       return;
     }
-    const vertices = formatCount(state.vertices);
     this.#write(
       this.progress,
-      `Level ${state.shownLevel} of ${state.lastLevel} · ${vertices} vertices · ${formatBytes(state.received)} received`,
+      t('progress.level', {
+        level: state.shownLevel,
+        last: state.lastLevel,
+        count: state.vertices,
+        size: formatBytes(state.received),
+      }),
     );
     const width = `${(100 * state.shownLevel) / Math.max(1, state.lastLevel)}%`;
     if (this.#barWidth !== width) this.bar.style.width = this.#barWidth = width;
@@ -395,17 +442,12 @@ export class ViewerUi {
    * @param {import('./viewer.js').ViewerState} state
    */
   #setColour(state) {
-    const texts = {
-      loading: 'Colour texture loading…',
-      low: 'Colour: low resolution · full resolution loading…',
-      full: 'Colour: full resolution',
-    };
-    const text = state.colourError
-      ? `Colour: ${state.colourError}`
-      : texts[/** @type {keyof typeof texts} */ (state.colour)] ?? null;
-    const key = `${state.colour}\n${state.colourError !== null}\n${text}`;
-    if (key === this.#colourKey) return;
-    this.#colourKey = key;
+    const texts = { loading: 'colour.loading', low: 'colour.low', full: 'colour.full' };
+    const key = texts[/** @type {keyof typeof texts} */ (state.colour)];
+    const text = state.colourError ? t('colour.error', { reason: state.colourError }) : key ? t(key) : null;
+    const shown = `${state.colour}\n${state.colourError !== null}\n${text}`;
+    if (shown === this.#colourKey) return;
+    this.#colourKey = shown;
     this.colour.hidden = text === null;
     this.#write(this.colour, text ?? '');
     this.colour.dataset.colour = state.colour;
@@ -433,17 +475,13 @@ export class ViewerUi {
     ramp.hidden = top === null;
     ticks.replaceChildren();
     if (top === null) {
-      this.legend.setAttribute('aria-label', 'Relief legend');
-      title.textContent = 'Relief: computing the normal deviation θ…';
+      this.legend.setAttribute('aria-label', t('legend.label'));
+      title.textContent = t('legend.computing');
       return;
     }
     const percentile = Math.round(100 * SCALE_PERCENTILE);
-    title.textContent = `Normal deviation θ (top: ${percentile}th percentile)`;
-    this.legend.setAttribute(
-      'aria-label',
-      `Relief legend: normal deviation θ from 0° (dark purple) to ${formatDegrees(top)} or more (yellow), ` +
-        `the ${percentile}th percentile of this level`,
-    );
+    title.textContent = t('legend.title', { percentile });
+    this.legend.setAttribute('aria-label', t('legend.description', { top: formatDegrees(top), percentile }));
     for (const value of reliefTicks(top)) {
       const span = document.createElement('span');
       span.textContent = value === top ? `≥ ${formatDegrees(value)}` : formatDegrees(value);
@@ -454,16 +492,26 @@ export class ViewerUi {
 
   #legendKey = '';
 
-  /** @param {string | null} text */
+  /**
+   * A notice over the view; a function is asked again after a change of language.
+   * @param {ChromeText} text
+   */
   showNotice(text) {
-    this.notice.hidden = text === null;
-    this.notice.textContent = text ?? '';
+    this.#notice = text;
+    const shown = typeof text === 'function' ? text() : text;
+    this.notice.hidden = shown === null;
+    this.notice.textContent = shown ?? '';
   }
 
-  /** @param {string | null} text */
-  showError(text) {
-    this.error.hidden = text === null;
-    /** @type {HTMLElement} */ (this.error.querySelector('p')).textContent = text ? `Could not show this model: ${text}` : '';
+  /**
+   * Why the model cannot be shown (null: it can); a function is asked again after a change of language.
+   * @param {ChromeText} reason
+   */
+  showError(reason) {
+    this.#error = reason;
+    const shown = typeof reason === 'function' ? reason() : reason;
+    this.error.hidden = shown === null;
+    /** @type {HTMLElement} */ (this.error.querySelector('p')).textContent = shown ? t('error.prefix', { reason: shown }) : '';
   }
 
   /** @param {boolean} on */
@@ -487,20 +535,6 @@ export class ViewerUi {
   }
 }
 
-/** Made once: a formatter per call would set one up for every notice. */
-const COUNT_FORMAT = new Intl.NumberFormat('en', { maximumFractionDigits: 0 });
+/** Text of the chrome that may be written again in another language: a string, or a function that writes it. @typedef {string | (() => string) | null} ChromeText */
 
-/**
- * A count with thousands separators (998,560).
- * @param {number} n a whole number
- */
-export function formatCount(n) {
-  return COUNT_FORMAT.format(n);
-}
-
-/** @param {number} bytes */
-export function formatBytes(bytes) {
-  if (bytes < 1024) return `${bytes} B`;
-  if (bytes < 1024 * 1024) return `${(bytes / 1024).toFixed(1)} KB`;
-  return `${(bytes / (1024 * 1024)).toFixed(2)} MB`;
-}
+export { formatBytes, formatCount } from './i18n/index.js';

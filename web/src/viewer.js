@@ -6,6 +6,7 @@
  * colour textures from colour-loader.js once the base mesh is on screen.
  */
 
+import { t } from './i18n/index.js';
 import { OrbitCamera } from './camera.js';
 import { ColourLoader } from './colour-loader.js';
 import { OrbitControls } from './controls.js';
@@ -143,10 +144,9 @@ const MESH_TOOLS = ['wireframe', 'relief', 'splats', 'measure'];
 const BUSY_RETRIES = 20;
 
 const REASONS = {
-  audience: () => 'the full-resolution scan is reserved for researchers',
-  device: (/** @type {string} */ device) => `that is the most detail sent to a ${device}`,
-  load: (/** @type {string} */ _, /** @type {number | null} */ retry) =>
-    `the server is busy${retry ? `; trying again every ${retry} s` : ''}`,
+  audience: () => t('cap.audience'),
+  device: (/** @type {string} */ device) => t(`cap.device.${device}`),
+  load: (/** @type {string} */ _, /** @type {number | null} */ retry) => (retry ? t('cap.busyRetry', { seconds: retry }) : t('cap.busy')),
 };
 
 export class Viewer {
@@ -859,10 +859,15 @@ export class Viewer {
     const { level, reason, retryAfterS } = this.#cap;
     const manifest = /** @type {Manifest} */ (this.manifest);
     const explain = REASONS[/** @type {keyof typeof REASONS} */ (reason ?? '')];
-    const why = explain ? explain(manifest.visitor.device, retryAfterS) : 'set by the server';
-    const message = `Refinement limited to level ${level} of ${manifest.last_level}: ${why}.`;
-    this.#set({ status: 'capped', message });
-    this.ui.showNotice(message);
+    // A function: the notice is written again when the visitor switches language.
+    const notice = () =>
+      t('cap.notice', {
+        level,
+        last: manifest.last_level,
+        why: explain ? explain(manifest.visitor.device, retryAfterS) : t('cap.server'),
+      });
+    this.#set({ status: 'capped', message: notice() });
+    this.ui.showNotice(notice);
     if (retryAfterS && !this.#retry) {
       // Plus 0–1 s of jitter, as for a 503: a crowd capped in the same
       // second must not come back in the same second.
@@ -938,7 +943,7 @@ export class Viewer {
       const wait = response.status === 503 ? retryAfterSeconds(response, body) : null;
       if (attempt !== undefined && wait !== null && tries < BUSY_RETRIES) {
         const seconds = Math.min(Math.ceil(wait), 300);
-        this.ui.showNotice(`Many visitors are arriving: starting in ${seconds} s`);
+        this.ui.showNotice(() => t('busy.waiting', { seconds }));
         await waitToRetry(seconds);
         if (attempt !== this.#attempt) throw new Error('stopped');
         continue;

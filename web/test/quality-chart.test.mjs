@@ -134,7 +134,7 @@ test('axes: the ends and powers of ten of the vertex counts; whole decades of er
   assert.ok(Math.abs(ys[1] - ys[2] - (ys[2] - ys[3])) < 1e-9);
   assert.equal(ys[0], layout.plot.bottom);
   assert.equal(ys[3], layout.plot.top);
-  assert.equal(describeLevel(curve, 3), 'Level 3: image RMSE 12.2 · colour RMSE 15.9 · Hausdorff 0.80 % of the diagonal');
+  assert.equal(describeLevel(curve, 3), 'Level 3: image RMSE 12.2 · colour RMSE 15.9 · Hausdorff 0.80% of the diagonal');
 });
 
 test('a quality study adds a bar per level with answers: the share of "sufficient"', async () => {
@@ -156,7 +156,7 @@ test('a quality study adds a bar per level with answers: the share of "sufficien
   assert.match(svg, /data-study-level="3" data-share="0.5"/);
   assert.match(svg, /sufficient %/);
   assert.equal(renderQualityChart(curve, 3).includes('data-study-level'), false, 'no study, no bars');
-  assert.equal(describeStudyLevel(study, 3), 'sufficient for 2 of 4 (50 %) in the quality study');
+  assert.equal(describeStudyLevel(study, 3), 'sufficient for 2 of 4 (50%) in the quality study');
   assert.equal(describeStudyLevel(study, 2), '');
   assert.equal(describeStudyLevel(null, 3), '');
 });

@@ -9,8 +9,8 @@ test('counts are grouped as toLocaleString("en") groups them', () => {
   }
 });
 
-test('bytes in B, KB, MB', () => {
-  assert.equal(formatBytes(512), '512 B');
-  assert.equal(formatBytes(89588), '87.5 KB');
+test('bytes in bytes, kB, MB (Intl units, English by default)', () => {
+  assert.equal(formatBytes(512), '512 bytes');
+  assert.equal(formatBytes(89588), '87.5 kB');
   assert.equal(formatBytes(676204 * 4), '2.58 MB');
 });

@@ -26,11 +26,15 @@
 //!   `iiif/`, which also carry a strong ETag of their bytes): `public,
 //!   max-age=300` ([`anonymous`]); the licence list, which changes with a
 //!   release: `public, max-age=3600`.
-//! - Errors: `no-store` (`error.rs`); pages: `no-cache` (`web.rs`).
+//! - Errors: `no-store` (`error.rs`); pages: `no-cache` ([`page`]), and
+//!   `Vary: Accept-Language` when their `<html lang>` was negotiated from it
+//!   (no `?lang=`: `language.rs`), so a shared cache never hands a Portuguese
+//!   page to a German visitor.
 //!
 //! Several layers (CORS, compression, these rules) name `Vary` headers; they
 //! are merged into one line ([`merge_vary`]), which every cache reads alike.
 
+use super::language::PageLanguage;
 use super::visitor::VisitorHints;
 use axum::http::{header, HeaderValue};
 use axum::response::Response;
@@ -77,6 +81,16 @@ pub fn anonymous(response: &mut Response, control: &'static str) {
     response
         .headers_mut()
         .insert(header::CACHE_CONTROL, HeaderValue::from_static(control));
+}
+
+/// A page of the viewer (`web.rs`): revalidated on every visit, and varying
+/// on `Accept-Language` when the page's language was read from it.
+pub fn page(response: &mut Response, language: PageLanguage) {
+    let headers = response.headers_mut();
+    headers.insert(header::CACHE_CONTROL, HeaderValue::from_static("no-cache"));
+    if language.negotiated {
+        headers.append(header::VARY, HeaderValue::from_static("Accept-Language"));
+    }
 }
 
 /// A download: `level_given` is whether `?level=` chose it (else it is the

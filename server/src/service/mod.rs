@@ -17,6 +17,7 @@ mod download;
 mod error;
 mod guard;
 mod iiif;
+mod language;
 mod layers;
 pub mod load;
 mod manifest;

@@ -111,7 +111,7 @@ fn list(viewer: Option<&Viewer>) -> OpenApiRouter<AppState> {
         .merge(ops_list())
         .routes(web::or_viewer(
             routes!(web::gallery),
-            viewer.map(Viewer::files),
+            viewer.map(Viewer::page),
         ))
         .routes(routes!(iiif::manifest))
         .routes(routes!(iiif::annotations))
@@ -123,16 +123,16 @@ fn list(viewer: Option<&Viewer>) -> OpenApiRouter<AppState> {
         .routes(routes!(web::model_page))
         .routes(web::or_viewer(
             routes!(web::embed_page),
-            viewer.map(Viewer::index),
+            viewer.map(Viewer::page),
         ))
         .routes(web::or_viewer(
             routes!(web::study_page),
-            viewer.map(Viewer::index),
+            viewer.map(Viewer::page),
         ))
         // The curators' page is never framed (a click-jacked "withdraw");
         // `/embed/{slug}` is the page other sites frame.
         .routes(
-            web::or_viewer(routes!(web::admin_page), viewer.map(Viewer::index))
+            web::or_viewer(routes!(web::admin_page), viewer.map(Viewer::page))
                 .map(|page| page.layer(axum::middleware::map_response(web::not_framed))),
         )
 }

@@ -4,8 +4,10 @@
 //! gallery so a fresh install shows something.
 
 use super::api::visible_models;
+use super::cache_headers;
 use super::curator::thumbnail;
 use super::error::{AppError, ErrorBody};
+use super::language::PageLanguage;
 use super::servable::{PathParams, ServableModel, SlugParam};
 use super::study::StudySlug;
 use super::visitor::{HintQuery, VisitorHints};
@@ -14,12 +16,12 @@ use crate::storage::{valid_slug, ModelKind, ModelRecord};
 use axum::extract::{Request, State};
 use axum::http::{header, HeaderMap, HeaderValue};
 use axum::response::{Html, IntoResponse, Response};
-use axum::routing::get_service;
+use axum::routing::{get, get_service, MethodRouter};
 use serde_json::json;
 use std::convert::Infallible;
 use std::path::{Path, PathBuf};
 use tower::Service;
-use tower_http::services::{ServeDir, ServeFile};
+use tower_http::services::ServeDir;
 use utoipa_axum::router::{UtoipaMethodRouter, UtoipaMethodRouterExt};
 
 /// The built web app, when `web_dir` has an `index.html`.
@@ -44,9 +46,31 @@ impl Viewer {
             .precompressed_gzip()
     }
 
-    /// The page every model route gets: the app reads the slug from the path.
-    pub fn index(&self) -> ServeFile {
-        ServeFile::new(&self.index)
+    /// The page every page route gets (the app reads the slug from the
+    /// path), its `<html lang dir>` in the visitor's language.
+    pub fn page(&self) -> MethodRouter {
+        let index = self.index.clone();
+        get(move |language: PageLanguage| {
+            let index = index.clone();
+            async move {
+                let html = read_index(&index)
+                    .await?
+                    .ok_or_else(|| AppError::Internal(format!("{} is gone", index.display())))?;
+                Ok::<_, AppError>(html_response(&html, language))
+            }
+        })
+    }
+}
+
+/// The viewer's `index.html`, `None` when there is no build.
+async fn read_index(index: &Path) -> Result<Option<String>, AppError> {
+    match tokio::fs::read_to_string(index).await {
+        Ok(html) => Ok(Some(html)),
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(None),
+        Err(e) => Err(AppError::Internal(format!(
+            "reading {}: {e}",
+            index.display()
+        ))),
     }
 }
 
@@ -128,19 +152,10 @@ pub async fn gallery(
 pub async fn model_page(
     State(state): State<AppState>,
     headers: HeaderMap,
+    language: PageLanguage,
     model: Result<ServableModel, AppError>,
 ) -> Result<Response, AppError> {
-    let index = state.config().web_dir.join("index.html");
-    let viewer = match tokio::fs::read_to_string(&index).await {
-        Ok(html) => Some(html),
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => None,
-        Err(e) => {
-            return Err(AppError::Internal(format!(
-                "reading {}: {e}",
-                index.display()
-            )))
-        }
-    };
+    let viewer = read_index(&state.config().web_dir.join("index.html")).await?;
     match (viewer, model) {
         (Some(html), Ok(model)) => {
             let tags = open_graph(&state, &headers, &model.record);
@@ -165,10 +180,10 @@ pub async fn model_page(
                 Some(at) => format!("{}{tags}{}", &html[..at], &html[at..]),
                 None => format!("{tags}{html}"),
             };
-            Ok(html_response(html))
+            Ok(html_response(&html, language))
         }
         // The viewer shows its own message for a model it cannot open.
-        (Some(html), Err(_)) => Ok(html_response(html)),
+        (Some(html), Err(_)) => Ok(html_response(&html, language)),
         (None, Ok(model)) => {
             let tags = open_graph(&state, &headers, &model.record);
             Ok(built_in_page(model, &tags))
@@ -297,14 +312,15 @@ fn structured_data(record: &ModelRecord, base: &str) -> String {
     format!("<script type=\"application/ld+json\">{text}</script>\n")
 }
 
-fn html_response(html: String) -> Response {
-    let mut response = Html(html).into_response();
-    let headers = response.headers_mut();
-    headers.insert(
+/// The viewer's page in `language` (its `<html lang dir>`), with the
+/// headers every page has.
+fn html_response(html: &str, language: PageLanguage) -> Response {
+    let mut response = Html(language.apply(html)).into_response();
+    response.headers_mut().insert(
         header::HeaderName::from_static("accept-ch"),
         HeaderValue::from_static("Sec-CH-UA-Mobile"),
     );
-    headers.insert(header::CACHE_CONTROL, HeaderValue::from_static("no-cache"));
+    cache_headers::page(&mut response, language);
     response
 }
 

@@ -215,3 +215,71 @@ async fn every_route_says_what_may_be_cached() {
     }
     server.shut_down().await;
 }
+
+/// The viewer's pages: `no-cache`, their `<html lang dir>` from `?lang=` or
+/// `Accept-Language`, and `Vary: Accept-Language` exactly when the header
+/// chose it, so a shared cache never hands one visitor's language to another.
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn pages_vary_on_the_language_they_negotiated() {
+    let db = TestDb::new(Backend::Sqlite).await.unwrap();
+    ingest_sample(&*db.storage, "vase", "open").await;
+    let web = tempfile::tempdir().unwrap();
+    std::fs::write(
+        web.path().join("index.html"),
+        "<!doctype html>\n<html>\n<head><title>Vitrine</title></head><body></body></html>\n",
+    )
+    .unwrap();
+    let mut config = test_config();
+    config.web_dir = web.path().to_owned();
+    let server = TestServer::start(db.storage.clone(), config).await;
+    let c = Client::new();
+    let page = |path: &str, accept: Option<&str>| {
+        let mut request = c.get(server.url(path));
+        if let Some(a) = accept {
+            request = request.header("accept-language", a);
+        }
+        async move {
+            let response = request.send().await.unwrap();
+            let h = response.headers().clone();
+            Answer {
+                status: response.status().as_u16(),
+                cache_control: h
+                    .get(CACHE_CONTROL)
+                    .map(|v| v.to_str().unwrap().to_owned())
+                    .unwrap_or_default(),
+                vary: h
+                    .get_all(VARY)
+                    .iter()
+                    .map(|v| v.to_str().unwrap().to_owned())
+                    .collect(),
+                body: response.text().await.unwrap(),
+            }
+        }
+    };
+    for path in ["/", "/m/vase", "/embed/vase", "/study/vase", "/admin"] {
+        let asked = page(path, Some("pt-BR,pt;q=0.9,en;q=0.5")).await;
+        assert_eq!(
+            (asked.status, asked.cache_control.as_str()),
+            (200, "no-cache"),
+            "{path}"
+        );
+        assert!(
+            asked.body.contains("<html lang=\"pt\" dir=\"ltr\">"),
+            "{path}: {}",
+            asked.body
+        );
+        assert!(varies_on(&asked, "Accept-Language"), "{path}");
+        let chosen = page(&format!("{path}?lang=ar"), Some("pt")).await;
+        assert!(
+            chosen.body.contains("<html lang=\"ar\" dir=\"rtl\">"),
+            "{path}"
+        );
+        assert!(!varies_on(&chosen, "Accept-Language"), "{path}");
+        let default = page(path, None).await;
+        assert!(
+            default.body.contains("<html lang=\"en\" dir=\"ltr\">"),
+            "{path}"
+        );
+    }
+    server.shut_down().await;
+}

@@ -10,12 +10,16 @@
  * status lines are live regions.
  */
 
+import { t } from '../i18n/index.js';
 import * as api from './api.js';
 
 const POLICIES = ['exhibition', 'open', 'researchers', 'open-download', 'exhibition-download'];
-const COLOURS = [['', 'default (ccc for a textured scan)'], ['ccc', 'ccc'], ['vertex', 'vertex'], ['vertex-metric', 'vertex-metric'], ['none', 'none']];
-const UNITS = [['', 'unknown'], ['mm', 'mm'], ['cm', 'cm'], ['m', 'm'], ['in', 'in']];
-const UP_AXES = [['', 'detect'], ...['x', 'y', 'z', '-x', '-y', '-z'].map((a) => [a, a])];
+/** Each option's value and what it shows: the value itself, or a catalogue key for the empty default. */
+const COLOURS = [['', 'admin.colour.default'], ...['ccc', 'vertex', 'vertex-metric', 'none'].map((c) => [c, c])];
+const UNITS = [['', 'admin.unit.unknown'], ...['mm', 'cm', 'm', 'in'].map((u) => [u, u])];
+const UP_AXES = [['', 'admin.up.detect'], ...['x', 'y', 'z', '-x', '-y', '-z'].map((a) => [a, a])];
+/** @param {string[]} option @returns {string} */
+const optionText = ([value, shown]) => (value === '' ? t(shown) : shown);
 /** The server's limit on a credit line, in bytes (maxlength counts characters: the server has the last word). */
 const CREDIT_MAX = 300;
 /** Form fields sent only when set: the server's defaults apply otherwise. */
@@ -58,7 +62,7 @@ function field(id, text, control) {
  * @param {string | null} [selected] a licence id
  */
 function licenceSelect(attributes, licences, selected = null) {
-  const select = /** @type {HTMLSelectElement} */ (el('select', attributes, [el('option', { value: '' }, ['— not stated —'])]));
+  const select = /** @type {HTMLSelectElement} */ (el('select', attributes, [el('option', { value: '' }, [t('admin.licence.none')])]));
   addLicences(select, licences);
   select.value = selected ?? '';
   return select;
@@ -76,7 +80,7 @@ function messageOf(e) {
 
 /** @param {HTMLElement} main */
 export function start(main) {
-  document.title = 'Vitrine admin';
+  document.title = t('admin.title');
   document.head.append(el('style', {}, [STYLE]));
   const page = new AdminPage(main);
   void page.refresh();
@@ -97,26 +101,26 @@ export class AdminPage {
     this.modelsKey = '';
     /** `GET /api/licences` (public), asked once; an empty list when it fails (the upload says why). */
     this.licences = api.licences().catch((e) => {
-      this.uploadStatus.textContent = `Licences: ${messageOf(e)}`;
+      this.uploadStatus.textContent = t('admin.licences', { reason: messageOf(e) });
       return /** @type {api.Licence[]} */ ([]);
     });
     this.form = this.uploadForm();
     main.replaceChildren(
       el('div', { class: 'admin' }, [
-        el('h1', {}, ['Vitrine admin']),
+        el('h1', {}, [t('admin.title')]),
         el('section', { 'aria-labelledby': 'token-h' }, [
-          el('h2', { id: 'token-h' }, ['Curator token']),
-          field('token', 'Token (from vitrine token create --scope curator)', this.tokenInput),
-          this.button('Use token', () => this.useToken()),
-          this.button('Forget token', () => this.forget()),
+          el('h2', { id: 'token-h' }, [t('admin.token.heading')]),
+          field('token', t('admin.token.field'), this.tokenInput),
+          this.button(t('admin.token.use'), () => this.useToken()),
+          this.button(t('admin.token.forget'), () => this.forget()),
           this.tokenStatus,
         ]),
-        el('section', { 'aria-labelledby': 'upload-h' }, [el('h2', { id: 'upload-h' }, ['Upload a scan']), this.form, this.uploadStatus]),
-        el('section', { 'aria-labelledby': 'jobs-h' }, [el('h2', { id: 'jobs-h' }, ['Ingest jobs']), this.jobList]),
-        el('section', { 'aria-labelledby': 'models-h' }, [el('h2', { id: 'models-h' }, ['Models']), this.modelList]),
+        el('section', { 'aria-labelledby': 'upload-h' }, [el('h2', { id: 'upload-h' }, [t('admin.upload.heading')]), this.form, this.uploadStatus]),
+        el('section', { 'aria-labelledby': 'jobs-h' }, [el('h2', { id: 'jobs-h' }, [t('admin.jobs.heading')]), this.jobList]),
+        el('section', { 'aria-labelledby': 'models-h' }, [el('h2', { id: 'models-h' }, [t('admin.models.heading')]), this.modelList]),
       ]),
     );
-    this.tokenStatus.textContent = api.savedToken() ? 'A token is set for this tab.' : 'No token yet.';
+    this.tokenStatus.textContent = api.savedToken() ? t('admin.token.set') : t('admin.token.none');
   }
 
   /** @param {string} text @param {() => unknown} action */
@@ -127,25 +131,26 @@ export class AdminPage {
   }
 
   uploadForm() {
-    const form = /** @type {HTMLFormElement} */ (el('form', { 'aria-label': 'Upload a scan' }));
+    const form = /** @type {HTMLFormElement} */ (el('form', { 'aria-label': t('admin.upload.heading') }));
     const policy = el('select', { name: 'policy' }, POLICIES.map((p) => el('option', { value: p }, [p])));
-    const colour = el('select', { name: 'colour' }, COLOURS.map(([v, t]) => el('option', { value: v }, [t])));
-    const unit = el('select', { name: 'unit' }, UNITS.map(([v, t]) => el('option', { value: v }, [t])));
-    const up = el('select', { name: 'up' }, UP_AXES.map(([v, t]) => el('option', { value: v }, [t])));
+    const options = (/** @type {string[][]} */ list) => list.map((o) => el('option', { value: o[0] }, [optionText(o)]));
+    const colour = el('select', { name: 'colour' }, options(COLOURS));
+    const unit = el('select', { name: 'unit' }, options(UNITS));
+    const up = el('select', { name: 'up' }, options(UP_AXES));
     const licence = licenceSelect({ name: 'licence' }, []);
     void this.licences.then((list) => addLicences(licence, list));
     form.append(
-      field('file', 'Scan (PLY, OBJ, OFF, GLB, glTF, MD2)', el('input', { type: 'file', name: 'file', required: '', accept: '.ply,.obj,.off,.glb,.gltf,.md2' })),
-      field('slug', 'Slug (a-z, 0-9, -)', el('input', { type: 'text', name: 'slug', required: '', pattern: '[a-z0-9]([a-z0-9-]{0,62}[a-z0-9])?' })),
-      field('title', 'Title', el('input', { type: 'text', name: 'title', required: '' })),
-      field('description', 'Description', el('textarea', { name: 'description', rows: '3' })),
-      field('policy', 'Audience policy', policy),
-      field('colour', 'Colour mode', colour),
-      field('unit', 'Unit of the coordinates', unit),
-      field('up', 'Up axis', up),
-      field('credit', 'Credit line (shown under the model)', el('input', { type: 'text', name: 'credit', maxlength: String(CREDIT_MAX) })),
-      field('licence', 'Licence', licence),
-      this.button('Upload', () => {}, 'submit'),
+      field('file', t('admin.field.file'), el('input', { type: 'file', name: 'file', required: '', accept: '.ply,.obj,.off,.glb,.gltf,.md2' })),
+      field('slug', t('admin.field.slug'), el('input', { type: 'text', name: 'slug', required: '', pattern: '[a-z0-9]([a-z0-9-]{0,62}[a-z0-9])?' })),
+      field('title', t('admin.field.title'), el('input', { type: 'text', name: 'title', required: '' })),
+      field('description', t('admin.field.description'), el('textarea', { name: 'description', rows: '3' })),
+      field('policy', t('admin.field.policy'), policy),
+      field('colour', t('admin.field.colour'), colour),
+      field('unit', t('admin.field.unit'), unit),
+      field('up', t('admin.field.up'), up),
+      field('credit', t('admin.field.credit'), el('input', { type: 'text', name: 'credit', maxlength: String(CREDIT_MAX) })),
+      field('licence', t('admin.field.licence'), licence),
+      this.button(t('admin.upload'), () => {}, 'submit'),
     );
     form.addEventListener('submit', (event) => {
       event.preventDefault();
@@ -158,13 +163,13 @@ export class AdminPage {
   async submit(form) {
     const data = new FormData(form);
     for (const name of OPTIONAL_FIELDS) if (String(data.get(name) ?? '').trim() === '') data.delete(name);
-    this.uploadStatus.textContent = 'Uploading…';
+    this.uploadStatus.textContent = t('admin.uploading');
     try {
       const { job } = await api.upload(data);
-      this.uploadStatus.textContent = `Uploaded: ingest job ${job} started.`;
+      this.uploadStatus.textContent = t('admin.uploaded', { job: String(job) });
       form.reset();
     } catch (e) {
-      this.uploadStatus.textContent = `Upload refused: ${messageOf(e)}`;
+      this.uploadStatus.textContent = t('admin.refused', { reason: messageOf(e) });
     }
     await this.refresh();
   }
@@ -172,13 +177,13 @@ export class AdminPage {
   useToken() {
     api.saveToken(this.tokenInput.value.trim() || null);
     this.tokenInput.value = '';
-    this.tokenStatus.textContent = api.savedToken() ? 'A token is set for this tab.' : 'No token yet.';
+    this.tokenStatus.textContent = api.savedToken() ? t('admin.token.set') : t('admin.token.none');
     void this.refresh();
   }
 
   forget() {
     api.saveToken(null);
-    this.tokenStatus.textContent = 'No token yet.';
+    this.tokenStatus.textContent = t('admin.token.none');
     this.jobList.replaceChildren();
   }
 
@@ -192,7 +197,7 @@ export class AdminPage {
         busy = jobs.some((j) => j.state === 'queued' || j.state === 'running');
         this.showJobs(jobs);
       } catch (e) {
-        this.jobList.replaceChildren(el('li', { class: 'error' }, [`Jobs: ${messageOf(e)}`]));
+        this.jobList.replaceChildren(el('li', { class: 'error' }, [t('admin.jobs.failed', { reason: messageOf(e) })]));
       }
     }
     await this.showModels();
@@ -202,19 +207,20 @@ export class AdminPage {
   /** @param {api.Job[]} jobs */
   showJobs(jobs) {
     if (jobs.length === 0) {
-      this.jobList.replaceChildren(el('li', {}, ['No uploads yet.']));
+      this.jobList.replaceChildren(el('li', {}, [t('admin.jobs.none')]));
       return;
     }
     this.jobList.replaceChildren(
       ...jobs.map((j) => {
         const item = el('li', { 'data-job': String(j.id), 'data-state': j.state }, [
-          `${j.title} (${j.slug}, ${j.source_name}): ${j.state}`,
+          // The state and the stage are the service's words (queued, running, done, failed).
+          t('admin.job', { title: j.title, slug: j.slug, file: j.source_name, state: j.state }),
           ' ',
-          el('progress', { max: '1', value: String(j.progress), 'aria-label': `progress of ${j.slug}` }),
+          el('progress', { max: '1', value: String(j.progress), 'aria-label': t('admin.job.progress', { slug: j.slug }) }),
           ` ${j.stage}`,
         ]);
-        if (j.state === 'failed') item.append(el('div', { class: 'error' }, [j.error ?? 'failed']));
-        if (j.state === 'done') item.append(' ', el('a', { href: `/m/${j.slug}` }, [`open version ${j.model_version}`]));
+        if (j.state === 'failed') item.append(el('div', { class: 'error' }, [j.error ?? t('admin.job.failed')]));
+        if (j.state === 'done') item.append(' ', el('a', { href: `/m/${j.slug}` }, [t('admin.job.open', { version: String(j.model_version) })]));
         return item;
       }),
     );
@@ -242,7 +248,7 @@ export class AdminPage {
           const item = el('li', { 'data-slug': m.slug }, [
             el('a', { href: `/m/${m.slug}` }, [m.title]),
             ' ',
-            this.button(`Versions of ${m.slug}`, () => this.showVersions(item, m.slug, versions)),
+            this.button(t('admin.versions', { slug: m.slug }), () => this.showVersions(item, m.slug, versions)),
             versions,
           ]);
           if (open.has(m.slug)) void this.showVersions(item, m.slug, versions);
@@ -251,7 +257,7 @@ export class AdminPage {
       );
     } catch (e) {
       this.modelsKey = '';
-      this.modelList.replaceChildren(el('li', { class: 'error' }, [`Models: ${messageOf(e)}`]));
+      this.modelList.replaceChildren(el('li', { class: 'error' }, [t('admin.models.failed', { reason: messageOf(e) })]));
     }
   }
 
@@ -289,13 +295,16 @@ export class AdminPage {
         status.textContent = messageOf(e);
       }
     };
-    const withdraw = v.status === 'ready' ? 'Withdraw' : 'Restore';
-    const entry = el('li', { 'data-version': String(v.version) }, [
-      `Version ${v.version} (${v.status}, ${v.levels} levels, ${v.policy}) `,
-      this.button(`${withdraw} version ${v.version}`, () => apply({ status: v.status === 'ready' ? 'withdrawn' : 'ready' })),
-      el('label', { for: id }, [`Good-enough level (empty: the 20 % rule)`]),
+    const version = String(v.version);
+    const withdraw = v.status === 'ready' ? t('admin.version.withdraw', { version }) : t('admin.version.restore', { version });
+    const entry = el('li', { 'data-version': version }, [
+      // The status and the policy are the service's words.
+      t('admin.version', { version, status: v.status, count: v.levels, policy: v.policy }),
+      ' ',
+      this.button(withdraw, () => apply({ status: v.status === 'ready' ? 'withdrawn' : 'ready' })),
+      el('label', { for: id }, [t('admin.version.goodEnough')]),
       level,
-      this.button('Set level', () => apply({ good_enough_level: level.value === '' ? null : Number(level.value) })),
+      this.button(t('admin.version.setLevel'), () => apply({ good_enough_level: level.value === '' ? null : Number(level.value) })),
       status,
       this.rightsForm(slug, v, licences, apply),
     ]);
@@ -312,6 +321,7 @@ export class AdminPage {
    * @param {(change: api.VersionChange) => Promise<void>} apply
    */
   rightsForm(slug, v, licences, apply) {
+    const version = String(v.version);
     const name = licences.find((l) => l.id === v.licence)?.name ?? v.licence;
     const credit = /** @type {HTMLInputElement} */ (
       el('input', { type: 'text', id: `credit-${slug}-${v.version}`, maxlength: String(CREDIT_MAX) })
@@ -319,13 +329,15 @@ export class AdminPage {
     credit.value = v.credit ?? '';
     const licence = licenceSelect({ id: `licence-${slug}-${v.version}` }, licences, v.licence ?? null);
     const form = /** @type {HTMLFormElement} */ (
-      el('form', { class: 'rights', 'aria-label': `Credit and licence of version ${v.version}` }, [
-        el('p', { class: 'rights-now' }, [`Credit: ${v.credit ?? 'not stated'} · Licence: ${name ?? 'not stated'}`]),
-        el('label', { for: credit.id }, [`Credit line of version ${v.version}`]),
+      el('form', { class: 'rights', 'aria-label': t('admin.rights', { version }) }, [
+        el('p', { class: 'rights-now' }, [
+          t('admin.rights.now', { credit: v.credit ?? t('admin.rights.notStated'), licence: name ?? t('admin.rights.notStated') }),
+        ]),
+        el('label', { for: credit.id }, [t('admin.rights.credit', { version })]),
         credit,
-        el('label', { for: licence.id }, [`Licence of version ${v.version}`]),
+        el('label', { for: licence.id }, [t('admin.rights.licence', { version })]),
         licence,
-        this.button(`Save credit and licence of version ${v.version}`, () => {}, 'submit'),
+        this.button(t('admin.rights.save', { version }), () => {}, 'submit'),
       ])
     );
     form.addEventListener('submit', (event) => {

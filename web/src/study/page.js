@@ -9,6 +9,7 @@
  */
 
 import '../element.js';
+import { formatNumber, t } from '../i18n/index.js';
 import { StudyApi, StudyError } from './api.js';
 import { ViewLog } from './log.js';
 import { StepMachine } from './machine.js';
@@ -20,22 +21,22 @@ import { StepMachine } from './machine.js';
 /** One turn of the original's turntable. */
 const TURNTABLE_MS = 15_000;
 
-/** The two questions (thesis §6.6.2); values as the API takes them. */
+/** The two questions (thesis §6.6.2); values as the API takes them, texts as catalogue keys. */
 export const QUESTIONS = {
   improvement: {
-    legend: 'Did you perceive an improvement during this step?',
+    legend: 'study.improvement',
     options: /** @type {const} */ ([
-      ['none', 'None'],
-      ['a-little', 'A little'],
-      ['improved', 'Improved'],
-      ['greatly', 'Greatly'],
+      ['none', 'study.improvement.none'],
+      ['a-little', 'study.improvement.aLittle'],
+      ['improved', 'study.improvement.improved'],
+      ['greatly', 'study.improvement.greatly'],
     ]),
   },
   sufficient: {
-    legend: 'Is this quality sufficient?',
+    legend: 'study.sufficient',
     options: /** @type {const} */ ([
-      ['yes', 'Yes'],
-      ['no', 'No'],
+      ['yes', 'study.sufficient.yes'],
+      ['no', 'study.sufficient.no'],
     ]),
   },
 };
@@ -101,14 +102,14 @@ export class StudyPage {
     try {
       info = await this.api.info();
     } catch (error) {
-      if (error instanceof StudyError && error.status === 403) this.#closed(`This study is closed. ${error.message}`);
-      else if (error instanceof StudyError && error.status === 404) this.#closed('There is no such model.');
-      else this.#closed(`The study could not be loaded: ${error instanceof Error ? error.message : error}`);
+      if (error instanceof StudyError && error.status === 403) this.#closed(t('study.closed', { reason: error.message }));
+      else if (error instanceof StudyError && error.status === 404) this.#closed(t('study.noModel'));
+      else this.#closed(t('study.loadFailed', { reason: reason(error) }));
       return;
     }
-    document.title = `Quality study: ${info.title} · Vitrine`;
+    document.title = t('study.tabTitle', { title: info.title });
     if (info.invitation === 'finished') {
-      this.#message('Thank you', 'You have already taken part in this study with this invitation.');
+      this.#message(t('study.thanks'), t('study.alreadyInvitation'));
       return;
     }
     this.#information(info);
@@ -118,7 +119,7 @@ export class StudyPage {
   #closed(text) {
     document.body.classList.add('study-closed');
     this.panel.className = 'study-panel study-page';
-    this.panel.replaceChildren(el('h1', {}, ['Quality study']), el('p', { role: 'alert' }, [text]));
+    this.panel.replaceChildren(el('h1', {}, [t('study.heading')]), el('p', { role: 'alert' }, [text]));
   }
 
   /** @param {string} title @param {string} text */
@@ -134,34 +135,27 @@ export class StudyPage {
   #information(info) {
     this.panel.className = 'study-panel study-page';
     const minutes = Math.max(1, Math.round((info.step_count * (2 * info.seconds + 10) + 60) / 60));
-    const next = button('Continue', { class: 'primary' });
-    const heading = el('h1', { tabindex: '-1' }, [`Quality study: ${info.title}`]);
+    const next = button(t('study.continue'), { class: 'primary' });
+    const heading = el('h1', { tabindex: '-1' }, [t('study.titled', { title: info.title })]);
     this.panel.replaceChildren(
       heading,
-      el('p', {}, [
-        'You will look at a 3D scan while it is shown at increasing levels of detail, and say what you see. ',
-        `It takes about ${minutes} minutes.`,
-      ]),
+      el('p', {}, [t('study.intro'), ' ', t('study.duration', { count: minutes })]),
       el('ol', {}, [
-        el('li', {}, ['A short practice: turn and zoom the model to get used to the controls.']),
-        el('li', {}, ['The original at its full detail, turning by itself (you can replay it).']),
-        el('li', {}, [
-          `${info.step_count} steps. In each, the model is shown for at least ${formatSeconds(info.seconds)}, `,
-          `its detail may then change, and it is shown for at least ${formatSeconds(info.seconds)} more. `,
-          'You may turn and zoom it freely meanwhile.',
-        ]),
+        el('li', {}, [t('study.plan.practice')]),
+        el('li', {}, [t('study.plan.original')]),
+        el('li', {}, [t('study.plan.steps', { count: info.step_count, time: formatSeconds(info.seconds) })]),
       ]),
-      el('p', {}, ['After each step the model stops responding and two questions appear:']),
+      el('p', {}, [t('study.plan.questions')]),
       el('dl', {}, [
-        el('dt', {}, [QUESTIONS.improvement.legend]),
-        el('dd', {}, ['None, a little, improved, or greatly: whether the model looked better by the end of the step than at its start. If unsure, answer "Improved".']),
-        el('dt', {}, [QUESTIONS.sufficient.legend]),
-        el('dd', {}, ['Yes or no: whether the model as it is now shown would be good enough for you to look at the object.']),
+        el('dt', {}, [t(QUESTIONS.improvement.legend)]),
+        el('dd', {}, [t('study.improvement.help')]),
+        el('dt', {}, [t(QUESTIONS.sufficient.legend)]),
+        el('dd', {}, [t('study.sufficient.help')]),
       ]),
       el('p', { class: 'actions' }, [next]),
     );
     if (info.invitation === 'started') {
-      heading.after(el('p', { class: 'study-resume' }, ['You have started this study before: it continues where you left off.']));
+      heading.after(el('p', { class: 'study-resume' }, [t('study.resume')]));
     }
     heading.focus();
     next.onclick = () => this.#consent();
@@ -169,29 +163,25 @@ export class StudyPage {
 
   #consent() {
     const box = /** @type {HTMLInputElement} */ (el('input', { type: 'checkbox', id: 'study-consent' }));
-    const start = button('Start', { class: 'primary' });
-    const heading = el('h1', { tabindex: '-1' }, ['Consent']);
+    const start = button(t('study.start'), { class: 'primary' });
+    const heading = el('h1', { tabindex: '-1' }, [t('study.consent')]);
     this.panel.replaceChildren(
       heading,
-      el('p', {}, [
-        'If you agree, this page stores your answers, how you moved the camera during the study, ',
-        'and your kind of device, window size and pixel ratio. They are kept under a random participant ',
-        'code, never with your name or address, and used only to choose how much detail this model needs.',
-      ]),
-      el('p', {}, ['Nothing is stored unless you agree. You may stop at any time by closing the page.']),
-      el('p', { class: 'consent' }, [box, el('label', { for: 'study-consent' }, ['I agree to take part and to the storing described above'])]),
+      el('p', {}, [t('study.consent.stored')]),
+      el('p', {}, [t('study.consent.nothing')]),
+      el('p', { class: 'consent' }, [box, el('label', { for: 'study-consent' }, [t('study.consent.agree')])]),
       el('p', { class: 'actions' }, [start]),
       this.status,
     );
     heading.focus();
     start.onclick = async () => {
       if (!box.checked) {
-        this.#say('Please tick the box to agree first, or close the page to leave.');
+        this.#say(t('study.consent.tick'));
         box.focus();
         return;
       }
       start.disabled = true;
-      this.#say('Starting…');
+      this.#say(t('study.starting'));
       try {
         const plan = await this.api.start({
           device: deviceClass(),
@@ -201,8 +191,8 @@ export class StudyPage {
         this.#begin(plan);
       } catch (error) {
         start.disabled = false;
-        if (error instanceof StudyError && error.status === 409) this.#message('Thank you', 'You have already taken part in this study.');
-        else this.#say(`The study could not start: ${error instanceof Error ? error.message : error}`);
+        if (error instanceof StudyError && error.status === 409) this.#message(t('study.thanks'), t('study.already'));
+        else this.#say(t('study.startFailed', { reason: reason(error) }));
       }
     };
   }
@@ -248,7 +238,7 @@ export class StudyPage {
       this.log?.interaction(kind);
     });
     element.addEventListener('vitrine-error', (event) => {
-      this.#say(`The model could not be shown: ${/** @type {CustomEvent<{ message: string }>} */ (event).detail.message}`);
+      this.#say(t('study.modelFailed', { reason: /** @type {CustomEvent<{ message: string }>} */ (event).detail.message }));
     });
     this.stage.replaceChildren(element);
     this.viewerElement = element;
@@ -265,16 +255,16 @@ export class StudyPage {
     const level = Math.max(0, Math.floor(plan.last_level / 2));
     const viewer = this.#mountViewer(level);
     this.log?.enter(0, 'practice');
-    const next = button('Continue', { class: 'primary' });
+    const next = button(t('study.continue'), { class: 'primary' });
     this.panel.className = 'study-panel study-overlay';
     this.panel.replaceChildren(
-      el('h2', {}, ['Practice']),
-      el('p', {}, ['Drag to turn the model, scroll or pinch to zoom, right-drag or drag with two fingers to move it. Arrow keys turn it, + and − zoom, when it has focus.']),
+      el('h2', {}, [t('study.practice')]),
+      el('p', {}, [t('study.practice.help')]),
       el('p', { class: 'actions' }, [next]),
       this.status,
     );
-    this.#say('Practice: the model is loading.');
-    void viewer.whenShown(level).then(() => this.#say('Practice: try the controls, then continue.'));
+    this.#say(t('study.practice.loading'));
+    void viewer.whenShown(level).then(() => this.#say(t('study.practice.ready')));
     next.focus();
     next.onclick = () => this.#original(viewer);
   }
@@ -285,22 +275,22 @@ export class StudyPage {
     const last = plan.last_level;
     this.log?.enter(0, 'original');
     viewer.display(last);
-    const replay = button('Replay');
-    const begin = button('Begin the steps', { class: 'primary' });
+    const replay = button(t('study.replay'));
+    const begin = button(t('study.begin'), { class: 'primary' });
     replay.disabled = true;
     this.panel.replaceChildren(
-      el('h2', {}, ['The original']),
-      el('p', {}, ['This is the model at its full detail, turning once. Replay it as often as you like, then begin.']),
+      el('h2', {}, [t('study.original')]),
+      el('p', {}, [t('study.original.help')]),
       el('p', { class: 'actions' }, [replay, begin]),
       this.status,
     );
-    this.#say('The original is loading…');
+    this.#say(t('study.original.loading'));
     const turn = () => {
       replay.disabled = true;
-      this.#say('The original, turning.');
+      this.#say(t('study.original.turning'));
       void viewer.turntable(TURNTABLE_MS).then(() => {
         replay.disabled = false;
-        if (this.viewerElement?.viewer === viewer) this.#say('The original: replay it, or begin the steps.');
+        if (this.viewerElement?.viewer === viewer) this.#say(t('study.original.done'));
       });
     };
     void viewer.whenShown(last).then(turn);
@@ -352,7 +342,7 @@ export class StudyPage {
     }
     if (change.state === 'loading') {
       this.panel.replaceChildren(this.status);
-      this.#say(`Step ${change.step} of ${total}: the model is loading.`);
+      this.#say(t('study.step.loading', { step: change.step, total }));
       return;
     }
     this.log?.enter(change.step, change.state, change.at);
@@ -362,7 +352,7 @@ export class StudyPage {
     }
     if (change.state === 'pre') {
       this.panel.replaceChildren(this.status);
-      this.#say(`Step ${change.step} of ${total}: look at the model; you may turn and zoom it. The questions follow.`);
+      this.#say(t('study.step.look', { step: change.step, total }));
     }
   }
 
@@ -373,11 +363,11 @@ export class StudyPage {
    */
   #questions(step, total) {
     const form = /** @type {HTMLFormElement} */ (el('form', { class: 'study-questions', 'aria-labelledby': 'study-q-title' }));
-    const title = el('h2', { id: 'study-q-title' }, [`Step ${step} of ${total}: your answers`]);
-    const submit = /** @type {HTMLButtonElement} */ (el('button', { type: 'submit', class: 'primary' }, ['Submit answers']));
+    const title = el('h2', { id: 'study-q-title' }, [t('study.step.answers', { step, total })]);
+    const submit = /** @type {HTMLButtonElement} */ (el('button', { type: 'submit', class: 'primary' }, [t('study.submit')]));
     form.append(title, radioGroup('improvement', step), radioGroup('sufficient', step), el('p', { class: 'actions' }, [submit]));
     this.panel.replaceChildren(form, this.status);
-    this.#say(`Step ${step} of ${total}: the model is paused. Answer the two questions.`);
+    this.#say(t('study.step.paused', { step, total }));
     /** @type {HTMLInputElement | null} */ (form.querySelector('input'))?.focus();
     form.onsubmit = async (event) => {
       event.preventDefault();
@@ -385,14 +375,14 @@ export class StudyPage {
       const improvement = data.get('improvement');
       const sufficient = data.get('sufficient');
       if (!improvement || !sufficient) {
-        this.#say('Please answer both questions.');
+        this.#say(t('study.answerBoth'));
         return;
       }
       const machine = /** @type {StepMachine} */ (this.machine);
       const timing = machine.answer();
       if (!timing) return;
       submit.disabled = true;
-      this.#say('Saving your answers…');
+      this.#say(t('study.saving'));
       try {
         await this.api.answer(timing.step, {
           improvement: /** @type {import('./api.js').Improvement} */ (String(improvement)),
@@ -402,7 +392,7 @@ export class StudyPage {
       } catch (error) {
         machine.failed();
         submit.disabled = false;
-        this.#say(`Your answers could not be saved: ${error instanceof Error ? error.message : error}. Please try again.`);
+        this.#say(t('study.saveFailed', { reason: reason(error) }));
         return;
       }
       void this.log?.flush();
@@ -412,18 +402,18 @@ export class StudyPage {
 
   async #finish() {
     this.machine?.stop();
-    this.#say('Finishing…');
+    this.#say(t('study.finishing'));
     try {
       await this.log?.flush();
       await this.api.finish();
     } catch (error) {
-      this.#say(`The study could not be finished: ${error instanceof Error ? error.message : error}`);
+      this.#say(t('study.finishFailed', { reason: reason(error) }));
       return;
     } finally {
       this.log?.stop();
     }
-    this.#message('Thank you', 'Your answers are saved. You may close this page.');
-    this.#say('The study is complete.');
+    this.#message(t('study.thanks'), t('study.saved'));
+    this.#say(t('study.complete'));
   }
 
   /** @param {string} text */
@@ -439,17 +429,24 @@ export class StudyPage {
  */
 function radioGroup(name, step) {
   const question = QUESTIONS[name];
-  const legend = el('legend', {}, [question.legend]);
+  const legend = el('legend', {}, [t(question.legend)]);
   const fieldset = el('fieldset', { class: `study-q study-q-${name}` }, [legend]);
   for (const [value, label] of question.options) {
     const id = `study-${step}-${name}-${value}`;
     const input = el('input', { type: 'radio', name, value, id, required: '' });
-    fieldset.append(el('label', { for: id }, [input, ` ${label}`]));
+    fieldset.append(el('label', { for: id }, [input, ' ', t(label)]));
   }
   return fieldset;
 }
 
-/** @param {number} seconds */
+/** @param {number} seconds a step's time, in the page's language ("4 seconds", "4 segundos") */
 function formatSeconds(seconds) {
-  return seconds >= 1 ? `${Number(seconds.toFixed(1))} seconds` : `${Math.round(seconds * 1000)} ms`;
+  return seconds >= 1
+    ? formatNumber(Number(seconds.toFixed(1)), { style: 'unit', unit: 'second', unitDisplay: 'long' })
+    : formatNumber(Math.round(seconds * 1000), { style: 'unit', unit: 'millisecond' });
+}
+
+/** @param {unknown} error the reason to show after a translated sentence */
+function reason(error) {
+  return error instanceof Error ? error.message : String(error);
 }
