@@ -22,7 +22,10 @@ async fn get(client: &Client, url: &str, token: Option<&str>) -> Answer {
     if let Some(t) = token {
         request = request.bearer_auth(t);
     }
-    let response = request.send().await.unwrap();
+    answer(request.send().await.unwrap()).await
+}
+
+async fn answer(response: reqwest::Response) -> Answer {
     let h = response.headers().clone();
     Answer {
         status: response.status().as_u16(),
@@ -238,23 +241,7 @@ async fn pages_vary_on_the_language_they_negotiated() {
         if let Some(a) = accept {
             request = request.header("accept-language", a);
         }
-        async move {
-            let response = request.send().await.unwrap();
-            let h = response.headers().clone();
-            Answer {
-                status: response.status().as_u16(),
-                cache_control: h
-                    .get(CACHE_CONTROL)
-                    .map(|v| v.to_str().unwrap().to_owned())
-                    .unwrap_or_default(),
-                vary: h
-                    .get_all(VARY)
-                    .iter()
-                    .map(|v| v.to_str().unwrap().to_owned())
-                    .collect(),
-                body: response.text().await.unwrap(),
-            }
-        }
+        async move { answer(request.send().await.unwrap()).await }
     };
     for path in ["/", "/m/vase", "/embed/vase", "/study/vase", "/admin"] {
         let asked = page(path, Some("pt-BR,pt;q=0.9,en;q=0.5")).await;
