@@ -29,6 +29,7 @@ mod gates;
 mod halfedge;
 mod inspect;
 mod mesh;
+mod meter;
 mod patch;
 mod predict;
 mod priors;
@@ -36,7 +37,7 @@ mod quantize;
 mod room;
 mod training;
 
-pub use bits::{bit_budget, PassBits};
+pub use bits::bit_budget;
 pub use charts::MAX_CHARTS;
 pub use decoder::{decode, ChartLevel, Decoder, Limits};
 pub use encoder::{
@@ -48,6 +49,7 @@ pub use format::{BatchChunk, Header, LevelInfo, StreamIndex, CHARTED_VERSION, MA
 pub use gates::GateStatistics;
 pub use inspect::{breakdown, LevelBreakdown};
 pub use mesh::IndexedMesh;
+pub use meter::PassBits;
 pub use quantize::Quantization;
 
 #[cfg(test)]

@@ -22,7 +22,7 @@ pub(crate) struct Scratch {
     valences: Vec<u8>,
     predictions: Vec<PatchPrediction>,
     /// Measures where the bits go ([`crate::bits`]); `None` when decoding.
-    pub meter: Option<Box<crate::bits::Meter>>,
+    pub meter: Option<Box<crate::meter::Meter>>,
 }
 
 impl Scratch {
@@ -202,7 +202,7 @@ impl Level {
         }
         scratch.decoded = decoded;
         if let Some(meter) = scratch.meter.as_mut() {
-            meter.record(&crate::bits::PassView {
+            meter.record(&crate::meter::PassView {
                 kind: pass.kind,
                 sections: [
                     pass.connectivity.len(),

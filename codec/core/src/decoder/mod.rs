@@ -189,9 +189,14 @@ impl Decoder {
     /// returns the meter that was running.
     pub(crate) fn meter(
         &mut self,
-        meter: Option<Box<crate::bits::Meter>>,
-    ) -> Option<Box<crate::bits::Meter>> {
+        meter: Option<Box<crate::meter::Meter>>,
+    ) -> Option<Box<crate::meter::Meter>> {
         std::mem::replace(&mut self.scratch.meter, meter)
+    }
+
+    /// The level's connectivity and quantized positions (for the meter).
+    pub(crate) fn connectivity_and_positions(&self) -> (&Connectivity, &[[i32; 3]]) {
+        (&self.level.conn, &self.level.positions_q)
     }
 
     /// The batch the meter attributes the next passes to.

@@ -14,6 +14,7 @@
 mod ids;
 pub mod import;
 mod presentation;
+mod values;
 mod web_annotation;
 
 use super::api::visible_models;

@@ -13,6 +13,7 @@
 //! text of unknown language. Vitrine's own labels ("Attribution") are `en`.
 
 use super::ids::{self, Ids, CONTEXT};
+use super::values::{language_map, point_selector};
 use super::web_annotation;
 use crate::service::scene::SceneFrame;
 use crate::storage::{AnnotationRecord, Bounds, ModelRecord, Rights};
@@ -34,13 +35,6 @@ pub struct ManifestInput<'a> {
     pub annotations: &'a [AnnotationRecord],
     /// `/api/models/{slug}/thumbnail?v=…`, when the version has one.
     pub thumbnail: Option<String>,
-}
-
-/// `{key: [text]}`: a Presentation language map of one value.
-pub fn language_map(language: Option<&str>, text: &str) -> Value {
-    let mut map = serde_json::Map::new();
-    map.insert(language.unwrap_or("none").to_owned(), json!([text]));
-    Value::Object(map)
 }
 
 /// The Manifest of a model. A model whose policy offers the public no
@@ -257,10 +251,6 @@ fn camera_and_light(ids: &Ids<'_>, scene_ref: &Value, bounds: &Bounds) -> [Value
         "target": placed(at([0.3, 0.8, 0.52], 2.0 * radius)),
     });
     [camera, light]
-}
-
-pub fn point_selector(p: [f64; 3]) -> Value {
-    json!({ "type": "PointSelector", "x": p[0], "y": p[1], "z": p[2] })
 }
 
 /// One entry of the Collection.

@@ -16,7 +16,7 @@
 //! plain text, a target that is not a point on this model's Scene.
 
 use super::ids::Ids;
-use super::presentation::{language_map, point_selector};
+use super::values::{language_map, point_selector};
 use crate::service::scene::SceneFrame;
 use crate::storage::AnnotationRecord;
 use serde_json::{json, Map, Value};
