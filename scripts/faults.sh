@@ -34,8 +34,10 @@ export RUST_BACKTRACE=0 RUST_LOG=${RUST_LOG:-warn}
 bin=$root/target/release/vitrine
 load=$root/target/release/vitrine-load
 if [ -z "${NO_BUILD:-}" ]; then
-    cargo build --release -p vitrine
-    cargo build --release -p vitrine-load
+    # One build of both, as scripts/build.sh makes it: built apart, the two
+    # unify their dependencies' features differently and the second build
+    # recompiles tokio, hyper, sqlx and the service.
+    cargo build --release -p vitrine -p vitrine-load
 fi
 ulimit -n "$(ulimit -Hn)" 2>/dev/null || true
 mesh=${MESH:-$root/../shared/data/meshes/igea.ply}

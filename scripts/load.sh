@@ -29,8 +29,10 @@ short=0
 [ "${1:-}" = --short ] && short=1
 
 export RUST_BACKTRACE=0
-cargo build --release -p vitrine
-cargo build --release -p vitrine-load
+# One build of both, as scripts/build.sh makes it: built apart, the two
+# unify their dependencies' features differently and the second build
+# recompiles tokio, hyper, sqlx and the service.
+cargo build --release -p vitrine -p vitrine-load
 bin=$root/target/release/vitrine
 load=$root/target/release/vitrine-load
 # Each visitor holds a connection in the harness and one in the server.

@@ -464,3 +464,52 @@ fn lod_glbs_of_a_textured_and_of_a_coloured_scan() {
         assert_eq!(got, colour_of(p), "GLB vertex {g}");
     }
 }
+
+#[test]
+fn lod_repairs_a_slightly_broken_md2_as_every_other_import() {
+    // The sample, plus what real models carry: a third face on one edge
+    // (non-manifold) and a face with a repeated corner (degenerate).
+    let mut model = sample_md2(24, 16, 3);
+    let first = model.triangles[0];
+    model
+        .triangles
+        .push(vitrine_mesh::import::md2::Md2Triangle {
+            vertex: [first.vertex[1], first.vertex[0], 200],
+            st: [first.st[1], first.st[0], 0],
+        });
+    model
+        .triangles
+        .push(vitrine_mesh::import::md2::Md2Triangle {
+            vertex: [5, 5, 6],
+            st: [5, 5, 6],
+        });
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("broken.md2");
+    let mut bytes = Vec::new();
+    write_md2(&model, &mut bytes).unwrap();
+    std::fs::write(&input, bytes).unwrap();
+    let out = dir.path().join("broken.glb");
+    let log = succeeds(&["lod", text(&input), "--format", "md2", "-o", text(&out)]);
+    assert!(
+        log.contains("repair:") && log.contains("non-manifold"),
+        "{log}"
+    );
+    assert!(log.contains("degenerate"), "{log}");
+    let mut sizes = Vec::new();
+    for p in [100usize, 80, 60, 40, 20] {
+        let path = dir.path().join(format!("broken-{p}.md2"));
+        let level = Md2::parse(&std::fs::read(&path).unwrap(), &ImportOptions::default()).unwrap();
+        assert_eq!(level.frames.len(), 3);
+        sizes.push(level.vertex_count());
+        let mesh = import_path(&path, &ImportOptions::default()).unwrap();
+        check_manifold(&vitrine_samples::compact(mesh)).unwrap();
+    }
+    // The split copies a vertex or more: exact percentages of the repaired model.
+    assert!(sizes[0] > 384, "{sizes:?}");
+    for (p, &n) in [100usize, 80, 60, 40, 20].iter().zip(&sizes) {
+        assert_eq!(n, sizes[0] * p / 100, "{p} %");
+    }
+    // A GLB as well, valid.
+    succeeds(&["lod", text(&input), "-o", text(&out)]);
+    assert_valid_gltf(std::slice::from_ref(&out));
+}

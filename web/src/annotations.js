@@ -8,10 +8,15 @@
  * camera stops); a list panel; markers and list items are buttons (Tab,
  * Enter); selecting one shows its text, restores its saved view and is
  * announced to screen readers. A server without the route (404) means no
- * notes, and the viewer shows none of this.
+ * notes, and the viewer shows none of this. A note's title and text show in
+ * the visitor's language where the curators translated it (the same choice
+ * as the model's own texts, content-language.js), marked with their language;
+ * note-editor.js lets a curator write the translations.
  */
 
+import { chooseText, markLanguage, visitorLanguages } from './content-language.js';
 import { formatCount, localise, onLanguageChange, t } from './i18n/index.js';
+import { NoteTranslations } from './note-editor.js';
 import { rotate } from './frame.js';
 import { diagonal, levelHausdorff } from './measure.js';
 import { projectPoint } from './pick.js';
@@ -26,7 +31,17 @@ import { projectPoint } from './pick.js';
  * @property {Vec3} position model coordinates
  * @property {Vec3} normal
  * @property {import('./camera.js').OrbitState | null} view
+ * @property {unknown} savedView the view as served (sent back as it is when a curator saves the note)
+ * @property {string | null} language BCP 47 tag of `title` and `text`, null when not stated
+ * @property {Record<string, NoteText>} translations the title and text in other languages, by tag
  */
+/**
+ * @typedef {object} NoteText
+ * @property {string} title
+ * @property {string} text the Markdown source
+ * @property {string | null} html sanitised by the server, as the note's own
+ */
+/** A note as shown: its text in one language. @typedef {NoteText & { lang: string | null }} ShownNote */
 
 /** Where each marker is on screen (tests read it). @typedef {{ id: string | number, x: number, y: number, visible: boolean }} Placed */
 
@@ -58,9 +73,47 @@ export function parseAnnotations(body) {
       position: a.position,
       normal: a.normal,
       view,
+      savedView: a.view ?? null,
+      language: typeof a.language === 'string' && a.language.trim() ? a.language.trim() : null,
+      translations: parseTranslations(a.translations),
     });
   }
   return out;
+}
+
+/**
+ * The translations that have a title; the rest is dropped.
+ * @param {unknown} value
+ * @returns {Record<string, NoteText>}
+ */
+function parseTranslations(value) {
+  /** @type {Record<string, NoteText>} */
+  const out = {};
+  if (!value || typeof value !== 'object' || Array.isArray(value)) return out;
+  for (const [tag, entry] of Object.entries(value)) {
+    if (!entry || typeof entry.title !== 'string' || !entry.title.trim()) continue;
+    out[tag] = {
+      title: entry.title,
+      text: typeof entry.text === 'string' ? entry.text : '',
+      html: typeof entry.html === 'string' ? entry.html : null,
+    };
+  }
+  return out;
+}
+
+/**
+ * A note in the language its reader prefers: the visitor's languages in
+ * order, an exact tag before one of the same primary language, the note's
+ * own words when none matches. Title and text go together.
+ * @param {Annotation} a
+ * @param {ReadonlyArray<string>} [preferences]
+ * @returns {ShownNote}
+ */
+export function noteInLanguage(a, preferences = visitorLanguages()) {
+  const titles = Object.fromEntries(Object.entries(a.translations).map(([tag, { title }]) => [tag, { title }]));
+  const { lang } = chooseText({ title: a.title, language: a.language, translations: titles }, 'title', preferences);
+  const translation = lang !== null && lang !== a.language ? a.translations[lang] : undefined;
+  return translation ? { ...translation, lang } : { title: a.title, text: a.text, html: a.html, lang: a.language };
 }
 
 export class Annotations {
@@ -89,8 +142,17 @@ export class Annotations {
       '<h2 data-i18n="notes.heading"></h2><ol class="note-list"></ol><div class="note-detail" hidden><h3></h3><div class="note-body"></div></div>';
     localise(this.pane);
     ui.panes.append(this.pane);
-    // The pane's fixed texts follow with the chrome (ui.js); the notes' labels are written here.
-    onLanguageChange(() => this.#label());
+    this.editor = new NoteTranslations({
+      url: (a) => `${this.#url()}/${encodeURIComponent(String(a.id))}`,
+      saved: (answer) => this.#replace(answer),
+    });
+    /** @type {HTMLElement} */ (this.pane.querySelector('.note-detail')).append(this.editor.root);
+    // The pane's fixed texts follow with the chrome (ui.js); the notes' labels and texts, in the
+    // visitor's language, are written here.
+    onLanguageChange(() => {
+      this.#label();
+      if (this.selected) this.#show(this.selected);
+    });
     this.button = ui.button('notes');
     this.button.onclick = () => this.toggle(this.pane.hidden === true);
   }
@@ -101,13 +163,25 @@ export class Annotations {
     this.button.setAttribute('aria-pressed', String(open));
   }
 
+  /** Settles once the notes of the model are in (or known to be none). @type {Promise<void>} */
+  loaded = Promise.resolve();
+
   /** Fetches the model's notes (after the manifest). */
-  async load() {
-    const url = `${this.viewer.options.manifestUrl.replace(/\/$/, '')}/annotations`;
+  load() {
+    this.loaded = this.#fetch();
+    return this.loaded;
+  }
+
+  /** The model's notes' address. */
+  #url() {
+    return `${this.viewer.options.manifestUrl.replace(/\/$/, '')}/annotations`;
+  }
+
+  async #fetch() {
     /** @type {Annotation[]} */
     let list = [];
     try {
-      const response = await fetch(url, { cache: 'no-store' });
+      const response = await fetch(this.#url(), { cache: 'no-store' });
       if (response.ok) list = parseAnnotations(await response.json());
     } catch {
       // No notes: the model is still shown.
@@ -136,7 +210,6 @@ export class Annotations {
       marker.type = 'button';
       marker.className = 'marker';
       marker.textContent = formatCount(k + 1);
-      marker.title = a.title;
       marker.hidden = true;
       marker.onclick = () => this.select(a);
       this.viewer.ui.markers.append(marker);
@@ -146,39 +219,85 @@ export class Annotations {
     this.place();
   }
 
-  /** The list's and the markers' names in the page's language ("Note 2: Front"). */
+  /**
+   * The list's and the markers' names in the page's language ("Note 2: Front"), each note's
+   * title in the visitor's language where it was translated.
+   */
   #label() {
     const items = this.pane.querySelectorAll('.note-item');
     this.list.forEach((a, k) => {
       const n = k + 1;
-      items[k].textContent = a.title || t('notes.untitled', { n });
+      const shown = noteInLanguage(a);
+      items[k].textContent = shown.title || t('notes.untitled', { n });
+      markLanguage(items[k], shown.title ? shown.lang : null);
       this.#markers[k].textContent = formatCount(n);
-      this.#markers[k].setAttribute('aria-label', t('notes.label', { n, title: a.title }));
+      this.#markers[k].title = shown.title;
+      this.#markers[k].setAttribute('aria-label', t('notes.label', { n, title: shown.title }));
     });
+  }
+
+  /**
+   * Takes a note as the server stored it after a curator's save in place of the one listed.
+   * @param {unknown} answer
+   * @returns {Annotation | null}
+   */
+  #replace(answer) {
+    const [note] = parseAnnotations([answer]);
+    const at = this.list.findIndex((a) => String(a.id) === String(note?.id));
+    if (!note || at < 0) return null;
+    this.list[at] = note;
+    this.#markers[at].onclick = () => this.select(note);
+    /** @type {HTMLButtonElement} */ (this.pane.querySelectorAll('.note-item')[at]).onclick = () => this.select(note);
+    this.#label();
+    if (String(this.selected?.id) === String(note.id)) {
+      this.selected = note;
+      this.#show(note);
+    }
+    return note;
   }
 
   /**
    * Shows a note's text, restores its saved view and announces it.
    * @param {Annotation} a
+   * @param {{ camera?: boolean }} [options] `camera: false` keeps the camera where it is (a shared view sets it)
    */
-  select(a) {
+  select(a, { camera: moveCamera = true } = {}) {
     this.selected = a;
     this.toggle(true);
-    const detail = /** @type {HTMLElement} */ (this.pane.querySelector('.note-detail'));
-    detail.hidden = false;
-    /** @type {HTMLElement} */ (detail.querySelector('h3')).textContent = a.title;
-    const body = /** @type {HTMLElement} */ (detail.querySelector('.note-body'));
-    // The server sanitises `html` (its Markdown renderer); without it, the text stays text.
-    if (a.html !== null) body.innerHTML = a.html;
-    else body.textContent = a.text;
+    const shown = this.#show(a);
+    this.editor.show(a);
     this.#markers.forEach((m, k) => m.setAttribute('aria-current', this.list[k] === a ? 'true' : 'false'));
-    this.viewer.ui.live.textContent = `${a.title}. ${body.textContent ?? ''}`.trim();
+    // Announced in the note's language.
+    const announcement = document.createElement('span');
+    announcement.textContent = `${shown.title}. ${shown.body}`.trim();
+    markLanguage(announcement, shown.lang);
+    this.viewer.ui.live.replaceChildren(announcement);
     const camera = this.viewer.camera;
-    if (a.view && camera) {
+    if (moveCamera && a.view && camera) {
       camera.state = structuredClone(a.view);
       this.viewer.renderer?.requestFrame();
       this.viewer.cameraMoved();
     }
+  }
+
+  /**
+   * Writes a note's title and text in the visitor's language into the detail.
+   * @param {Annotation} a
+   * @returns {{ title: string, body: string, lang: string | null }}
+   */
+  #show(a) {
+    const shown = noteInLanguage(a);
+    const detail = /** @type {HTMLElement} */ (this.pane.querySelector('.note-detail'));
+    detail.hidden = false;
+    const heading = /** @type {HTMLElement} */ (detail.querySelector('h3'));
+    heading.textContent = shown.title;
+    markLanguage(heading, shown.lang);
+    const body = /** @type {HTMLElement} */ (detail.querySelector('.note-body'));
+    // The server sanitises `html` (its Markdown renderer); without it, the text stays text.
+    if (shown.html !== null) body.innerHTML = shown.html;
+    else body.textContent = shown.text;
+    markLanguage(body, shown.lang);
+    return { title: shown.title, body: body.textContent ?? '', lang: shown.lang };
   }
 
   /** A new level is on screen: the surface that may hide a marker changed. */
@@ -262,5 +381,14 @@ export const NOTES_STYLE = `
 .marker { position: absolute; left: 0; top: 0; pointer-events: auto; min-height: 0; width: 28px; height: 28px; padding: 0;
   border-radius: 50%; background: #ebcb8b; color: #1d2026; border: 2px solid #1d2026; font-weight: 700; font-size: 13px; }
 .marker:hover { background: #f3dca8; }
+.note-curation { margin-top: 8px; }
+.note-translations h4 { font-size: 13px; margin: 8px 0 2px; }
+.note-translations fieldset { border: 1px solid #4c566a; border-radius: 6px; margin: 6px 0; padding: 4px 8px 8px; }
+.note-translations label { display: block; margin-top: 4px; }
+.note-translations input, .note-translations textarea { display: block; width: 100%; box-sizing: border-box; font: inherit;
+  color: #eceff4; background: #1d2026; border: 1px solid #81a1c1; border-radius: 4px; padding: 4px 6px; }
+.note-translations input:focus-visible, .note-translations textarea:focus-visible { outline: 2px solid #88c0d0; outline-offset: 1px; }
+.note-translations button { margin-block-start: 6px; margin-inline-end: 6px; }
+.note-original, .note-status { color: #cfd5de; margin: 4px 0; }
 .marker[aria-current="true"] { background: #88c0d0; }
 `;

@@ -4,13 +4,16 @@
  * model page at `/m/{slug}` (viewer, description, embed snippets) and the
  * bare viewer at `/embed/{slug}` for iframes, and the quality study at
  * `/study/{slug}?invitation=…` (study/page.js). `?device=`, `?token=`,
- * `?level=`, `?offscreen=off`, `?decoders=`, `?antialias=` and `?motion=` on a page's URL are passed to the viewer.
+ * `?level=`, `?offscreen=off`, `?decoders=`, `?antialias=`, `?motion=`, `?iiif-content=`, `?tour=`, `?step=`, `?refine=` and `?vertex-budget=` on a page's URL are passed to the viewer, and so is a shared view in its fragment (view-state.js).
  */
 
 import './element.js';
+import { chooseText, markLanguage } from './content-language.js';
 import { onLanguageChange, t } from './i18n/index.js';
 import { startLanguage } from './i18n/switch.js';
 import { fetchResults } from './study/api.js';
+import { readContentState } from './content-state.js';
+import { contentStateMessage } from './share.js';
 import { StudyPage } from './study/page.js';
 
 startLanguage();
@@ -18,7 +21,8 @@ const main = /** @type {HTMLElement} */ (document.getElementById('app'));
 const params = new URLSearchParams(location.search);
 const route = location.pathname.match(/^\/(m|embed|study)\/([a-z0-9-]+)\/?$/);
 
-if (!route) void (location.pathname === '/admin' ? import('./admin/page.js').then((admin) => admin.start(main)) : gallery());
+if (!route && location.pathname === '/' && params.has('iiif-content')) void contentStatePage(params.get('iiif-content') ?? '');
+else if (!route) void (location.pathname === '/admin' ? import('./admin/page.js').then((admin) => admin.start(main)) : gallery());
 else if (route[1] === 'm') modelPage(route[2]);
 else if (route[1] === 'study') void new StudyPage(main, route[2], params).start();
 else embedPage(route[2]);
@@ -38,16 +42,19 @@ function el(tag, attributes = {}, children = []) {
 /** @param {string} slug */
 function viewerElement(slug) {
   const viewer = el('vitrine-viewer', { src: `/api/models/${slug}` });
-  for (const key of ['device', 'token', 'level', 'offscreen', 'decoders', 'antialias', 'motion']) {
+  for (const key of ['device', 'token', 'level', 'offscreen', 'decoders', 'antialias', 'motion', 'iiif-content', 'tour', 'step', 'refine', 'vertex-budget']) {
     const value = params.get(key);
     if (value !== null) viewer.setAttribute(key, value);
   }
+  // A shared view travels in the fragment (view-state.js).
+  if (location.hash.length > 1) viewer.setAttribute('view', location.hash.slice(1));
   return viewer;
 }
 
 /**
  * The model list, written again in the visitor's language when it changes.
- * @typedef {{ slug: string, title: string, levels: number, page_url: string, thumbnail?: string | null }} ListedModel
+ * @typedef {{ slug: string, title: string, levels: number, page_url: string, thumbnail?: string | null,
+ *   language?: string | null, translations?: Record<string, { title?: string }> }} ListedModel
  */
 async function gallery() {
   document.body.classList.add('gallery');
@@ -64,7 +71,11 @@ async function gallery() {
     if (answer.models.length === 0) list.append(el('li', {}, [t('gallery.empty')]));
     for (const m of answer.models) {
       const levels = el('small', {}, [t('gallery.levels', { count: m.levels })]);
-      list.append(el('li', {}, [el('a', { href: m.page_url }, [thumbnail(m), el('strong', {}, [m.title]), levels])]));
+      // The title in the visitor's language where the museum gave one (content-language.js).
+      const title = chooseText(m, 'title');
+      const name = el('strong', {}, [title.text]);
+      markLanguage(name, title.lang);
+      list.append(el('li', {}, [el('a', { href: m.page_url }, [thumbnail(title.text, m.thumbnail), name, levels])]));
     }
   };
   draw();
@@ -79,6 +90,34 @@ async function gallery() {
   draw();
 }
 
+/**
+ * `/?iiif-content=…`: the model a IIIF Content State names, opened at its
+ * view; a Content State that names another site, no model of this one or
+ * nothing readable gets a message (and no request leaves for another host).
+ * @param {string} value
+ */
+async function contentStatePage(value) {
+  /** @type {() => string} */
+  let problem;
+  try {
+    const { slug } = readContentState(value, { origin: location.origin, prefix: '' });
+    const response = await fetch('/api/models', { cache: 'no-store' });
+    const listed = response.ok ? /** @type {{ models: ListedModel[] }} */ (await response.json()).models : [];
+    if (listed.some((m) => m.slug === slug)) return modelPage(slug);
+    problem = () => t('contentState.unknown', { name: slug });
+  } catch (error) {
+    problem = () => contentStateMessage(error);
+  }
+  const draw = () =>
+    main.replaceChildren(
+      el('header', {}, [el('h1', {}, [siteName()])]),
+      el('p', { class: 'error', role: 'alert' }, [problem()]),
+      el('p', {}, [el('a', { href: '/' }, [t('page.allModels')])]),
+    );
+  draw();
+  onLanguageChange(draw);
+}
+
 /** The site's name as the server states it (`--site-name`). */
 function siteName() {
   return document.querySelector('meta[name="application-name"]')?.getAttribute('content') || 'Vitrine';
@@ -88,12 +127,13 @@ function siteName() {
  * The model's picture (rendered at ingest), lazily loaded in a box of
  * fixed aspect so the grid does not move as pictures arrive; a neutral
  * placeholder when the server has none (or an older server, without the field).
- * @param {{ title: string, thumbnail?: string | null }} m
+ * @param {string} title
+ * @param {string | null | undefined} src
  */
-function thumbnail(m) {
+function thumbnail(title, src) {
   const box = el('span', { class: 'thumb' });
-  if (typeof m.thumbnail === 'string' && m.thumbnail) {
-    const img = el('img', { src: m.thumbnail, alt: t('gallery.preview', { title: m.title }), loading: 'lazy', decoding: 'async', width: '320', height: '240' });
+  if (typeof src === 'string' && src) {
+    const img = el('img', { src, alt: t('gallery.preview', { title }), loading: 'lazy', decoding: 'async', width: '320', height: '240' });
     img.addEventListener('error', () => img.replaceWith(el('span', { class: 'thumb-none', 'aria-hidden': 'true' })));
     box.append(img);
   } else {
@@ -130,16 +170,29 @@ function modelPage(slug) {
   };
   draw();
   onLanguageChange(draw);
-  // The quality study's answers, when the model has a study (404: none, nothing shown).
-  void fetchResults(slug)
-    .then((results) => {
-      if (results) /** @type {any} */ (viewer).viewer?.ui.setStudy(results.levels);
-    })
-    .catch(() => {});
-  viewer.addEventListener('vitrine-level', () => {
-    const title = /** @type {any} */ (viewer).viewer?.manifest?.title;
+  // The quality study's answers, asked only when the manifest links them
+  // (a model without a study would answer 404, a failed request).
+  viewer.addEventListener(
+    'vitrine-level',
+    () => {
+      const manifest = /** @type {any} */ (viewer).viewer?.manifest;
+      if (!manifest?.study_results) return;
+      void fetchResults(slug)
+        .then((results) => {
+          if (results) /** @type {any} */ (viewer).viewer?.ui.setStudy(results.levels);
+        })
+        .catch(() => {});
+    },
+    { once: true },
+  );
+  // The tab's title: the model's, in the visitor's language where the museum gave one.
+  const retitle = () => {
+    const manifest = /** @type {any} */ (viewer).viewer?.manifest;
+    const title = manifest ? chooseText(manifest, 'title').text : '';
     if (title) document.title = `${title} · ${siteName()}`;
-  });
+  };
+  viewer.addEventListener('vitrine-level', retitle);
+  onLanguageChange(retitle);
 }
 
 /** @param {string} slug */

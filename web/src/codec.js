@@ -252,8 +252,138 @@ export class StreamDecoder {
     return Array.from(new Uint32Array(e.memory.buffer, e.sizes_ptr(), charts));
   }
 
+  /**
+   * Turns this decoder (its global batches applied) into a view whose charts
+   * each refine by their own parts (issue 41); this decoder is spent.
+   * @param {Uint8Array} head the first parted batch's head ({@link VitrineCodec#partedLayout})
+   * @returns {PartView}
+   */
+  intoView(head) {
+    this.codec.input(head);
+    const view = this.codec.exports.view_new(this.handle, head.length);
+    if (view === 0) throw this.codec.lastError();
+    return new PartView(this.codec, view);
+  }
+
   free() {
     this.codec.exports.decoder_free(this.handle);
+  }
+}
+
+/**
+ * A parted batch's layout: its level, the head a view starts from and each
+ * chart's part, as byte ranges within the batch (an empty range: the chart
+ * sits the batch out).
+ * @typedef {object} PartedLayout
+ * @property {number} level
+ * @property {[number, number]} head
+ * @property {[number, number][]} parts
+ */
+
+/**
+ * The layout of a batch: null for a global batch (not cut into parts).
+ * @param {VitrineCodec} codec
+ * @param {Uint8Array} batch
+ * @returns {PartedLayout | null}
+ */
+export function partedLayout(codec, batch) {
+  const e = codec.exports;
+  codec.input(batch);
+  const charts = e.parted_layout(batch.length);
+  if (charts < 0) throw codec.lastError();
+  if (charts === 0) return null;
+  const words = new Uint32Array(e.memory.buffer, e.sizes_ptr(), 3 + 2 * charts).slice();
+  /** @type {[number, number][]} */
+  const parts = [];
+  for (let k = 0; k < charts; k++) parts.push([words[3 + 2 * k], words[4 + 2 * k]]);
+  return { level: words[0], head: [words[1], words[2]], parts };
+}
+
+/**
+ * A charted stream's charts, each at its own depth: the decoder of a viewer
+ * that fetches parts, not batches (codec/core's ChartView). Every chart
+ * shares the cut bit for bit whatever the depths, so the union of the
+ * charts is watertight.
+ */
+export class PartView {
+  /**
+   * @param {VitrineCodec} codec
+   * @param {number} handle
+   */
+  constructor(codec, handle) {
+    this.codec = codec;
+    this.handle = handle;
+  }
+
+  chartCount() {
+    return this.codec.exports.view_charts(this.handle);
+  }
+
+  /** Parts applied to a chart (0: as the cut left it). @param {number} chart */
+  depth(chart) {
+    return this.codec.exports.view_depth(this.handle, chart);
+  }
+
+  /** The depth of every chart at the stream's final level. */
+  finalDepth() {
+    return this.codec.exports.view_final_depth(this.handle);
+  }
+
+  /** Vertices held, all charts together. */
+  residentVertices() {
+    return this.codec.exports.view_resident(this.handle);
+  }
+
+  /**
+   * The most vertices the view may hold: a part past it is refused and
+   * changes nothing (reset charts out of view, then try again).
+   * @param {number} vertices
+   */
+  setVertexBudget(vertices) {
+    this.codec.exports.view_set_budget(this.handle, Math.min(vertices, 0xffffffff));
+  }
+
+  /**
+   * Applies a chart's next part; on error the chart is as it was, or back
+   * at the cut, and the others are untouched.
+   * @param {number} chart
+   * @param {Uint8Array} part
+   */
+  applyPart(chart, part) {
+    this.codec.input(part);
+    if (this.codec.exports.view_apply_part(this.handle, chart, part.length) !== 0) throw this.codec.lastError();
+  }
+
+  /** Puts a chart back where the cut left it, freeing what it had grown. @param {number} chart */
+  reset(chart) {
+    this.codec.exports.view_reset(this.handle, chart);
+  }
+
+  /**
+   * One chart as copies: positions, colours and triangles in its own ids.
+   * @param {number} chart
+   * @returns {{ positions: Float32Array, colours: Uint8Array | null, indices: Uint32Array }}
+   */
+  chart(chart) {
+    const e = this.codec.exports;
+    /** @param {number} kind @param {number} size */
+    const copy = (kind, size) => {
+      const ptr = e.view_buffer_ptr(this.handle, chart, kind);
+      const len = e.view_buffer_len(this.handle, chart, kind);
+      return ptr === 0 && len === 0 ? null : e.memory.buffer.slice(ptr, ptr + len * size);
+    };
+    const positions = copy(POSITIONS, 4);
+    const colours = copy(COLOURS, 1);
+    const indices = copy(INDICES, 4);
+    return {
+      positions: new Float32Array(positions ?? 0),
+      colours: colours ? new Uint8Array(colours) : null,
+      indices: new Uint32Array(indices ?? 0),
+    };
+  }
+
+  free() {
+    this.codec.exports.view_free(this.handle);
   }
 }
 

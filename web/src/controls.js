@@ -6,8 +6,13 @@
  * - right or middle button, or shift + left: pan;
  * - two fingers: pinch to zoom, move together to pan;
  * - wheel: zoom;
- * - keys (when the canvas has focus): arrows rotate, shift + arrows pan,
- *   + / - zoom, R reset, W wireframe, F fullscreen.
+ * - keys, only while the canvas has focus (WCAG 2.1.4: no single-key
+ *   shortcut acts elsewhere on the page): arrows rotate, shift + arrows
+ *   pan, + / - zoom, R reset, W wireframe, F fullscreen, Enter or Space
+ *   picks the point under the centre of the view (the measurement's
+ *   crosshair);
+ * - `nudge()`: one key step, for on-screen buttons that turn and zoom
+ *   without a drag (WCAG 2.5.7).
  * While `locked` (the quality study's questions) all of it is ignored.
  */
 
@@ -26,9 +31,15 @@ const WHEEL_ZOOM_PER_PX = 0.0015;
  *   study's log coalesces them)
  * @property {(on: boolean) => void} [grabbed] a pointer went down on the view (true), or the last
  *   one came up (false): the renderer keeps drawing as if moving in between (motion.js)
+ * @property {() => boolean} [pickCentre] Enter or Space: pick the point under the view's centre;
+ *   false when nothing takes a pick now (the key then does what it does elsewhere)
  */
 
 /** @typedef {'orbit' | 'pan' | 'zoom' | 'pinch' | 'key'} Interaction */
+/** One step of the view, as a key or an on-screen button makes it. @typedef {'left' | 'right' | 'up' | 'down' | 'in' | 'out'} Nudge */
+
+/** @type {Record<string, Nudge>} */
+const KEY_NUDGES = { ArrowLeft: 'left', ArrowRight: 'right', ArrowUp: 'up', ArrowDown: 'down', '+': 'in', '=': 'in', '-': 'out' };
 
 export class OrbitControls {
   /** @type {Map<number, { x: number, y: number }>} */
@@ -141,36 +152,49 @@ export class OrbitControls {
     this.actions.interacted?.('zoom');
   }
 
+  /**
+   * Turns, tilts or zooms the view by one key step; `pan` moves it instead of turning.
+   * @param {Nudge} step
+   * @param {{ pan?: boolean }} [options]
+   * @returns {boolean} whether the camera moved (false while locked or before the model)
+   */
+  nudge(step, { pan = false } = {}) {
+    const camera = this.actions.camera();
+    if (!camera || this.#locked) return false;
+    if (step === 'in' || step === 'out') {
+      camera.zoom(step === 'in' ? 1 / KEY_ZOOM : KEY_ZOOM);
+    } else {
+      const [dx, dy] = { left: [-1, 0], right: [1, 0], up: [0, -1], down: [0, 1] }[step].map((s) => s * KEY_STEP_PX);
+      const height = this.canvas.clientHeight || 1;
+      if (pan) camera.pan(dx, dy, height);
+      else camera.rotate(dx, dy, height);
+    }
+    this.actions.changed();
+    this.actions.interacted?.('key');
+    return true;
+  }
+
   /** @param {KeyboardEvent} e */
   #key(e) {
     if (e.ctrlKey || e.metaKey || e.altKey || this.#locked) return;
-    const camera = this.actions.camera();
-    const height = this.canvas.clientHeight || 1;
-    const arrows = { ArrowLeft: [-1, 0], ArrowRight: [1, 0], ArrowUp: [0, -1], ArrowDown: [0, 1] };
-    const arrow = arrows[/** @type {keyof typeof arrows} */ (e.key)];
-    if (arrow && camera) {
-      const [dx, dy] = arrow.map((s) => s * KEY_STEP_PX);
-      if (e.shiftKey) camera.pan(dx, dy, height);
-      else camera.rotate(dx, dy, height);
-    } else if ((e.key === '+' || e.key === '=') && camera) {
-      camera.zoom(1 / KEY_ZOOM);
-    } else if (e.key === '-' && camera) {
-      camera.zoom(KEY_ZOOM);
+    const nudge = KEY_NUDGES[e.key];
+    if (nudge) {
+      // Shift + an arrow pans; shift + "=" is "+" on most keyboards.
+      const pan = e.shiftKey && e.key.startsWith('Arrow');
+      if (this.nudge(nudge, { pan })) e.preventDefault();
     } else if (e.key === 'r' || e.key === 'R' || e.key === 'Home') {
       this.actions.reset();
+      this.actions.changed();
+      this.actions.interacted?.('key');
+      e.preventDefault();
     } else if (e.key === 'w' || e.key === 'W') {
       this.actions.toggleWireframe();
       e.preventDefault();
-      return;
     } else if (e.key === 'f' || e.key === 'F') {
       this.actions.toggleFullscreen();
       e.preventDefault();
-      return;
-    } else {
-      return;
+    } else if ((e.key === 'Enter' || e.key === ' ') && this.actions.pickCentre?.()) {
+      e.preventDefault();
     }
-    e.preventDefault();
-    this.actions.changed();
-    this.actions.interacted?.('key');
   }
 }

@@ -17,7 +17,13 @@
  * drawn while the view moves: `auto`, a coarser level where the level on
  * screen is slow to draw; `full`; `coarse`: motion.js). `chrome="none"` draws the model and nothing else. The
  * worker and the decoder are loaded from beside this script, so the element
- * works on another origin (the service answers CORS).
+ * works on another origin (the service answers CORS). `view` opens at a
+ * shared view (the fragment of a share link: view-state.js) and
+ * `iiif-content` at a IIIF Content State (content-state.js); `tour` and
+ * `step` open a guided tour at a step (from 1; tour.js). `refine="view"` refines a
+ * charted stream chart by chart where the camera looks, within `vertex-budget`
+ * vertices (default by device; README, "View-dependent refinement");
+ * `refine="uniform"`, the default, batch by batch.
  */
 
 import { t } from './i18n/index.js';
@@ -25,6 +31,7 @@ import { startLanguage } from './i18n/switch.js';
 import { motionMode } from './motion.js';
 import { ViewerUi } from './ui.js';
 import { Viewer } from './viewer.js';
+import { parseView } from './view-state.js';
 
 /**
  * @param {string} src
@@ -85,6 +92,11 @@ export class VitrineViewerElement extends HTMLElement {
       decoders: positiveInteger(this.getAttribute('decoders')),
       antialias: onOff(this.getAttribute('antialias')),
       motion: motionMode(this.getAttribute('motion')),
+      view: parseView(this.getAttribute('view')),
+      contentState: this.getAttribute('iiif-content'),
+      tour: tourLink(this.getAttribute('tour'), this.getAttribute('step')),
+      refine: this.getAttribute('refine') === 'view' ? 'view' : 'uniform',
+      vertexBudget: positiveInteger(this.getAttribute('vertex-budget')),
     });
     void this.viewer.start();
   }
@@ -106,6 +118,16 @@ if (!customElements.get('vitrine-viewer')) customElements.define('vitrine-viewer
 /** @param {string | null} value @returns {boolean | null} `on`: true, `off`: false, else null */
 function onOff(value) {
   return value === 'on' ? true : value === 'off' ? false : null;
+}
+
+/**
+ * @param {string | null} tour
+ * @param {string | null} step
+ * @returns {{ tour: number, step: number } | null}
+ */
+function tourLink(tour, step) {
+  const id = positiveInteger(tour);
+  return id === null ? null : { tour: id, step: positiveInteger(step) ?? 1 };
 }
 
 /** @param {string | null} value @returns {number | null} */

@@ -83,6 +83,19 @@ export class Inspection {
     });
   }
 
+  /**
+   * Enter or Space on the view while measuring: picks the point under the
+   * crosshair at the view's centre (turn or pan the model to bring a point
+   * there), so a measurement needs no pointer.
+   * @returns {boolean} whether a pick was taken
+   */
+  pickCentre() {
+    if (!this.measuring) return false;
+    const canvas = this.viewer.ui.canvas;
+    void this.pickAt(canvas.clientWidth / 2, canvas.clientHeight / 2);
+    return true;
+  }
+
   /** The manifest is in: the readouts use its unit. */
   begin() {
     this.clear();
@@ -101,6 +114,7 @@ export class Inspection {
     this.measure.pane.hidden = !on;
     this.viewer.ui.button('measure').setAttribute('aria-pressed', String(on));
     this.viewer.ui.canvas.style.cursor = on ? 'crosshair' : '';
+    this.viewer.ui.stage.classList.toggle('measuring', on);
     if (!on) this.clear();
   }
 
@@ -260,6 +274,47 @@ export class Inspection {
     this.viewer.ui.button('section').setAttribute('aria-pressed', String(on));
     if (on) this.#updateSection({});
     else this.viewer.setLook({ section: null });
+  }
+
+  /**
+   * The section in force, as the pane sets it (view-state.js); undefined: none.
+   * @returns {{ axis: 'x' | 'y' | 'z', fraction: number, flip: boolean } | undefined}
+   */
+  currentSection() {
+    if (!this.viewer.look.section) return undefined;
+    const s = this.section;
+    const axis = /** @type {'x' | 'y' | 'z'} */ (s.axis.find((b) => b.getAttribute('aria-pressed') === 'true')?.dataset.axis ?? 'x');
+    return { axis, fraction: Number(s.offset.value) / Number(s.offset.max), flip: s.flip.getAttribute('aria-pressed') === 'true' };
+  }
+
+  /**
+   * Sets the pane and the plane from a shared view (null: no section).
+   * @param {{ axis: 'x' | 'y' | 'z', fraction: number, flip: boolean } | null} section
+   */
+  restoreSection(section) {
+    if (!section) {
+      if (this.viewer.look.section) this.setSection(false);
+      return;
+    }
+    this.section.offset.value = String(Math.round(section.fraction * Number(this.section.offset.max)));
+    this.section.axis.forEach((b) => b.setAttribute('aria-pressed', String(b.dataset.axis === section.axis)));
+    this.section.flip.setAttribute('aria-pressed', String(section.flip));
+    this.setSection(true);
+  }
+
+  /**
+   * Measures between two points of a shared view, on the level on screen (null: no measurement).
+   * @param {[Vec3, Vec3] | null} points
+   */
+  restoreMeasurement(points) {
+    if (!points) {
+      if (this.measuring) this.setMeasuring(false);
+      return;
+    }
+    this.setMeasuring(true);
+    this.points = [points[0], points[1]];
+    void this.#read(Math.max(0, this.viewer.state.shownLevel));
+    this.#show();
   }
 
   /**

@@ -32,6 +32,16 @@ import { NetworkError, fetchPayload } from './payload.js';
  * @property {Record<string, string>} [headers] sent with every request
  * @property {number} [capacity] vertices of the last level (from the manifest): the
  *   renderer sizes its position and colour buffers once for it
+ * @property {PartsRequest} [parts] refine a charted stream by parts where the camera
+ *   looks, after its global batches (worker.js, part-refinement.js)
+ */
+
+/**
+ * @typedef {object} PartsRequest
+ * @property {string} indexUrl absolute URL of the part index (the manifest's `parts`)
+ * @property {string} apiBase the URL the index's paths are relative to (the manifest's)
+ * @property {[string, string][]} query forwarded on every request (`device`, `token`)
+ * @property {number} budget resident vertices, at most
  */
 
 /**
@@ -62,6 +72,8 @@ import { NetworkError, fetchPayload } from './payload.js';
  * @property {number} decodeMs time in the WASM decoder so far (apply + copy out)
  * @property {number} deriveMs time computing normals, edges and θ so far
  * @property {number} decoders members decoding the stream (1, or a pool's size: decode-pool.js)
+ * @property {boolean} [standIn] false: never the stand-in while the view moves (motion.js), as
+ *   the vertices it reads may be sent again (part-refinement.js)
  */
 
 /**
@@ -224,6 +236,18 @@ export class Reconstruction {
   current() {
     if (!this.#decoder || this.level < 0) throw new Error('no level decoded yet');
     return this.#decoder.level();
+  }
+
+  /**
+   * Hands the decoder over, its batches applied (view-dependent refinement:
+   * part-refinement.js), and stops; null with a pool (decode-pool.js).
+   * @returns {import('./codec.js').StreamDecoder | null}
+   */
+  release() {
+    const decoder = this.#decoder instanceof PooledDecoder ? null : this.#decoder;
+    if (decoder) this.#decoder = null;
+    this.cancel();
+    return decoder;
   }
 
   cancel() {

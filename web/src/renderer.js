@@ -262,7 +262,8 @@ export class Renderer {
   show(level) {
     this.#store.receive(level);
     const candidate = this.#candidate;
-    if (this.#motion.keeps(level.indices.length / 3, candidate && candidate.indices.length / 3, this.#store.capacity)) {
+    const keeps = level.standIn !== false && this.#motion.keeps(level.indices.length / 3, candidate && candidate.indices.length / 3, this.#store.capacity);
+    if (keeps) {
       this.#candidate = level;
     }
     if (this.lost) {

@@ -30,7 +30,7 @@ export function measurePane() {
   const p = pane(
     'measure',
     'measure.pane',
-    `<h2 data-i18n="measure.heading"></h2><p class="measure-status" role="status"></p><p class="measure-reading"></p>
+    `<h2 data-i18n="measure.heading"></h2><p class="measure-status" role="status"></p><p class="measure-reading" aria-live="polite"></p>
 <p class="measure-surface"></p><div class="row"><button type="button" class="refine" hidden></button>
 <button type="button" class="clear" data-i18n="measure.clear"></button></div>`,
   );

@@ -10,7 +10,10 @@
 import { describeLevel, describeStudyLevel, renderQualityChart } from './quality-chart.js';
 import { NOTES_STYLE } from './annotations.js';
 import { TOOLS_STYLE } from './tools-ui.js';
+import { SHARE_STYLE } from './share.js';
+import { TOUR_STYLE } from './tour.js';
 import { SCALE_PERCENTILE, formatDegrees, rampGradient, reliefTicks } from './relief.js';
+import { chooseText, markLanguage } from './content-language.js';
 import { creditLine } from './rights.js';
 import { formatBytes, language, localise, onLanguageChange, t } from './i18n/index.js';
 import { languageSwitch } from './i18n/switch.js';
@@ -24,7 +27,25 @@ export const STYLE = `
 .stage { position: absolute; inset: 0; }
 canvas { display: block; width: 100%; height: 100%; outline: none; cursor: grab; }
 canvas:active { cursor: grabbing; }
-canvas:focus-visible { box-shadow: inset 0 0 0 2px #88c0d0; }
+/* The focus ring sits inside the canvas's edge, in the 10 px the chrome leaves free (2.4.11). */
+canvas:focus-visible { box-shadow: inset 0 0 0 3px #88c0d0; }
+.crosshair { display: none; position: absolute; left: 50%; top: 50%; width: 24px; height: 24px; margin: -12px 0 0 -12px;
+  pointer-events: none; }
+.stage.measuring .crosshair { display: block; }
+.crosshair::before, .crosshair::after { content: ""; position: absolute; background: #ebcb8b; box-shadow: 0 0 0 1px #1d2026; }
+.crosshair::before { left: 11px; top: 0; width: 2px; height: 24px; }
+.crosshair::after { top: 11px; left: 0; height: 2px; width: 24px; }
+/* Turn and zoom without a drag (2.5.7): a pad of 28 px buttons (2.5.8 asks 24) over the view's
+   start edge, out of the chrome's flow (whose height is spoken for on small screens); the
+   tool panes open on the other side. Its arrows point the same way in either direction of text.
+   Views under 480 px tall have no room for it beside the panel and the status (turning there
+   needs the keys or a drag; the README says so). */
+.nav { position: absolute; left: 10px; top: 55%; transform: translateY(-50%); display: grid;
+  grid-template-columns: repeat(3, 28px); grid-auto-rows: 28px; gap: 4px; direction: ltr; }
+.stage:dir(rtl) .nav { left: auto; right: 10px; }
+.nav button { min-height: 0; padding: 0; line-height: 1; }
+@media (max-height: 480px) { .nav { display: none; } }
+@media (prefers-reduced-motion: reduce) { * { transition: none !important; animation: none !important; } }
 .pill { background: rgba(20, 22, 26, 0.72); border-radius: 6px; padding: 6px 10px; }
 .chrome { position: absolute; inset: 10px 10px 12px; display: flex; flex-direction: column; gap: 8px;
   pointer-events: none; min-height: 0; }
@@ -47,7 +68,7 @@ select.language { font: inherit; color: inherit; background: rgba(20, 22, 26, 0.
   border-radius: 6px; min-height: 36px; min-width: 36px; padding: 4px 6px; cursor: pointer; }
 select.language:focus-visible { outline: 2px solid #88c0d0; outline-offset: 1px; }
 select.language option { background: #212329; color: #eceff4; }
-button[aria-pressed="true"] { background: #5e81ac; border-color: #81a1c1; }
+button[aria-pressed="true"] { background: #4a6b96; border-color: #81a1c1; }
 .panes { display: flex; flex-wrap: wrap; justify-content: flex-end; align-items: flex-start; gap: 8px;
   min-height: 0; flex: 0 1 auto; overflow: auto; pointer-events: none; }
 .panes:not(:has(> :not([hidden]))) { display: none; }
@@ -112,7 +133,7 @@ button[aria-pressed="true"] { background: #5e81ac; border-color: #81a1c1; }
 :host([chrome="minimal"]) .panel p { display: none; }
 :host([chrome="minimal"]) .quality { display: none; }
 :host([chrome="minimal"]) button.optional { display: none; }
-:host([chrome="none"]) :is(.chrome, .bar, .markers) { display: none !important; }
+:host([chrome="none"]) :is(.chrome, .bar, .markers, .nav) { display: none !important; }
 `;
 
 export class ViewerUi {
@@ -122,6 +143,8 @@ export class ViewerUi {
   onSplats = () => {};
   onRetry = () => {};
   onResize = () => {};
+  /** An on-screen button turned or zoomed the view by one step. @type {(step: import('./controls.js').Nudge) => void} */
+  onNudge = () => {};
   /** The quality curve the chart shows. @type {ReadonlyArray<import('./quality-chart.js').QualityPoint> | null} */
   #curve = null;
   /** Level the chart's marker was drawn at (`null`: redraw). @type {number | null} */
@@ -136,10 +159,11 @@ export class ViewerUi {
    */
   constructor(host, shadow) {
     this.root = host;
-    shadow.innerHTML = `<style>${STYLE}${TOOLS_STYLE}${NOTES_STYLE}</style>
+    shadow.innerHTML = `<style>${STYLE}${TOOLS_STYLE}${NOTES_STYLE}${SHARE_STYLE}${TOUR_STYLE}</style>
 <div class="stage" part="stage">
-  <canvas data-i18n-label="view.canvas"></canvas>
+  <canvas></canvas>
   <div class="markers"></div>
+  <div class="crosshair" aria-hidden="true"></div>
   <div class="chrome">
   <div class="top">
   <div class="panel pill" part="panel"></div>
@@ -148,12 +172,14 @@ export class ViewerUi {
     <button data-action="wireframe" data-i18n="tools.wireframe" data-i18n-title="tools.wireframe.title" aria-pressed="false" class="optional"></button>
     <button data-action="relief" data-i18n="tools.relief" data-i18n-title="tools.relief.title" aria-pressed="false" class="optional"></button>
     <button data-action="splats" data-i18n="tools.splats" data-i18n-title="tools.splats.title" aria-pressed="false" class="optional"></button>
+    <button data-action="tour" data-i18n="tools.tour" data-i18n-title="tools.tour.title" aria-pressed="false" hidden></button>
     <button data-action="notes" data-i18n="tools.notes" data-i18n-title="tools.notes.title" aria-pressed="false" hidden></button>
     <button data-action="measure" data-i18n="tools.measure" data-i18n-title="tools.measure.title" aria-pressed="false" class="optional"></button>
     <button data-action="light" data-i18n="tools.light" data-i18n-title="tools.light.title" aria-pressed="false" class="optional"></button>
     <button data-action="section" data-i18n="tools.section" data-i18n-title="tools.section.title" aria-pressed="false" class="optional"></button>
     <button data-action="clay" data-i18n="tools.clay" data-i18n-title="tools.clay.title" aria-pressed="false" class="optional"></button>
     <button data-action="snapshot" data-i18n="tools.snapshot" data-i18n-title="tools.snapshot.title" class="optional"></button>
+    <button data-action="share" data-i18n="tools.share" data-i18n-title="tools.share.title" aria-pressed="false"></button>
     <button data-action="fullscreen" data-i18n="tools.fullscreen" data-i18n-title="tools.fullscreen.title"></button>
   </div>
   </div>
@@ -168,12 +194,22 @@ export class ViewerUi {
     </div>
     <div class="notice pill" role="status" hidden></div>
     <div class="colour pill" hidden></div>
-    <div class="progress pill" aria-live="polite" data-i18n="progress.loading"></div>
+    <div class="progress pill" data-i18n="progress.loading"></div>
   </div>
   <div class="credit" part="credit" role="group" data-i18n-label="credit.label" hidden></div>
   </div>
   </div>
+  <div class="nav" role="group" data-i18n-label="nav.label">
+    <button type="button" data-nudge="in" data-i18n-label="nav.in" data-i18n-title="nav.in">+</button>
+    <button type="button" data-nudge="up" data-i18n-label="nav.up" data-i18n-title="nav.up">▲</button>
+    <button type="button" data-nudge="out" data-i18n-label="nav.out" data-i18n-title="nav.out">−</button>
+    <button type="button" data-nudge="left" data-i18n-label="nav.left" data-i18n-title="nav.left">◀</button>
+    <button type="button" data-nudge="down" data-i18n-label="nav.down" data-i18n-title="nav.down">▼</button>
+    <button type="button" data-nudge="right" data-i18n-label="nav.right" data-i18n-title="nav.right">▶</button>
+  </div>
   <div class="live" aria-live="polite"></div>
+  <div class="live loading-live" role="status"></div>
+  <div class="live view-description" id="view-description" aria-hidden="true"></div>
   <div class="bar" style="width: 0"></div>
   <div class="error" role="alert" hidden><div><p></p><button data-action="retry" data-i18n="error.retry"></button></div></div>
 </div>`;
@@ -210,6 +246,10 @@ export class ViewerUi {
     this.splatsButton.onclick = () => this.onSplats();
     $('[data-action="fullscreen"]').onclick = () => this.toggleFullscreen();
     $('[data-action="retry"]').onclick = () => this.onRetry();
+    for (const b of shadow.querySelectorAll('[data-nudge]')) {
+      const button = /** @type {HTMLButtonElement} */ (b);
+      button.onclick = () => this.onNudge(/** @type {import('./controls.js').Nudge} */ (button.dataset.nudge));
+    }
     /** The language switch, last in the toolbar. */
     this.languages = languageSwitch();
     $('.tools').append(this.languages);
@@ -230,6 +270,7 @@ export class ViewerUi {
     this.#legendKey = '';
     this.#colourKey = '';
     if (this.#state) this.setProgress(this.#state);
+    if (this.#content) this.setDetails(this.#content);
     if (this.#rights) this.setRights(...this.#rights);
     this.showNotice(this.#notice);
     this.showError(this.#error);
@@ -244,6 +285,8 @@ export class ViewerUi {
   #state = null;
   /** @type {[Partial<import('./rights.js').Rights> | null | undefined, { href: string, bytes: number } | null] | null} */
   #rights = null;
+  /** The model's own words (title, description, credit) in every language given. @type {import('./content-language.js').ContentSource | null} */
+  #content = null;
   /** @type {ChromeText} */
   #notice = null;
   /** @type {ChromeText} */
@@ -287,20 +330,26 @@ export class ViewerUi {
   }
 
   /**
-   * @param {string} title
-   * @param {string} description
+   * The model's title and description, each in the visitor's language where
+   * the museum wrote it (content-language.js), marked with its language.
+   * @param {import('./content-language.js').ContentSource} content the manifest
    */
-  setDetails(title, description) {
-    this.panel.replaceChildren();
-    const h = document.createElement('h1');
-    h.textContent = title;
-    this.panel.append(h);
-    if (description) {
-      const p = document.createElement('p');
-      p.textContent = description;
-      this.panel.append(p);
-    }
-    this.panel.append(this.quality);
+  setDetails(content) {
+    this.#content = content;
+    const title = chooseText(content, 'title');
+    const description = chooseText(content, 'description');
+    // Written in place: the quality chart after them keeps its focus through a change of language.
+    const h = this.panel.querySelector(':scope > h1') ?? document.createElement('h1');
+    const p = this.panel.querySelector(':scope > p.description') ?? document.createElement('p');
+    if (!(p instanceof HTMLElement)) return;
+    p.className = 'description';
+    h.textContent = title.text;
+    markLanguage(h, title.lang);
+    p.textContent = description.text;
+    markLanguage(p, description.lang);
+    p.hidden = !description.text;
+    if (!h.isConnected) this.panel.prepend(h, p);
+    if (!this.quality.isConnected) this.panel.append(this.quality);
   }
 
   /**
@@ -313,7 +362,10 @@ export class ViewerUi {
    */
   setRights(rights, download = null) {
     this.#rights = [rights, download];
-    const line = creditLine(rights);
+    // The credit in the visitor's language where the museum gave one (setDetails' manifest); a
+    // version without a credit of its own shows none in any language, as the server's page head.
+    const credit = this.#content && rights?.credit ? chooseText(this.#content, 'credit') : { text: rights?.credit ?? '', lang: null };
+    const line = creditLine(rights ? { ...rights, credit: credit.text } : rights);
     this.credit.replaceChildren();
     this.credit.hidden = line === null && !download;
     if (this.credit.hidden) return;
@@ -338,6 +390,7 @@ export class ViewerUi {
       const text = part('credit-text');
       text.textContent = line.credit;
       text.title = line.credit;
+      markLanguage(text, credit.lang);
     }
     if (line?.licence) {
       const licence = part('credit-licence');

@@ -7,17 +7,21 @@
  */
 
 import { t } from './i18n/index.js';
-import { OrbitCamera } from './camera.js';
+import { OrbitCamera, multiply } from './camera.js';
 import { ColourLoader } from './colour-loader.js';
 import { OrbitControls } from './controls.js';
-import { frameBox, upRotation, validBounds } from './frame.js';
+import { frameBox, unrotate, upRotation, validBounds } from './frame.js';
+import { defaultBudget } from './part-selection.js';
 import { DEFAULT_LOOK } from './program.js';
 import { Annotations } from './annotations.js';
 import { Inspection } from './inspection.js';
+import { ViewText } from './view-text.js';
 import { canTransfer, openRenderer } from './render-host.js';
 import { retryAfterSeconds, waitToRetry } from './retry.js';
 import { BACKGROUND } from './shading.js';
 import { MeshSplats } from './splats/mesh-splat-view.js';
+import { ShareView } from './share.js';
+import { TourPlayer } from './tour.js';
 import { PointModel } from './splats/point-model.js';
 
 /**
@@ -41,6 +45,14 @@ import { PointModel } from './splats/point-model.js';
  * @property {import('./motion.js').MotionMode | null} [motion] what is drawn while the view
  *   moves (motion.js): `auto` (null or absent) a coarser level where the level on screen is
  *   slow to draw, `full` always that level, `coarse` always the coarser one
+ * @property {import('./view-state.js').ViewState} [view] a shared view to open at (view-state.js)
+ * @property {string | null} [contentState] a IIIF Content State to open at (`iiif-content`; content-state.js)
+ * @property {{ tour: number, step: number } | null} [tour] a tour link: open this tour at this step (from 1; tour.js)
+ * @property {'uniform' | 'view' | null} [refine] how a charted stream with a part index refines:
+ *   `uniform` (null or absent) batch by batch to the cap, `view` chart by chart where the camera
+ *   looks (part-refinement.js; README, "View-dependent refinement")
+ * @property {number | null} [vertexBudget] with `refine: 'view'`, the most vertices held
+ *   (null or absent: by the visitor's device, part-selection.js VERTEX_BUDGETS)
  */
 
 /**
@@ -49,6 +61,9 @@ import { PointModel } from './splats/point-model.js';
  * @property {string} slug
  * @property {string} title
  * @property {string} description
+ * @property {string | null} [language] the BCP 47 tag of `title`, `description` and `rights.credit` (null: not stated)
+ * @property {Record<string, import('./content-language.js').ContentTranslation>} [translations] the same texts in other
+ *   languages, by tag, each field optional (content-language.js chooses)
  * @property {boolean} has_colour
  * @property {number} last_level
  * @property {Array<{ level: number, vertices: number, faces: number, bytes: number, url: string, allowed: boolean }>} levels
@@ -61,6 +76,7 @@ import { PointModel } from './splats/point-model.js';
  * @property {import('./geometry.js').Bounds} [bounds] every level's extent, model coordinates
  * @property {'mesh' | 'points'} [kind] a point cloud's levels are prefixes of a point stream (splats/point-model.js)
  * @property {number} [stream_format] 5: a charted stream, whose charts a pool of workers refines
+ * @property {string} [parts] the part index of a charted stream (view-dependent refinement)
  * @property {import('./rights.js').Rights} [rights] credit line and licence (absent from older servers)
  * @property {{ url: string, level: number, bytes: number } | null} [download] a GLB of the level this visitor may take, where the policy offers one
  */
@@ -136,6 +152,9 @@ export const MAX_DECODERS = 4;
 
 /** The charted stream format (codec/core/FORMAT.md). */
 const CHARTED_FORMAT = 5;
+
+/** The decode worker hears where the camera is at most this often (view-dependent refinement). */
+const PART_CAMERA_MS = 150;
 
 /** Toolbar buttons for a mesh only: hidden on a point cloud. */
 const MESH_TOOLS = ['wireframe', 'relief', 'splats', 'measure'];
@@ -230,6 +249,13 @@ export class Viewer {
   /** @type {Map<number, (answer: { distance?: number, level?: number, error?: string }) => void>} */
   #geodesics = new Map();
   #nextGeodesic = 1;
+  /** View-dependent refinement's state, from the decode worker (null: not refining by parts). @type {import('./part-refinement.js').PartsState | null} */
+  #parts = null;
+  /** @type {ReturnType<typeof setTimeout> | null} */
+  #partCameraTimer = null;
+  #partCameraAt = 0;
+  /** @type {Map<number, (answer: any) => void>} */
+  #partCharts = new Map();
   /** The cap in force: from the manifest, or from a batch the server refused. */
   #cap = { level: 0, reason: /** @type {string | null} */ (null), retryAfterS: /** @type {number | null} */ (null) };
 
@@ -258,7 +284,9 @@ export class Viewer {
       toggleFullscreen: () => ui.toggleFullscreen(),
       interacted: (kind) => this.#emit('vitrine-interaction', { kind }),
       grabbed: (on) => this.renderer?.setGrabbed(on),
+      pickCentre: () => this.inspection.pickCentre(),
     });
+    ui.onNudge = (step) => this.controls.nudge(step);
     ui.onReset = () => this.resetView();
     ui.onWireframe = () => this.setWireframe(!this.#wireframe);
     ui.onRelief = () => this.setRelief(!this.#relief);
@@ -272,6 +300,14 @@ export class Viewer {
     this.inspection = new Inspection(this);
     /** The curators' notes on the model (annotations.js). */
     this.annotations = new Annotations(this);
+    /** The view's accessible name, description and loading announcements (view-text.js). */
+    this.viewText = new ViewText(this);
+    /** Share links, and the shared view or Content State opened with (share.js). */
+    this.share = new ShareView(this);
+    this.share.expect(options.view ?? {}, options.contentState ?? null);
+    /** Guided tours of the version on screen (tour.js). */
+    this.tours = new TourPlayer(this);
+    this.tours.openAt(options.tour ?? null);
   }
 
   /** The look in force (program.js Look). */
@@ -291,8 +327,52 @@ export class Viewer {
 
   /** The camera moved or the view was resized: what is anchored to the model follows. */
   cameraMoved() {
+    this.#sendPartCamera();
     this.annotations.place();
     this.inspection.place();
+    this.viewText?.changed();
+  }
+
+  /**
+   * View-dependent refinement's state (null when the model does not refine by parts):
+   * charts, their depths, the final depth, resident vertices and the budget, bytes fetched.
+   */
+  partsState() {
+    return this.#parts && structuredClone(this.#parts);
+  }
+
+  /**
+   * One chart as the decode worker holds it (tests compare it with a whole decoder's chart).
+   * @param {number} chart
+   * @returns {Promise<{ depth: number, positions: Float32Array, colours: Uint8Array | null, indices: Uint32Array }>}
+   */
+  partChart(chart) {
+    const worker = this.#worker;
+    if (!worker) return Promise.reject(new Error('no model loaded'));
+    const id = this.#nextGeodesic++;
+    return new Promise((resolve, reject) => {
+      this.#partCharts.set(id, (answer) => (answer.error ? reject(new Error(answer.error)) : resolve(answer)));
+      worker.postMessage({ type: 'part-chart', id, chart });
+    });
+  }
+
+  /** Where the camera looks, to the decode worker, at most every {@link PART_CAMERA_MS}. */
+  #sendPartCamera() {
+    if (!this.#parts || !this.camera || this.#partCameraTimer) return;
+    const wait = this.#partCameraAt + PART_CAMERA_MS - performance.now();
+    this.#partCameraTimer = setTimeout(() => {
+      this.#partCameraTimer = null;
+      this.#partCameraAt = performance.now();
+      const camera = this.camera;
+      if (!camera || !this.#worker) return;
+      const m = this.#look.model;
+      // prettier-ignore
+      const model = new Float32Array([m[0], m[1], m[2], 0, m[3], m[4], m[5], 0, m[6], m[7], m[8], 0, 0, 0, 0, 1]);
+      const clip = multiply(multiply(camera.projection(this.aspect()), camera.view()), model);
+      const eye = unrotate(m, camera.basis().eye);
+      const pixelsPerRadian = this.ui.canvas.height / camera.fovY;
+      this.#worker.postMessage({ type: 'part-camera', camera: { eye, clip: Array.from(clip), pixelsPerRadian } });
+    }, Math.max(0, wait));
   }
 
   /** The view's aspect, as the renderer draws it. */
@@ -307,7 +387,21 @@ export class Viewer {
    */
   #makeCamera(baseBounds) {
     this.camera ??= new OrbitCamera(frameBox(this.#look, baseBounds), this.aspect());
+    for (const resolve of this.#cameraWaiters.splice(0)) resolve(this.camera);
     return this.camera;
+  }
+
+  /** @type {Array<(camera: OrbitCamera) => void>} */
+  #cameraWaiters = [];
+
+  /**
+   * Resolves once the camera is made (a level can reach the screen through
+   * the render worker before the decode worker's notice makes it here).
+   * @returns {Promise<OrbitCamera>}
+   */
+  whenCamera() {
+    if (this.camera) return Promise.resolve(this.camera);
+    return new Promise((resolve) => this.#cameraWaiters.push(resolve));
   }
 
   /**
@@ -354,6 +448,7 @@ export class Viewer {
     this.#set({ status: 'loading', message: null });
     this.ui.showError(null);
     this.ui.showNotice(null);
+    this.viewText.restart();
     try {
       // Manifest, decoder and worker script load in parallel.
       // The renderer starts beside them and is not waited for: the decode
@@ -398,6 +493,7 @@ export class Viewer {
 
   stop() {
     this.#attempt++;
+    this.#parts = null;
     this.#worker?.terminate();
     this.#worker = null;
     for (const helper of this.#helpers) helper.terminate();
@@ -473,7 +569,9 @@ export class Viewer {
   /**
    * The turntable: from the home view, the camera orbits once about the
    * vertical axis in `periodMs`, with the visitor's controls locked; resolves
-   * when the turn is complete (or stopTurntable()).
+   * when the turn is complete (or stopTurntable()). A visitor who asked for
+   * reduced motion (`prefers-reduced-motion: reduce`) sees the home view
+   * held still for the same time instead.
    * @param {number} [periodMs]
    * @returns {Promise<void>}
    */
@@ -481,6 +579,7 @@ export class Viewer {
     this.stopTurntable();
     const wasLocked = this.controls.locked;
     this.setLocked(true);
+    const still = typeof matchMedia === 'function' && matchMedia('(prefers-reduced-motion: reduce)').matches;
     return new Promise((resolve) => {
       /** @type {number | null} */
       let start = null;
@@ -501,7 +600,7 @@ export class Viewer {
         }
         if (camera && start !== null) {
           const t = Math.min(1, (now - start) / periodMs);
-          camera.state.yaw = yaw + 2 * Math.PI * t;
+          if (!still) camera.state.yaw = yaw + 2 * Math.PI * t;
           this.renderer?.requestFrame();
           if (t >= 1) {
             this.#endTurn?.();
@@ -561,11 +660,15 @@ export class Viewer {
     this.#pointTools(false);
     this.points?.destroy();
     this.points = null;
-    this.ui.setDetails(manifest.title, manifest.description);
+    this.ui.setDetails(manifest);
+    // The view's name follows the model at once (the description settles
+    // with the camera); a debounced write could land long after the title.
+    this.viewText.update();
     this.ui.setRights(manifest.rights, this.#download(manifest));
     this.ui.setQuality(manifest.quality ?? null);
     this.#look = { ...this.#look, model: upRotation(manifest.up), bounds: validBounds(manifest.bounds, null) };
     this.annotations.load();
+    void this.tours.load();
     this.inspection.begin();
     this.#worker = worker;
     worker.onmessage = (event) => this.#message(event.data);
@@ -595,11 +698,20 @@ export class Viewer {
         ? 'always'
         : 'last',
     };
+    const byParts = Boolean(manifest.parts) && this.options.refine === 'view' && this.options.level === null && this.#hold === null;
+    if (byParts) {
+      request.parts = {
+        indexUrl: url(/** @type {string} */ (manifest.parts)),
+        apiBase: this.options.manifestUrl,
+        query: [...this.options.query],
+        budget: this.options.vertexBudget ?? defaultBudget(manifest.visitor?.device),
+      };
+    }
     // Levels and edges go through a port to the renderer (a render worker
     // directly, or this page in the fallback); the page gets each level as
     // a notice without its buffers.
     const channel = new MessageChannel();
-    const helpers = manifest.stream_format === CHARTED_FORMAT ? this.#startHelpers(module) : [];
+    const helpers = manifest.stream_format === CHARTED_FORMAT && !byParts ? this.#startHelpers(module) : [];
     worker.postMessage({ type: 'load', module, request, port: channel.port2, helpers }, [channel.port2, ...helpers]);
     return channel.port1;
   }
@@ -654,7 +766,8 @@ export class Viewer {
    */
   #beginPoints(manifest, module) {
     this.manifest = manifest;
-    this.ui.setDetails(manifest.title, manifest.description);
+    this.ui.setDetails(manifest);
+    this.viewText.update();
     this.ui.setRights(manifest.rights);
     this.#look = { ...this.#look, model: upRotation(manifest.up), bounds: validBounds(manifest.bounds, null) };
     this.#cap = { level: manifest.cap.level, reason: manifest.cap.reason, retryAfterS: manifest.cap.retry_after_s };
@@ -747,9 +860,26 @@ export class Viewer {
     this.ui.root.dispatchEvent(new CustomEvent(type, { detail, bubbles: true, composed: true }));
   }
 
-  /** @param {import('./reconstruction.js').PageMessage | import('./splats/mesh-splat-view.js').LevelData | { type: 'geodesic', id: number, distance?: number, level?: number, error?: string }} message */
+  /**
+   * @param {import('./reconstruction.js').PageMessage | import('./splats/mesh-splat-view.js').LevelData
+   *   | { type: 'geodesic', id: number, distance?: number, level?: number, error?: string }
+   *   | { type: 'parts', state: import('./part-refinement.js').PartsState } | { type: 'part-chart', id: number }} message
+   */
   #message(message) {
     if (message.type === 'level-data') return void this.meshSplats.receive(message);
+    if (message.type === 'part-chart') {
+      this.#partCharts.get(message.id)?.(message);
+      this.#partCharts.delete(message.id);
+      return;
+    }
+    if (message.type === 'parts') {
+      const before = this.#parts;
+      this.#parts = message.state;
+      if (this.state.shownLevel >= 0) this.#set({ vertices: message.state.resident, received: message.state.bytesFetched });
+      if (!before) this.#sendPartCamera();
+      if (!before || before.depths.some((d, k) => d !== message.state.depths[k])) this.#emit('vitrine-parts', { depths: message.state.depths });
+      return;
+    }
     if (message.type === 'geodesic') {
       this.#geodesics.get(message.id)?.(message);
       this.#geodesics.delete(message.id);
@@ -813,10 +943,14 @@ export class Viewer {
 
   /** @param {{ level: number, vertices: number, normalsMs: number }} level */
   #shown(level) {
-    this.#set({ shownLevel: level.level, vertices: level.vertices, normalsMs: level.normalsMs });
+    // By parts, the level's vertices count copies the renderer keeps aside: the charts' are the ones held.
+    this.#set({ shownLevel: level.level, vertices: this.#parts?.resident ?? level.vertices, normalsMs: level.normalsMs });
     this.annotations.levelShown();
     this.inspection.levelShown();
     this.meshSplats.levelShown();
+    this.viewText.levelShown(level.level, this.state.lastLevel);
+    void this.share.levelShown();
+    void this.tours.levelShown();
     this.#ready(level.level);
     if (level.level < this.state.targetLevel || this.state.status !== 'refining') return;
     const last = /** @type {Manifest} */ (this.manifest).last_level;

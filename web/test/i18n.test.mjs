@@ -10,7 +10,7 @@ import { readFileSync, readdirSync } from 'node:fs';
 import { dirname, join, relative } from 'node:path';
 import test from 'node:test';
 import { fileURLToPath } from 'node:url';
-import { CATALOGUES, formatBytes, formatCount, formatDate, setLanguage, t } from '../src/i18n/index.js';
+import { CATALOGUES, formatBytes, formatCount, formatDate, onLanguageChange, setLanguage, setOverrides, t } from '../src/i18n/index.js';
 import { LANGUAGES, chooseLanguage } from '../src/i18n/languages.js';
 import { literalHtmlStrings, literalUiStrings } from './support/ui-strings.mjs';
 
@@ -165,4 +165,24 @@ test('the language is ?lang=, then the kept choice, then the browser, then Engli
   assert.equal(chooseLanguage({ query: 'xx', stored: 'fr', preferred: ['de'] }), 'fr');
   assert.equal(chooseLanguage({ query: null, stored: null, preferred: ['ja', 'pt-BR', 'de'] }), 'pt');
   assert.equal(chooseLanguage({ preferred: ['ja'] }), 'en');
+});
+
+test("a museum's own words replace a message per language, and only where given", () => {
+  setLanguage('en');
+  /** @type {string[]} */
+  const heard = [];
+  const stop = onLanguageChange((code) => heard.push(code));
+  setOverrides({ en: { 'page.allModels': '← All stories', 'gallery.levels': 42 }, pt: { 'page.allModels': '← Todas as histórias' }, xx: 'no' });
+  assert.equal(t('page.allModels'), '← All stories');
+  assert.equal(t('gallery.levels', { count: 2 }), '2 levels', 'a value that is not text is left out');
+  assert.deepEqual(heard, ['en'], 'the page is written again');
+  setLanguage('pt');
+  assert.equal(t('page.allModels'), '← Todas as histórias');
+  assert.equal(t('page.embed'), 'Incorporar este modelo', 'the catalogue where nothing is given');
+  setLanguage('de');
+  assert.equal(t('page.allModels'), '← Alle Modelle');
+  setOverrides(null);
+  setLanguage('en');
+  assert.equal(t('page.allModels'), '← All models');
+  stop();
 });

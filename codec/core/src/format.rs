@@ -11,6 +11,10 @@ pub const VERSION: u8 = 4;
 /// The chart-parallel stream: after its global batches, every batch is cut
 /// into one part per chart, each decoded on its own (`charts` module).
 pub const CHARTED_VERSION: u8 = 5;
+/// The nested-chart stream: phases of parted batches, each phase's charts
+/// splitting the previous phase's (`charts::nested`); every batch payload
+/// starts with a deferred-precision byte.
+pub const NESTED_VERSION: u8 = 6;
 pub(crate) const HEADER_FIXED: usize = 40;
 pub(crate) const LEVEL_ENTRY: usize = 12;
 pub(crate) const BASE_TAG: u8 = b'M';
@@ -80,9 +84,9 @@ impl Header {
             return Err(Error::stream("not a Vitrine stream (bad magic)"));
         }
         let version = r.u8()?;
-        if version != VERSION && version != CHARTED_VERSION {
+        if !(VERSION..=NESTED_VERSION).contains(&version) {
             return Err(Error::stream(format!(
-                "unsupported version {version} (this build reads {VERSION} and {CHARTED_VERSION})"
+                "unsupported version {version} (this build reads {VERSION} to {NESTED_VERSION})"
             )));
         }
         let flags = r.u8()?;
@@ -214,7 +218,7 @@ impl ChunkHeader {
             )));
         }
         let version = r.u8()?;
-        if version != VERSION && version != CHARTED_VERSION {
+        if !(VERSION..=NESTED_VERSION).contains(&version) {
             return Err(Error::stream("chunk version mismatch"));
         }
         let h = ChunkHeader {
@@ -265,6 +269,7 @@ impl<'a> BatchChunk<'a> {
 }
 
 /// A bounds-checked little-endian cursor: every read past the end is an error.
+#[derive(Clone)]
 pub(crate) struct Reader<'a> {
     bytes: &'a [u8],
     at: usize,

@@ -1,7 +1,7 @@
 //! Per-level byte breakdown of a stream, read from section lengths only.
 
 use crate::decoder::read_pass;
-use crate::format::{ChunkHeader, Reader, BASE_TAG, BATCH_TAG, PARTED_TAG};
+use crate::format::{ChunkHeader, Reader, BASE_TAG, BATCH_TAG, NESTED_VERSION, PARTED_TAG};
 use crate::gates::PassKind;
 use crate::{Result, StreamIndex};
 
@@ -35,6 +35,8 @@ pub fn breakdown(stream: &[u8]) -> Result<Vec<LevelBreakdown>> {
         ..Default::default()
     }];
     let mut cut = false;
+    let nested = index.header.version >= NESTED_VERSION;
+    let mut phase = None;
     for (k, range) in index.batches.iter().enumerate() {
         let (chunk, payload) =
             ChunkHeader::parse(&stream[range.clone()], &[BATCH_TAG, PARTED_TAG])?;
@@ -45,7 +47,25 @@ pub fn breakdown(stream: &[u8]) -> Result<Vec<LevelBreakdown>> {
             ..Default::default()
         };
         let mut r = Reader::new(payload);
-        if chunk.tag == PARTED_TAG {
+        if nested {
+            // The deferred-precision byte (0 in every stream written today).
+            r.u8()?;
+        }
+        if chunk.tag == PARTED_TAG && nested {
+            let this = r.varint()?;
+            let charts = r.varint()?;
+            if phase != Some(this) {
+                // The labels or the split count as connectivity.
+                b.connectivity += r.section()?.len() as u32;
+                phase = Some(this);
+            }
+            for _ in 0..charts {
+                let part = r.section()?;
+                if !part.is_empty() {
+                    add_passes(&mut Reader::new(part), &mut b)?;
+                }
+            }
+        } else if chunk.tag == PARTED_TAG {
             let charts = r.varint()?;
             if !cut {
                 // The chart labels count as connectivity.

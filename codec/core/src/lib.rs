@@ -30,6 +30,7 @@ mod halfedge;
 mod inspect;
 mod mesh;
 mod meter;
+mod parts;
 mod patch;
 mod predict;
 mod priors;
@@ -38,18 +39,25 @@ mod room;
 mod training;
 
 pub use bits::bit_budget;
+pub use charts::nested::{Shape as NestedShape, MAX_PHASE_CHARTS};
 pub use charts::MAX_CHARTS;
-pub use decoder::{decode, ChartLevel, Decoder, Limits};
+pub use decoder::{decode, ChartLevel, ChartView, Decoder, Limits, NestedView};
 pub use encoder::{
     encode, BaseTarget, CandidatePatch, Charts, EncodeOptions, EncodeProgress, Encoded, Encoder,
     PatchGuard,
 };
 pub use error::{Error, Result};
-pub use format::{BatchChunk, Header, LevelInfo, StreamIndex, CHARTED_VERSION, MAGIC, VERSION};
+pub use format::{
+    BatchChunk, Header, LevelInfo, StreamIndex, CHARTED_VERSION, MAGIC, NESTED_VERSION, VERSION,
+};
 pub use gates::GateStatistics;
 pub use inspect::{breakdown, LevelBreakdown};
 pub use mesh::IndexedMesh;
 pub use meter::PassBits;
+pub use parts::{
+    nested_part_table, part_table, NestedLayout, NestedPartTable, NestedSummary, PartRecord,
+    PartedLayout, SplitRecord,
+};
 pub use quantize::Quantization;
 
 #[cfg(test)]

@@ -13,7 +13,7 @@
 
 use std::path::PathBuf;
 
-use vitrine_codec::{decode, encode, EncodeOptions, IndexedMesh, Limits};
+use vitrine_codec::{decode, encode, Charts, EncodeOptions, IndexedMesh, Limits};
 use vitrine_samples::golden::{check_or_bless, GoldenEntry};
 use vitrine_samples::{add_noise, icosphere, paint, plate_with_tunnels, torus};
 
@@ -47,6 +47,32 @@ fn encoder_output_matches_golden_values() {
         // A golden stream must at least decode to the mesh's size.
         let d = decode(&encoded.bytes, None, Limits::default()).unwrap();
         assert_eq!(d.vertex_count(), mesh.positions.len(), "{name}");
+        found.push(GoldenEntry::of(name, &encoded.bytes));
+    }
+    // Charted (format 5) and nested (format 6) streams of a larger scan-like torus.
+    let mut scan = torus(120, 48, 1.0, 0.35);
+    add_noise(&mut scan, 0.003, 5);
+    paint(&mut scan);
+    for (name, charts, version) in [
+        ("charted-4-painted-noisy-torus-120x48", Charts::Count(4), 5),
+        (
+            "nested-2x2x2-painted-noisy-torus-120x48",
+            Charts::NestedShape {
+                top: 2,
+                fanout: 2,
+                phases: 2,
+            },
+            6,
+        ),
+    ] {
+        let options = EncodeOptions {
+            charts,
+            ..EncodeOptions::default()
+        };
+        let encoded = encode(&scan, &options).unwrap();
+        assert_eq!(encoded.header.version, version, "{name}");
+        let d = decode(&encoded.bytes, None, Limits::default()).unwrap();
+        assert_eq!(d.vertex_count(), scan.positions.len(), "{name}");
         found.push(GoldenEntry::of(name, &encoded.bytes));
     }
     let diffs = check_or_bless(&golden_path(), HEADER, &found);

@@ -77,6 +77,24 @@ fn main() {
     .unwrap();
     assert_eq!(charted.header.version, vitrine_codec::CHARTED_VERSION);
     write("decode_stream", "charted", &charted.bytes);
+    // A nested stream (format 6): phases, splits, deferred-precision bytes.
+    let mut painted = torus(60, 30, 1.0, 0.3);
+    paint(&mut painted);
+    let nested = encode(
+        &painted,
+        &EncodeOptions {
+            min_base_vertices: 8,
+            charts: Charts::NestedShape {
+                top: 2,
+                fanout: 2,
+                phases: 2,
+            },
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    assert_eq!(nested.header.version, vitrine_codec::NESTED_VERSION);
+    write("decode_stream", "nested", &nested.bytes);
 
     // decode_points: small point streams, with and without attributes.
     for (i, (n, attrs)) in [(40usize, false), (300, true)].into_iter().enumerate() {
@@ -86,13 +104,17 @@ fn main() {
             normals: attrs.then_some(nrm),
             ..vitrine_points::PointCloud::from_positions(pos)
         };
-        let opts = vitrine_points::stream::EncodeOptions {
-            bits: 10,
-            base_points: 16,
-            ..Default::default()
-        };
-        let s = vitrine_points::stream::encode(&cloud, &opts).unwrap();
-        write("decode_points", &format!("sphere-{i}"), &s.bytes);
+        // Both stream versions (2: neighbour-dependent mask contexts).
+        for version in vitrine_points::stream::VERSIONS {
+            let opts = vitrine_points::stream::EncodeOptions {
+                bits: 10,
+                base_points: 16,
+                version,
+                ..Default::default()
+            };
+            let s = vitrine_points::stream::encode(&cloud, &opts).unwrap();
+            write("decode_points", &format!("sphere-{i}-v{version}"), &s.bytes);
+        }
     }
 
     // decode_batch: selector byte, then batch 1's payload or whole chunk.

@@ -272,6 +272,27 @@ fn validate(mesh: &IndexedMesh, what: &'static str) -> Result<()> {
 ///
 /// A mesh left without any triangle is [`Error::Unsupported`].
 pub fn prepare(mesh: IndexedMesh, opts: &RepairOptions) -> Result<(IndexedMesh, RepairReport)> {
+    prepare_traced(mesh, opts).map(|(mesh, report, _)| (mesh, report))
+}
+
+/// Where each part of a repaired mesh came from, for callers that carry
+/// more per vertex or per corner than [`IndexedMesh`] holds (an MD2's
+/// frames and texture coordinates).
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct RepairTrace {
+    /// Each output vertex's input vertex (a split vertex's copies share it;
+    /// with welding, the first of the merged vertices).
+    pub vertex_origin: Vec<u32>,
+    /// Each output face's input face. Its corners are the input face's in
+    /// the same order, or `[a, c, b]` for `[a, b, c]` when it was flipped.
+    pub face_origin: Vec<u32>,
+}
+
+/// [`prepare`], with where each output vertex and face came from.
+pub fn prepare_traced(
+    mesh: IndexedMesh,
+    opts: &RepairOptions,
+) -> Result<(IndexedMesh, RepairReport, RepairTrace)> {
     validate(&mesh, "mesh")?;
     let mut report = RepairReport::default();
     let IndexedMesh {
@@ -292,11 +313,19 @@ pub fn prepare(mesh: IndexedMesh, opts: &RepairOptions) -> Result<(IndexedMesh, 
     let edges = drop_duplicate_faces(&mut work, &mut report)?;
     let nv0 = work.pos.len();
     let edges = orient_faces(&mut work.tris, edges, nv0, &mut report);
-    split_until_manifold(&mut work, edges, opts, &mut report)?;
-    let tris = restore_input_order(work.tris, work.face_of);
-    let mesh = drop_unreferenced_vertices(work.pos, work.col, tris, &mut report);
+    let base = split_until_manifold(&mut work, edges, opts, &mut report)?;
+    let (tris, face_origin) = restore_input_order(work.tris, work.face_of);
+    let (mesh, kept) = drop_unreferenced_vertices(work.pos, work.col, tris, &mut report);
     debug_assert!(check_manifold(&mesh).is_ok(), "{:?}", check_manifold(&mesh));
-    Ok((mesh, report))
+    let vertex_origin = kept
+        .iter()
+        .map(|&v| work.first[base[v as usize] as usize])
+        .collect();
+    let trace = RepairTrace {
+        vertex_origin,
+        face_origin,
+    };
+    Ok((mesh, report, trace))
 }
 
 /// The vertices after welding, and how to renumber the faces.
@@ -481,7 +510,7 @@ fn split_until_manifold(
     mut edges: Edges,
     opts: &RepairOptions,
     report: &mut RepairReport,
-) -> Result<()> {
+) -> Result<Vec<u32>> {
     let nv0 = work.pos.len();
     let mut splits = Splits {
         base: (0..nv0 as u32).collect(),
@@ -509,7 +538,7 @@ fn split_until_manifold(
     }
     drop(edges);
     report.non_manifold_vertices = splits.marked.iter().filter(|&&m| m).count();
-    Ok(())
+    Ok(splits.base)
 }
 
 /// Glues the corners across every manifold edge, and across the first
@@ -626,20 +655,22 @@ fn detach_extra_faces(work: &mut Work, splits: &mut Splits, bad: &[u32]) -> usiz
     added
 }
 
-/// Back to the input's face order (less the dropped faces).
-fn restore_input_order(tris: Vec<[u32; 3]>, face_of: Vec<u32>) -> Vec<[u32; 3]> {
+/// Back to the input's face order (less the dropped faces), with each
+/// face's input index.
+fn restore_input_order(tris: Vec<[u32; 3]>, face_of: Vec<u32>) -> (Vec<[u32; 3]>, Vec<u32>) {
     let mut faces: Vec<([u32; 3], u32)> = tris.into_iter().zip(face_of).collect();
     radsort::sort_by_key(&mut faces, |&(_, input)| input);
-    faces.into_iter().map(|(t, _)| t).collect()
+    faces.into_iter().unzip()
 }
 
-/// Step 6: drop unreferenced vertices, keeping order.
+/// Step 6: drop unreferenced vertices, keeping order. Returns the mesh and
+/// the vertex each output vertex was.
 fn drop_unreferenced_vertices(
     mut pos: Vec<[f32; 3]>,
     mut col: Option<Vec<[u8; 3]>>,
     mut tris: Vec<[u32; 3]>,
     report: &mut RepairReport,
-) -> IndexedMesh {
+) -> (IndexedMesh, Vec<u32>) {
     let mut new_id = vec![NONE; pos.len()];
     for t in &tris {
         for &v in t {
@@ -672,11 +703,15 @@ fn drop_unreferenced_vertices(
             *t = t.map(|v| new_id[v as usize]);
         }
     }
-    IndexedMesh {
+    let kept = (0..new_id.len() as u32)
+        .filter(|&v| new_id[v as usize] != NONE)
+        .collect();
+    let mesh = IndexedMesh {
         positions: pos,
         colors: col,
         triangles: tris,
-    }
+    };
+    (mesh, kept)
 }
 
 /// Flips faces so that faces sharing an edge (with exactly two faces) agree,
@@ -925,5 +960,51 @@ mod tests {
         };
         let e = prepare(mesh(p, t), &strict).unwrap_err();
         assert!(e.to_string().contains("non-manifold edge"), "{e}");
+    }
+
+    #[test]
+    fn the_trace_names_each_output_vertex_and_face_of_the_input() {
+        // A grid with a flipped face, a degenerate and a duplicate face, an
+        // unused vertex, and a bow-tie (two fans at one vertex).
+        let mut m = grid(3);
+        m.triangles[4].swap(0, 1);
+        m.triangles.insert(2, [5, 5, 6]);
+        m.triangles.push(m.triangles[0]);
+        m.positions.push([9.0, 9.0, 9.0]); // unused
+        let tip = m.positions.len() as u32;
+        m.positions.extend([[-1.0, -1.0, 0.0], [-1.0, -2.0, 0.0]]);
+        m.triangles.push([0, tip + 1, tip]); // touches the grid at vertex 0 only
+        let input = m.clone();
+        let options = RepairOptions {
+            weld: false,
+            ..Default::default()
+        };
+        let (out, report, trace) = prepare_traced(m, &options).unwrap();
+        assert!(
+            report.split_vertices >= 1 && report.flipped_faces == 1,
+            "{report:?}"
+        );
+        assert_eq!(trace.vertex_origin.len(), out.positions.len());
+        assert_eq!(trace.face_origin.len(), out.triangles.len());
+        for (v, &o) in trace.vertex_origin.iter().enumerate() {
+            assert_eq!(out.positions[v], input.positions[o as usize], "vertex {v}");
+        }
+        for (t, &f) in out.triangles.iter().zip(&trace.face_origin) {
+            let back = t.map(|v| trace.vertex_origin[v as usize]);
+            let u = input.triangles[f as usize];
+            let flipped = [u[0], u[2], u[1]];
+            let rotations = |w: [u32; 3]| [w, [w[1], w[2], w[0]], [w[2], w[0], w[1]]];
+            assert!(
+                rotations(u).contains(&back) || rotations(flipped).contains(&back),
+                "face {f}: {back:?} from {u:?}"
+            );
+        }
+        // The degenerate, the duplicate and the unused vertex are gone.
+        assert!(!trace.face_origin.contains(&2));
+        assert!(!trace
+            .face_origin
+            .contains(&(input.triangles.len() as u32 - 2)));
+        assert!(!trace.vertex_origin.contains(&(tip - 1)));
+        check_manifold(&out).unwrap();
     }
 }

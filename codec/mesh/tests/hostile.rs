@@ -18,7 +18,7 @@ use std::time::{Duration, Instant};
 
 use vitrine_codec::{
     decode, encode, Decoder, EncodeOptions, Error, Header, Limits, StreamIndex, CHARTED_VERSION,
-    MAGIC, VERSION,
+    MAGIC, NESTED_VERSION, VERSION,
 };
 use vitrine_samples::icosphere;
 
@@ -289,7 +289,7 @@ fn wrong_magic_is_refused() {
 #[test]
 fn unsupported_version_is_refused() {
     // VERSION − 1: a stream from the previous format, as a database may hold.
-    for v in [0, VERSION - 1, CHARTED_VERSION + 1, 0x7f, 0xff] {
+    for v in [0, VERSION - 1, NESTED_VERSION + 1, 0x7f, 0xff] {
         let mut b = sphere_stream().to_vec();
         b[AT_VERSION] = v;
         assert_stream_err(
@@ -305,6 +305,15 @@ fn unsupported_version_is_refused() {
         &[
             "chunk version mismatch",
             "version 4 chunk in a version 5 stream",
+        ],
+    );
+    // And claiming the nested format (6).
+    b[AT_VERSION] = NESTED_VERSION;
+    assert_stream_err(
+        decode(&b, None, Limits::default()),
+        &[
+            "chunk version mismatch",
+            "version 4 chunk in a version 6 stream",
         ],
     );
 }

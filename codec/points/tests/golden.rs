@@ -29,16 +29,40 @@ fn clouds() -> Vec<(&'static str, PointCloud, EncodeOptions)> {
         colours: Some(colours),
     };
     let (cube_pos, _) = cube(8000, 1.0, 7);
+    // Version 1 streams must stay byte for byte what they were.
     let small = EncodeOptions {
         base_points: 256,
+        version: 1,
         ..Default::default()
     };
+    let small_v2 = EncodeOptions {
+        version: 2,
+        ..small.clone()
+    };
+    let cube = PointCloud::from_positions(cube_pos);
     vec![
-        ("sphere-5000-normals-colours-14bit", painted, small.clone()),
+        (
+            "sphere-5000-normals-colours-14bit",
+            painted.clone(),
+            small.clone(),
+        ),
         (
             "cube-8000-positions-11bit",
-            PointCloud::from_positions(cube_pos),
+            cube.clone(),
             EncodeOptions { bits: 11, ..small },
+        ),
+        (
+            "v2-sphere-5000-normals-colours-14bit",
+            painted,
+            small_v2.clone(),
+        ),
+        (
+            "v2-cube-8000-positions-11bit",
+            cube,
+            EncodeOptions {
+                bits: 11,
+                ..small_v2
+            },
         ),
     ]
 }

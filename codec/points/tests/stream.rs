@@ -34,17 +34,23 @@ fn coloured_sphere(n: usize, seed: u64) -> PointCloud {
 #[test]
 fn stream_round_trip_is_bit_exact() {
     let cloud = coloured_sphere(20_000, 1);
-    for bits in [6u8, 11, 16] {
+    for (bits, version) in [6u8, 11, 16].into_iter().flat_map(|b| [(b, 1u8), (b, 2)]) {
         let opts = EncodeOptions {
             bits,
             base_points: 500,
+            version,
             ..Default::default()
         };
         let enc = encode(&cloud, &opts).unwrap();
         let dec = decode(&enc.bytes, None, Limits::default()).unwrap();
         assert!(dec.is_complete());
+        assert_eq!(dec.header().version, version);
         assert_eq!(dec.point_count(), cloud.len());
-        assert_eq!(dec.quantized(), &enc.quantized[..], "bits {bits}");
+        assert_eq!(
+            dec.quantized(),
+            &enc.quantized[..],
+            "bits {bits} v{version}"
+        );
         assert_eq!(dec.normal_codes().unwrap(), enc.normals.clone().unwrap());
         let want_colours: Vec<[u8; 3]> = enc
             .order
@@ -94,10 +100,17 @@ fn stream_positions_only_round_trip_and_split() {
 
 #[test]
 fn stream_levels_are_prefixes_with_one_point_per_occupied_cell() {
+    for version in [1, 2] {
+        levels_are_prefixes(version);
+    }
+}
+
+fn levels_are_prefixes(version: u8) {
     let cloud = coloured_sphere(40_000, 2);
     let opts = EncodeOptions {
         bits: 12,
         base_points: 300,
+        version,
         ..Default::default()
     };
     let enc = encode(&cloud, &opts).unwrap();
@@ -147,11 +160,18 @@ fn stream_levels_are_prefixes_with_one_point_per_occupied_cell() {
 
 #[test]
 fn stream_truncated_or_corrupt_gives_errors() {
+    for version in [1, 2] {
+        truncated_or_corrupt_gives_errors(version);
+    }
+}
+
+fn truncated_or_corrupt_gives_errors(version: u8) {
     let cloud = coloured_sphere(3_000, 3);
     let enc = encode(
         &cloud,
         &EncodeOptions {
             base_points: 200,
+            version,
             ..Default::default()
         },
     )
@@ -176,7 +196,7 @@ fn stream_truncated_or_corrupt_gives_errors() {
     }
     assert!(
         failures > 100,
-        "only {failures} of 400 corruptions were detected"
+        "v{version}: only {failures} of 400 corruptions were detected"
     );
     // A header declaring more than the limit is refused before any work.
     let r = decode(bytes, None, Limits { max_points: 100 });
@@ -210,5 +230,83 @@ fn stream_single_point_and_all_duplicates() {
         enc.bytes.len() < 200,
         "{} bytes for 1000 equal points",
         enc.bytes.len()
+    );
+}
+
+#[test]
+fn stream_v2_positions_only_is_smaller_and_levels_count_alike() {
+    // A surface sampled at random, as positions-only scans arrive.
+    let (pos, _) = sphere(30_000, [0.0; 3], 1.0, 11);
+    let cloud = PointCloud::from_positions(pos);
+    let at = |version| {
+        let opts = EncodeOptions {
+            bits: 12,
+            base_points: 500,
+            version,
+            ..Default::default()
+        };
+        encode(&cloud, &opts).unwrap()
+    };
+    let (v1, v2) = (at(1), at(2));
+    // The version changes only how masks are coded: same points, same order.
+    assert_eq!(v1.level_points, v2.level_points);
+    assert_eq!(v1.order, v2.order);
+    assert!(
+        v2.bytes.len() < v1.bytes.len(),
+        "v2 {} bytes, v1 {}",
+        v2.bytes.len(),
+        v1.bytes.len()
+    );
+    for level in 0..v2.header.levels() {
+        let d = decode(&v2.bytes, Some(level + 1), Limits::default()).unwrap();
+        assert_eq!(d.point_count(), v2.level_points[level] as usize);
+    }
+}
+
+#[test]
+fn stream_v2_hostile_header_and_version_byte() {
+    let cloud = coloured_sphere(2_000, 4);
+    let v2 = EncodeOptions {
+        version: 2,
+        ..EncodeOptions::default()
+    };
+    let enc = encode(&cloud, &v2).unwrap();
+    assert_eq!(enc.header.version, 2);
+    // A v2 body read as v1 (or the reverse) must fail or stay in bounds.
+    let mut b = enc.bytes.clone();
+    b[4] = 1;
+    if let Ok(d) = decode(&b, None, Limits::default()) {
+        assert_eq!(d.point_count(), cloud.len());
+    }
+    for version in [0u8, 3, 255] {
+        let mut b = enc.bytes.clone();
+        b[4] = version;
+        assert!(decode(&b, None, Limits::default()).is_err());
+    }
+    // Every chunk's payload replaced by noise: errors, never a panic.
+    let (header, chunks) = split(&enc.bytes).unwrap();
+    let mut s = 17u64;
+    for _ in 0..50 {
+        let mut b = enc.bytes.clone();
+        for c in &chunks {
+            for byte in &mut b[c.start + 8..c.end] {
+                *byte = next(&mut s) as u8;
+            }
+        }
+        if let Ok(d) = decode(&b, None, Limits::default()) {
+            assert_eq!(d.point_count(), header.points as usize);
+        }
+    }
+    // Writing an unknown version is a parameter error.
+    let r = encode(
+        &cloud,
+        &EncodeOptions {
+            version: 3,
+            ..Default::default()
+        },
+    );
+    assert!(
+        matches!(r, Err(vitrine_points::Error::Parameter(_))),
+        "{r:?}"
     );
 }

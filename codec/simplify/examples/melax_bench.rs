@@ -10,51 +10,18 @@
 //!
 //! `--seed-cost` runs the seed's crease term sin²(θ/2) instead of sin(θ/2).
 
-use std::process::Command;
 use std::time::Instant;
 
-use vitrine_codec::IndexedMesh;
-use vitrine_mesh::export::write_ply;
 use vitrine_mesh::import::{import_path, ImportOptions};
 use vitrine_mesh::repair::{prepare, RepairOptions};
 use vitrine_quality::metrics::hausdorff;
 use vitrine_simplify::melax::{compact, melax_chain, MelaxCost, MelaxModel};
 
-const PERCENTS: [u32; 4] = [80, 60, 40, 20];
-const SAMPLES: usize = 200_000;
+#[path = "support/mod.rs"]
+mod support;
+use support::{peer, SAMPLES};
 
-/// The peer on `mesh` keeping `fraction` of its faces: faces, Hausdorff, seconds.
-fn peer(
-    script: &str,
-    mesh: &IndexedMesh,
-    fraction: f64,
-) -> Result<(usize, f64, f64), Box<dyn std::error::Error>> {
-    let dir = std::env::temp_dir().join(format!("vitrine-melax-peer-{}", std::process::id()));
-    std::fs::create_dir_all(&dir)?;
-    let (input, output) = (dir.join("in.ply"), dir.join("out.ply"));
-    let geometry = IndexedMesh {
-        colors: None,
-        ..mesh.clone()
-    };
-    write_ply(
-        &geometry,
-        &mut std::io::BufWriter::new(std::fs::File::create(&input)?),
-    )?;
-    let run = Command::new("python3")
-        .arg(script)
-        .arg(&input)
-        .arg(&output)
-        .arg(fraction.to_string())
-        .output()?;
-    if !run.status.success() {
-        return Err(String::from_utf8_lossy(&run.stderr).into_owned().into());
-    }
-    let ms: f64 = String::from_utf8_lossy(&run.stdout).trim().parse()?;
-    let simplified = import_path(&output, &ImportOptions::default())?;
-    let h = hausdorff(mesh, &simplified, SAMPLES).relative();
-    std::fs::remove_dir_all(&dir)?;
-    Ok((simplified.triangles.len(), h, ms / 1000.0))
-}
+const PERCENTS: [u32; 4] = [80, 60, 40, 20];
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut paths: Vec<String> = std::env::args().skip(1).collect();

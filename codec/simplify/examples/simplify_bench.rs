@@ -1,5 +1,5 @@
 //! The normal-deviation simplifier (each collapse variant, with the seed's
-//! placement and with quadric placement) at 10 % and 2 % of the faces,
+//! placement and with quadric placement) at 10 %, 5 % and 1 % of the faces,
 //! beside a quadric-error peer on the very same repaired mesh: symmetric
 //! Hausdorff over the bounding-box diagonal, and time.
 //!
@@ -7,18 +7,19 @@
 //!     cargo run --release -p vitrine-simplify --example simplify_bench -- \
 //!         [--peer scripts/peer_quadric.py] MESH…
 
-use std::process::Command;
 use std::time::Instant;
 
 use vitrine_codec::IndexedMesh;
-use vitrine_mesh::export::write_ply;
 use vitrine_mesh::import::{import_path, ImportOptions};
 use vitrine_mesh::repair::{prepare, RepairOptions};
 use vitrine_quality::metrics::hausdorff;
 use vitrine_simplify::{simplify, Collapse, Placement, SimplifyOptions, StopReason, Target};
 
-const FRACTIONS: [f64; 2] = [0.10, 0.02];
-const SAMPLES: usize = 200_000;
+#[path = "support/mod.rs"]
+mod support;
+use support::{peer, SAMPLES};
+
+const FRACTIONS: [f64; 3] = [0.10, 0.05, 0.01];
 
 /// One simplifier's result: faces, Hausdorff over the diagonal, seconds, how it stopped.
 fn ours(
@@ -43,39 +44,6 @@ fn ours(
     };
     let h = hausdorff(mesh, &out.mesh, SAMPLES).relative();
     (out.mesh.triangles.len(), h, seconds, stopped)
-}
-
-/// The peer on `mesh` (written to a temporary PLY), read back and measured.
-fn peer(
-    script: &str,
-    mesh: &IndexedMesh,
-    fraction: f64,
-) -> Result<(usize, f64, f64), Box<dyn std::error::Error>> {
-    let dir = std::env::temp_dir().join(format!("vitrine-peer-{}", std::process::id()));
-    std::fs::create_dir_all(&dir)?;
-    let (input, output) = (dir.join("in.ply"), dir.join("out.ply"));
-    let geometry = IndexedMesh {
-        colors: None,
-        ..mesh.clone()
-    };
-    write_ply(
-        &geometry,
-        &mut std::io::BufWriter::new(std::fs::File::create(&input)?),
-    )?;
-    let run = Command::new("python3")
-        .arg(script)
-        .arg(&input)
-        .arg(&output)
-        .arg(fraction.to_string())
-        .output()?;
-    if !run.status.success() {
-        return Err(String::from_utf8_lossy(&run.stderr).into_owned().into());
-    }
-    let ms: f64 = String::from_utf8_lossy(&run.stdout).trim().parse()?;
-    let simplified = import_path(&output, &ImportOptions::default())?;
-    let h = hausdorff(mesh, &simplified, SAMPLES).relative();
-    std::fs::remove_dir_all(&dir)?;
-    Ok((simplified.triangles.len(), h, ms / 1000.0))
 }
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {

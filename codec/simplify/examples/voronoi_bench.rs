@@ -1,6 +1,6 @@
 //! The intrinsic Voronoi simplifier (seed 001) measured three ways:
 //!
-//! - `hausdorff [--peer scripts/peer_quadric.py] [--radius R]… MESH…`: at
+//! - `hausdorff [--peer scripts/peer_quadric.py] [--radius R]… [--sharp D] MESH…`: at
 //!   each radius (default 0.02 and 0.05 of the diagonal), our output's
 //!   faces, then the quadric-error peer (fast-simplification) asked for as
 //!   many faces, on the very same repaired mesh; symmetric Hausdorff over
@@ -13,25 +13,26 @@
 //!   0.05, or only CODE (DI, DD, …) at R, so that `time` can give its CPU
 //!   seconds.
 //!
+//! `plate` in place of a mesh is the generated genus-3 plate (sharp creases).
+//!
 //! Run as:
 //!
 //!     pip install fast-simplification plyfile numpy
 //!     cargo run --release -p vitrine-simplify --example voronoi_bench -- hausdorff \
 //!         --peer scripts/peer_quadric.py ../shared/data/meshes/bunny.ply
 
-use std::process::Command;
 use std::time::Instant;
 
 use vitrine_codec::IndexedMesh;
-use vitrine_mesh::export::write_ply;
-use vitrine_mesh::import::{import_path, ImportOptions};
-use vitrine_mesh::repair::{prepare, RepairOptions};
 use vitrine_quality::metrics::hausdorff;
 use vitrine_simplify::{
     simplify_voronoi, Distance, Order, Radius, VoronoiOptions, VoronoiSimplified,
 };
 
-const SAMPLES: usize = 200_000;
+#[path = "support/mod.rs"]
+mod support;
+use support::{load, name, peer, ratio, Failure, SAMPLES};
+
 const CONFIGURATIONS: [(&str, Distance, Order); 6] = [
     ("DI", Distance::Dijkstra, Order::Incremental),
     ("DD", Distance::Dijkstra, Order::Farthest),
@@ -41,30 +42,18 @@ const CONFIGURATIONS: [(&str, Distance, Order); 6] = [
     ("FC", Distance::FastMarching, Order::Curvature),
 ];
 
-type Failure = Box<dyn std::error::Error>;
-
-fn load(path: &str) -> Result<IndexedMesh, Failure> {
-    let mesh = import_path(path.as_ref(), &ImportOptions::default())?;
-    Ok(prepare(mesh, &RepairOptions::default())?.0)
-}
-
-fn name(path: &str) -> &str {
-    std::path::Path::new(path)
-        .file_name()
-        .and_then(|n| n.to_str())
-        .unwrap_or(path)
-}
-
 fn ours(
     mesh: &IndexedMesh,
     distance: Distance,
     order: Order,
     r: f64,
+    sharp_degrees: Option<f64>,
 ) -> Result<(VoronoiSimplified, f64), Failure> {
     let options = VoronoiOptions {
         distance,
         order,
         radius: Radius::Fraction(r),
+        sharp_degrees,
         ..VoronoiOptions::default()
     };
     let t = Instant::now();
@@ -72,42 +61,16 @@ fn ours(
     Ok((out, t.elapsed().as_secs_f64()))
 }
 
-/// The peer asked for `fraction` of the faces: its faces, Hausdorff, seconds.
-fn peer(script: &str, mesh: &IndexedMesh, fraction: f64) -> Result<(usize, f64, f64), Failure> {
-    let dir = std::env::temp_dir().join(format!("vitrine-voronoi-peer-{}", std::process::id()));
-    std::fs::create_dir_all(&dir)?;
-    let (input, output) = (dir.join("in.ply"), dir.join("out.ply"));
-    let geometry = IndexedMesh {
-        colors: None,
-        ..mesh.clone()
-    };
-    write_ply(
-        &geometry,
-        &mut std::io::BufWriter::new(std::fs::File::create(&input)?),
-    )?;
-    let run = Command::new("python3")
-        .arg(script)
-        .arg(&input)
-        .arg(&output)
-        .arg(fraction.to_string())
-        .output()?;
-    if !run.status.success() {
-        return Err(String::from_utf8_lossy(&run.stderr).into_owned().into());
-    }
-    let ms: f64 = String::from_utf8_lossy(&run.stdout).trim().parse()?;
-    let simplified = import_path(&output, &ImportOptions::default())?;
-    let h = hausdorff(mesh, &simplified, SAMPLES).relative();
-    std::fs::remove_dir_all(&dir)?;
-    Ok((simplified.triangles.len(), h, ms / 1000.0))
-}
-
 fn hausdorff_table(mut args: Vec<String>) -> Result<(), Failure> {
     let mut script = None;
     let mut radii = Vec::new();
+    let mut sharp = VoronoiOptions::default().sharp_degrees;
     while args.len() > 1 && args[0].starts_with("--") {
         match args[0].as_str() {
             "--peer" => script = Some(args[1].clone()),
             "--radius" => radii.push(args[1].parse::<f64>()?),
+            // 0: the seed's cover, without creases first.
+            "--sharp" => sharp = Some(args[1].parse::<f64>()?).filter(|&d| d > 0.0),
             other => return Err(format!("unknown flag {other}").into()),
         }
         args.drain(..2);
@@ -120,7 +83,7 @@ fn hausdorff_table(mut args: Vec<String>) -> Result<(), Failure> {
     for path in &args {
         let mesh = load(path)?;
         for &r in &radii {
-            let (out, s) = ours(&mesh, Distance::Dijkstra, Order::Farthest, r)?;
+            let (out, s) = ours(&mesh, Distance::Dijkstra, Order::Farthest, r, sharp)?;
             let faces = out.mesh.triangles.len();
             let h = hausdorff(&mesh, &out.mesh, SAMPLES).relative();
             let mut row = format!(
@@ -132,7 +95,7 @@ fn hausdorff_table(mut args: Vec<String>) -> Result<(), Failure> {
                 Some(script) => {
                     let fraction = faces as f64 / mesh.triangles.len() as f64;
                     let (pf, ph, ps) = peer(script, &mesh, fraction)?;
-                    row += &format!(" {pf}, {ph:.5}, {ps:.2} | {:.2} |", h / ph);
+                    row += &format!(" {pf}, {ph:.5}, {ps:.2} | {} |", ratio(h, ph));
                 }
                 None => row += " – | – |",
             }
@@ -159,7 +122,13 @@ fn configuration(
     order: Order,
     r: f64,
 ) -> Result<(), Failure> {
-    let (out, s) = ours(mesh, distance, order, r)?;
+    let (out, s) = ours(
+        mesh,
+        distance,
+        order,
+        r,
+        VoronoiOptions::default().sharp_degrees,
+    )?;
     let st = out.stages;
     println!(
         "| {label} ({}) | {code} | {r} | {} | {} → {} | {} | {:.2} | {:.2} / {:.2} / {:.2} / {:.2} |",

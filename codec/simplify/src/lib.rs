@@ -54,4 +54,6 @@ pub use feature_search::{
     at_vertices, decoded_mesh, first_level_with, level_curve, search_feature_guard, FeatureProbe,
     GuardSearch, GuardSetting, LevelMeasure, DEFAULT_CONNECTIVITY_BUDGET, SEARCHED_SETTINGS,
 };
-pub use voronoi::{simplify_voronoi, Distance, Order, Radius, VoronoiOptions, VoronoiSimplified};
+pub use voronoi::{
+    simplify_voronoi, Distance, Order, Radius, VoronoiOptions, VoronoiSimplified, SHARP_DEGREES,
+};

@@ -494,3 +494,26 @@ fn quadric_placement_stays_closer_to_a_smooth_surface() {
         assert!(q < bound * s, "{collapse:?}: quadric {q}, seed {s}");
     }
 }
+
+#[test]
+fn a_plate_keeps_its_sharp_edges_under_quadric_placement() {
+    // Flat faces and 90° edges: quadric simplification loses nothing at 10
+    // and 5 %. A vertex whose cheap merges were refused used to take its
+    // dearest one across an edge of the plate (8 % of the diagonal).
+    let plate = plate_with_tunnels(3, 6);
+    for collapse in [Collapse::Edge, Collapse::HalfEdge] {
+        for fraction in [0.10, 0.05] {
+            let out = simplify(
+                &plate,
+                &options_at(collapse, Placement::Quadric, Target::Fraction(fraction)),
+            )
+            .unwrap();
+            assert_eq!(out.stopped, StopReason::Target);
+            let h = vitrine_quality::metrics::hausdorff(&plate, &out.mesh, 50_000).relative();
+            assert!(
+                h < 1e-4,
+                "{collapse:?} at {fraction}: Hausdorff {h} over the diagonal"
+            );
+        }
+    }
+}

@@ -20,7 +20,9 @@
 //! `chart_new_from`, `chart_buffer_ptr` and `chart_buffer_len` read one
 //! chart (`web/src/decode-pool.js` merges them).
 //!
-//! [`geodesic`] adds distance along the surface of a decoded level, for
+//! [`view`] decodes a charted stream part by part, each chart to its own
+//! depth (issue 41); [`nested`] does the same for a nested stream's tree
+//! of charts (format 6). [`geodesic`] adds distance along the surface of a decoded level, for
 //! the viewer's measurement tool; [`points`] decodes point streams and
 //! preprocesses splats.
 //!
@@ -29,7 +31,9 @@
 #![deny(unsafe_code)]
 
 pub mod geodesic;
+pub mod nested;
 pub mod points;
+pub mod view;
 
 use std::cell::RefCell;
 use vitrine_codec::{Decoder, Limits};
@@ -38,7 +42,7 @@ thread_local! {
     pub(crate) static INPUT: RefCell<Vec<u8>> = const { RefCell::new(Vec::new()) };
     static ERROR: RefCell<String> = const { RefCell::new(String::new()) };
     static DECODERS: RefCell<Vec<Option<Decoder>>> = const { RefCell::new(Vec::new()) };
-    static SIZES: RefCell<Vec<u32>> = const { RefCell::new(Vec::new()) };
+    pub(crate) static SIZES: RefCell<Vec<u32>> = const { RefCell::new(Vec::new()) };
 }
 
 /// Buffer kinds for [`buffer_ptr`] and [`buffer_len`].
@@ -49,7 +53,7 @@ pub const INDICES: u32 = 2;
 /// for [`chart_buffer_ptr`] only.
 pub const LEVEL_INDICES: u32 = 3;
 
-fn fail(message: String) -> i32 {
+pub(crate) fn fail(message: String) -> i32 {
     ERROR.with(|e| *e.borrow_mut() = message);
     -1
 }
@@ -85,6 +89,14 @@ pub extern "C" fn decoder_new(len: u32) -> u32 {
             0
         }
     }
+}
+
+/// Takes decoder `handle` out of its slot (for [`view::view_new`]).
+pub(crate) fn take_decoder(handle: u32) -> Option<Decoder> {
+    DECODERS.with(|ds| {
+        let mut ds = ds.borrow_mut();
+        ds.get_mut((handle as usize).checked_sub(1)?)?.take()
+    })
 }
 
 fn with_decoder<T>(handle: u32, f: impl FnOnce(&mut Decoder) -> T) -> Option<T> {

@@ -50,7 +50,8 @@ pub struct EncodeArgs {
     pub guard: GuardArgs,
     /// Cut the stream into charts that decode on several cores (format 5):
     /// `off` (the default: format 4), `auto` (2 charts from 100,000 vertices, 4 from 200,000;
-    /// plain below 100,000) or a number of charts, 2–64.
+    /// plain below 100,000), a number of charts, 2–64, or `nested` (format 6:
+    /// nested charts for view-dependent streaming).
     #[arg(long, default_value = "off")]
     pub charts: ChartsArg,
 }

@@ -63,7 +63,8 @@ pub struct IngestArgs {
     /// cores at once (format 5): `auto` (the default: 2 charts from 100,000
     /// vertices, 4 from 200,000, a plain stream below; about 1–1.5 % more
     /// bytes, 1.3–1.5× faster to the last level with two decode workers:
-    /// BENCHMARKS.md, "Charts"), `off` (format 4) or 2–64.
+    /// BENCHMARKS.md, "Charts"), `off` (format 4), 2–64, or `nested`
+    /// (format 6: nested charts, each part served on its own).
     #[arg(long, default_value = "auto")]
     pub charts: ChartsArg,
     /// How colour travels: `ccc` (a cubic cell complex: a cell texture and
@@ -104,6 +105,12 @@ pub struct IngestArgs {
     /// CC-BY-NC-ND-4.0, InC, InC-EDU, InC-NC, NoC-NC, NKC or CNE.
     #[arg(long, value_parser = licence_arg)]
     pub licence: Option<&'static Licence>,
+    /// The language of --title, --description and --credit, as a BCP 47
+    /// tag (pt, pt-BR, en): pages and the manifest mark them with it, and
+    /// a visitor in another language sees a translation where one was
+    /// given (`vitrine texts`), these texts otherwise.
+    #[arg(long, value_parser = language_arg)]
+    pub language: Option<String>,
     /// Do not measure every level's Hausdorff distance (sampled, on by
     /// default: the manifest's `hausdorff`, the viewer's "± error at this
     /// level"). It costs about levels × vertices point queries.
@@ -236,6 +243,7 @@ impl IngestArgs {
                 credit: self.credit.clone(),
                 licence: self.licence,
             },
+            language: self.language.clone(),
         }
     }
 
@@ -316,6 +324,10 @@ fn print_quality(q: &MeasuredQuality) {
 
 fn credit_arg(s: &str) -> Result<String, String> {
     parse_credit(Some(s))?.ok_or_else(|| "the credit line is blank".into())
+}
+
+fn language_arg(s: &str) -> Result<String, String> {
+    crate::service::curator::annotations::parse_language(s.trim())
 }
 
 fn licence_arg(s: &str) -> Result<&'static Licence, String> {

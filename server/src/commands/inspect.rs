@@ -18,6 +18,11 @@ pub struct InspectArgs {
     /// written beside the stream by `encode --colour ccc` is used for colour.
     #[arg(long)]
     pub original: Option<PathBuf>,
+    /// For a charted stream: what a viewer refining where the visitor looks
+    /// fetches (the shared prefix, each chart's parts and errors, a
+    /// close-up's bytes).
+    #[arg(long)]
+    pub parts: bool,
     /// Side of the image metric's snapshots.
     #[arg(long, default_value_t = 512)]
     pub image_size: u32,
@@ -43,6 +48,12 @@ pub fn run(args: InspectArgs) -> anyhow::Result<()> {
         header.batch_count()
     );
     print_levels(&bytes, &levels, header.final_level().vertices);
+    if args.parts {
+        match super::parts::report(&bytes)? {
+            Some(report) => print!("{report}"),
+            None => println!("a plain stream: no parts (encode with --charts)"),
+        }
+    }
     if let Some(original) = &args.original {
         print_quality(&bytes, &args, original)?;
     }

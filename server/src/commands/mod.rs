@@ -12,11 +12,13 @@ pub mod inspect;
 pub mod lod;
 pub mod mesh_format;
 pub mod models;
+mod parts;
 pub mod sample;
 pub mod serve;
 pub mod simplify;
 pub mod simplify_voronoi;
 pub mod study;
+pub mod texts;
 pub mod token;
 
 #[cfg(feature = "dev-tools")]
@@ -56,6 +58,9 @@ pub enum Command {
     /// Levels of detail by Melax's collapses: one GLB with MSFT_lod (and an
     /// MD2's frames as morph targets), or one GLB or MD2 per level.
     Lod(lod::LodArgs),
+    /// A model's title, description and credit in other languages: set,
+    /// remove or list the translations of a version.
+    Texts(texts::TextsArgs),
 }
 
 impl Command {
@@ -72,6 +77,7 @@ impl Command {
             Command::Simplify(args) => simplify::run(args),
             Command::Study(args) => block_on(study::run(args)),
             Command::Lod(args) => lod::run(args),
+            Command::Texts(args) => block_on(texts::run(args)),
         }
     }
 }

@@ -4,8 +4,9 @@
 //! models that state none are counted).
 
 use crate::database::open_storage;
-use crate::storage::{ConnectOptions, ModelSummary};
+use crate::storage::{ConnectOptions, ModelKind, ModelSummary};
 use std::fmt::Write as _;
+use vitrine_codec::{CHARTED_VERSION, NESTED_VERSION};
 
 #[derive(clap::Args, Clone, Debug)]
 pub struct ModelsArgs {
@@ -32,8 +33,17 @@ pub fn models_table(models: &[ModelSummary]) -> (String, usize) {
     );
     let mut stale = 0;
     let mut unlicensed = 0;
+    let mut partless = 0;
     for m in models {
-        let format = if m.servable() {
+        let charted = m.kind == ModelKind::Mesh
+            && (m.stream_format == CHARTED_VERSION || m.stream_format == NESTED_VERSION);
+        let format = if charted && !m.has_parts {
+            partless += 1;
+            format!(
+                "{} (no part index: ingest it again to refine where visitors look)",
+                m.stream_format
+            )
+        } else if m.servable() {
             m.stream_format.to_string()
         } else {
             stale += 1;
@@ -60,7 +70,8 @@ pub fn models_table(models: &[ModelSummary]) -> (String, usize) {
     let _ = write!(
         out,
         "{} model(s); {stale} stored in a stream format this build cannot serve; \
-         {unlicensed} public without a stated licence",
+         {unlicensed} public without a stated licence; \
+         {partless} charted without a part index",
         models.len()
     );
     (out, stale)

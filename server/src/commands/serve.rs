@@ -161,6 +161,11 @@ pub struct ServeArgs {
     /// once; this is its fallback). 0: never.
     #[arg(long, env = "VITRINE_COHERENCE_POLL_MS", default_value_t = 2000)]
     pub coherence_poll_ms: u64,
+    /// The museum's own words for the viewer: only from the file's
+    /// `[ui.strings.<language>]` tables (config/mod.rs), never a flag.
+    #[arg(skip)]
+    #[serde(skip)]
+    pub ui_strings: crate::service::UiStrings,
 }
 
 impl ServeArgs {
@@ -218,6 +223,7 @@ impl ServeArgs {
             },
             trusted_proxies: self.trusted_proxies.clone(),
             site_name: self.site_name.clone(),
+            ui_strings: self.ui_strings.clone(),
         }
     }
 

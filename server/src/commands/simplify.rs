@@ -385,7 +385,7 @@ fn print_report(r: &SimplifyReport, output: &Path) {
                 .final_feature_threshold_degrees
                 .filter(|&f| f > t)
                 .map_or_else(String::new, |f| {
-                    format!(", raised to {f:.2}° to meet the target")
+                    format!(", raised to {f:.2}° where features merged more cheaply than the rest or the target needed them")
                 });
             format!(" ({c} collapses, {placement} placement, feature threshold {t:.2}°{raised})")
         }

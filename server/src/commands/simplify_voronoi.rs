@@ -8,7 +8,7 @@
 use clap::{Args, ValueEnum};
 use serde::Serialize;
 use vitrine_codec::IndexedMesh;
-use vitrine_simplify::{simplify_voronoi, Distance, Order, Radius, VoronoiOptions};
+use vitrine_simplify::{simplify_voronoi, Distance, Order, Radius, VoronoiOptions, SHARP_DEGREES};
 
 /// How geodesic distance is measured.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -38,6 +38,10 @@ pub struct VoronoiArgs {
     /// voronoi: the order disc centres are taken in.
     #[arg(long, value_enum, default_value_t = OrderKind::Farthest)]
     pub order: OrderKind,
+    /// voronoi: edges whose faces turn by this many degrees or more are
+    /// creases, whose vertices become sites first (0: the seed's cover).
+    #[arg(long, default_value_t = SHARP_DEGREES)]
+    pub sharp_degrees: f64,
 }
 
 /// What the report adds for this method.
@@ -92,10 +96,17 @@ pub fn run(mesh: &IndexedMesh, args: &VoronoiArgs, t: TargetFlags) -> anyhow::Re
         OrderKind::Farthest => (Order::Farthest, "farthest"),
         OrderKind::Curvature => (Order::Curvature, "curvature"),
     };
+    if !(0.0..=180.0).contains(&args.sharp_degrees) {
+        anyhow::bail!(
+            "--sharp-degrees must be within 0–180, got {}",
+            args.sharp_degrees
+        );
+    }
     let options = VoronoiOptions {
         distance,
         order,
         radius,
+        sharp_degrees: (args.sharp_degrees > 0.0).then_some(args.sharp_degrees),
         ..VoronoiOptions::default()
     };
     let out = simplify_voronoi(mesh, &options)?;

@@ -9,6 +9,9 @@
 //! argument, and the whole is parsed again. So a value in the file is checked
 //! by the same parser, with the same messages, as the flag, and no setting
 //! can exist in one form and not the other.
+//!
+//! One table is no flag: `[ui.strings.<language>]`, a museum's own words in
+//! place of the viewer's (service/ui_strings.rs).
 
 use crate::commands::serve::ServeArgs;
 use anyhow::{bail, Context};
@@ -44,7 +47,12 @@ pub fn resolve(argv: &[OsString]) -> anyhow::Result<ServeArgs> {
     let Some(path) = first.config.clone() else {
         return Ok(first);
     };
-    let table = read_table(&path)?;
+    let mut table = read_table(&path)?;
+    let ui_strings = match table.remove("ui") {
+        Some(ui) => crate::service::UiStrings::from_toml(&ui)
+            .with_context(|| format!("{}: the museum's own words", path.display()))?,
+        None => crate::service::UiStrings::default(),
+    };
     let mut extra = Vec::new();
     for (key, value) in &table {
         let name = key.replace('_', "-");
@@ -75,8 +83,9 @@ pub fn resolve(argv: &[OsString]) -> anyhow::Result<ServeArgs> {
         }
     }
     let again: Vec<OsString> = full.into_iter().chain(extra).collect();
-    let parsed = ServeOnly::try_parse_from(&again)
+    let mut parsed = ServeOnly::try_parse_from(&again)
         .map_err(|e| anyhow::anyhow!("{} (from {})", e.render(), path.display()))?;
+    parsed.serve.ui_strings = ui_strings;
     Ok(parsed.serve)
 }
 

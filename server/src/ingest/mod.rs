@@ -8,6 +8,7 @@
 pub mod curation;
 mod guards;
 mod mapping;
+mod parts;
 pub mod points;
 mod store;
 
@@ -47,6 +48,8 @@ pub struct ModelMeta {
     pub unit: Option<String>,
     /// Credit line and licence.
     pub rights: Rights,
+    /// The BCP 47 tag of the title, description and credit, if stated.
+    pub language: Option<String>,
 }
 
 impl ModelMeta {
@@ -62,6 +65,7 @@ impl ModelMeta {
             up: None,
             unit: None,
             rights: Rights::default(),
+            language: None,
         }
     }
 }

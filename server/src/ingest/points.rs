@@ -141,6 +141,7 @@ pub async fn ingest_points(
         up_axis: Some(up),
         unit: meta.unit.clone(),
         rights: meta.rights.clone(),
+        language: meta.language.clone(),
         bounds: Some(encoding.bounds),
         thumbnail: Some(encoding.thumbnail.clone()),
     };
@@ -215,7 +216,7 @@ fn compression(encoding: &Encoding, options: &IngestOptions) -> NewCompression {
     let base_end = chunks.first().map_or(encoded.bytes.len(), |c| c.end);
     let points = &options.points;
     NewCompression {
-        codec_version: stream::VERSION,
+        codec_version: header.version,
         options: json!({
             "kind": "points",
             "bits": points.bits,
@@ -245,6 +246,8 @@ fn compression(encoding: &Encoding, options: &IngestOptions) -> NewCompression {
             .skip(1)
             .map(|(k, r)| level(k, &encoded.bytes[r.clone()]))
             .collect(),
+        parts: Vec::new(),
+        splits: Vec::new(),
     }
 }
 

@@ -7,7 +7,8 @@ use super::{
     ModelMeta, SourceInfo,
 };
 use crate::storage::{
-    LevelMetrics, ModelKind, NewCompression, NewLevel, NewModel, Storage, StoredModel,
+    LevelMetrics, ModelKind, NewCompression, NewLevel, NewModel, PartRecord, SplitRecord, Storage,
+    StoredModel,
 };
 use anyhow::{bail, Context};
 use serde_json::json;
@@ -45,6 +46,7 @@ pub(super) async fn store(
     let index = StreamIndex::parse(&product.encoded.bytes)
         .context("encoder produced an unreadable stream")?;
     check_levels(&index, &meta, product.quality.as_ref())?;
+    let (parts, splits) = super::parts::measure(&product.encoded.bytes, &index).await?;
     let (mapping, ccc) = mapping.unzip();
     let curated = product.curated.as_ref();
     let new = NewModel {
@@ -58,11 +60,19 @@ pub(super) async fn store(
         source_name: (!source.name.is_empty()).then(|| source.name.clone()),
         source_vertices: source.vertices,
         source_faces: source.faces,
-        compression: compression(&product, &index, ccc.as_ref(), &source, options),
+        compression: compression(
+            &product,
+            &index,
+            ccc.as_ref(),
+            &source,
+            options,
+            (parts, splits),
+        ),
         mapping,
         up_axis: curated.map(|c| c.up),
         unit: meta.unit.clone(),
         rights: meta.rights.clone(),
+        language: meta.language.clone(),
         bounds: curated.map(|c| c.bounds),
         thumbnail: curated.and_then(|c| c.thumbnail.clone()),
     };
@@ -117,6 +127,7 @@ fn compression(
     ccc: Option<&CccReport>,
     source: &SourceInfo,
     options: &IngestOptions,
+    (parts, splits): (Vec<PartRecord>, Vec<SplitRecord>),
 ) -> NewCompression {
     let bytes = &product.encoded.bytes;
     let level = |k: usize, range: &Range<usize>| new_level(product, index, k, range);
@@ -135,6 +146,8 @@ fn compression(
             .enumerate()
             .map(|(k, r)| level(k + 1, r))
             .collect(),
+        parts,
+        splits,
     }
 }
 

@@ -7,7 +7,7 @@ use super::manifest::{self, Manifest};
 use super::servable::{ServableModel, SlugParam};
 use super::visitor::{HintQuery, VisitorHints};
 use super::AppState;
-use crate::storage::{Licence, ModelKind, ModelSummary, LICENCES};
+use crate::storage::{Licence, ModelKind, ModelSummary, Translations, LICENCES};
 use axum::extract::State;
 use axum::response::{IntoResponse, Response};
 use axum::Json;
@@ -24,6 +24,12 @@ pub struct ModelList {
 struct ListedModel {
     slug: String,
     title: String,
+    /// BCP 47 tag of `title`, or null when not stated.
+    language: Option<String>,
+    /// Titles in other languages: `{"pt": {"title": "…"}}` (the viewer
+    /// shows the visitor's, else `title`).
+    #[schema(value_type = Object)]
+    translations: Translations,
     version: u32,
     /// `mesh` or `points` (a point cloud).
     kind: ModelKind,
@@ -84,6 +90,8 @@ pub async fn list(
             page_url: format!("/m/{}", m.slug),
             slug: m.slug,
             title: m.title,
+            language: m.language,
+            translations: m.translations,
             version: m.version,
             kind: m.kind,
             levels: m.batch_count + 1,

@@ -229,6 +229,8 @@ mod tests {
                 .collect(),
             mapping: None,
             textures: vec![],
+            texts: Default::default(),
+            has_study: false,
             curation: Default::default(),
         }
     }

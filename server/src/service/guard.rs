@@ -48,6 +48,16 @@ pub async fn admit(State(state): State<AppState>, request: Request, next: Next) 
     // A IIIF annotation import is the one other body over the usual limit.
     let body_limit = if route == super::iiif::import::PATH && request.method() == Method::POST {
         super::iiif::import::MAX_IMPORT_BYTES
+    } else if matches!(
+        route,
+        super::tours::ADMIN_PATH | super::tours::ADMIN_ONE_PATH
+    ) && (request.method() == Method::POST || request.method() == Method::PUT)
+    {
+        // A tour's texts in a dozen languages outgrow the usual limit.
+        super::tours::input::MAX_TOUR_BYTES
+    } else if route == super::texts::ADMIN_PATH && request.method() == Method::PUT {
+        // Twenty languages' descriptions outgrow it too.
+        super::texts::input::MAX_TEXTS_BYTES
     } else {
         limits.max_body_bytes
     };
@@ -66,6 +76,7 @@ pub async fn admit(State(state): State<AppState>, request: Request, next: Next) 
             }
             .into_response(),
             Ok(_permit) if !upload && body_too_large(&request, body_limit) => {
+                discard_body(request).await;
                 AppError::PayloadTooLarge.into_response()
             }
             // An upload is counted as it streams (413 past the limit); a
@@ -192,6 +203,33 @@ fn body_too_large(request: &Request, max: usize) -> bool {
         .and_then(|v| v.to_str().ok())
         .map(|v| v.parse::<u64>().map_or(true, |n| n > max as u64));
     declared.unwrap_or_else(|| headers.contains_key(header::TRANSFER_ENCODING))
+}
+
+/// Bodies up to this size are read and thrown away before a 413 is sent.
+const DISCARD_MAX_BYTES: u64 = 4 << 20;
+/// How long a refused body may take to be discarded.
+const DISCARD_TIME: std::time::Duration = std::time::Duration::from_secs(2);
+
+/// Reads a refused body to its end (up to [`DISCARD_MAX_BYTES`] and
+/// [`DISCARD_TIME`]) so the client, still writing it, reads the 413 instead of
+/// a reset connection: hyper closes a connection whose body was left unread,
+/// and a browser sending a 1 MiB tour then reports a network error, not the
+/// limit. (nginx's lingering close does the same.) Past either bound the
+/// connection is simply closed.
+async fn discard_body(request: Request) {
+    use http_body_util::BodyExt;
+    if declared_over(&request, DISCARD_MAX_BYTES) || !has_length(&request) {
+        return;
+    }
+    let mut body = request.into_body();
+    let _ = tokio::time::timeout(DISCARD_TIME, async {
+        while let Some(Ok(_)) = body.frame().await {}
+    })
+    .await;
+}
+
+fn has_length(request: &Request) -> bool {
+    request.headers().contains_key(header::CONTENT_LENGTH)
 }
 
 /// A response body that keeps its request counted in flight until the body

@@ -83,6 +83,15 @@ impl<S: Send + Sync> FromRequestParts<S> for PageLanguage {
 }
 
 fn from_parts(query: Option<&str>, headers: &HeaderMap) -> PageLanguage {
+    let (lang, accept) = query_and_header(query, headers);
+    PageLanguage::choose(lang, accept)
+}
+
+/// `?lang=`'s value and the `Accept-Language` header.
+fn query_and_header<'a>(
+    query: Option<&'a str>,
+    headers: &'a HeaderMap,
+) -> (Option<&'a str>, Option<&'a str>) {
     // Codes are plain ASCII: a percent-encoded value names no supported
     // language, so the pairs are read as they are.
     let lang = query
@@ -92,7 +101,89 @@ fn from_parts(query: Option<&str>, headers: &HeaderMap) -> PageLanguage {
     let accept = headers
         .get(header::ACCEPT_LANGUAGE)
         .and_then(|v| v.to_str().ok());
-    PageLanguage::choose(lang, accept)
+    (lang, accept)
+}
+
+/// The languages a visitor wants a model's own texts in (its title,
+/// description, credit), most wanted first: `?lang=`'s tag as given (a
+/// museum may write in languages the viewer's controls do not speak), then
+/// the `Accept-Language` ranges by q-value when the page's language was
+/// negotiated from them, then the page's language.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct ContentLanguages {
+    pub wanted: Vec<String>,
+    /// `?lang=`'s tag, when it gave a well-formed one.
+    pub asked: Option<String>,
+    /// Whether `Accept-Language` was read (the answer varies on it).
+    pub negotiated: bool,
+}
+
+impl ContentLanguages {
+    pub fn choose(lang_query: Option<&str>, accept_language: Option<&str>) -> ContentLanguages {
+        let page = PageLanguage::choose(lang_query, accept_language);
+        let asked = lang_query
+            .map(str::trim)
+            .filter(|t| well_formed(t))
+            .map(str::to_owned);
+        let mut wanted: Vec<String> = asked.iter().cloned().collect();
+        if page.negotiated {
+            wanted.extend(accept_language.map(ranges_by_q).unwrap_or_default());
+        }
+        wanted.push(page.code.to_owned());
+        let mut seen = Vec::<String>::new();
+        wanted.retain(|t| {
+            let new = !seen.iter().any(|s| s.eq_ignore_ascii_case(t));
+            seen.push(t.clone());
+            new
+        });
+        ContentLanguages {
+            wanted,
+            asked,
+            negotiated: page.negotiated,
+        }
+    }
+}
+
+impl<S: Send + Sync> FromRequestParts<S> for ContentLanguages {
+    type Rejection = Infallible;
+
+    async fn from_request_parts(parts: &mut Parts, _: &S) -> Result<Self, Infallible> {
+        let (lang, accept) = query_and_header(parts.uri.query(), &parts.headers);
+        Ok(ContentLanguages::choose(lang, accept))
+    }
+}
+
+/// Letters, digits, hyphens (and the underscores some clients send), 1–35
+/// bytes: worth comparing with a stored tag (checked properly when written).
+fn well_formed(tag: &str) -> bool {
+    (1..=35).contains(&tag.len())
+        && tag
+            .bytes()
+            .all(|b| b.is_ascii_alphanumeric() || b == b'-' || b == b'_')
+}
+
+/// The header's language ranges with q > 0, highest q first (stable for
+/// equals), `*` left out.
+fn ranges_by_q(header: &str) -> Vec<String> {
+    let mut ranges: Vec<(String, f32)> = header
+        .split(',')
+        .filter_map(|range| {
+            let mut parts = range.split(';');
+            let tag = parts.next()?.trim();
+            let q = parts
+                .filter_map(|p| p.trim().strip_prefix("q="))
+                .find_map(|q| q.trim().parse::<f32>().ok())
+                .unwrap_or(1.0);
+            (q > 0.0 && tag != "*" && well_formed(tag)).then(|| (tag.to_owned(), q))
+        })
+        .collect();
+    ranges.sort_by(|a, b| b.1.total_cmp(&a.1));
+    ranges.into_iter().map(|(tag, _)| tag).collect()
+}
+
+/// Whether the viewer speaks `code` (a primary subtag, lower case).
+pub fn is_supported(code: &str) -> bool {
+    SUPPORTED.iter().any(|&(c, _)| c == code)
 }
 
 /// The supported language a tag (`pt-BR`, `AR`) belongs to.
@@ -108,20 +199,7 @@ fn supported(tag: &str) -> Option<&'static str> {
 /// the visitor listed first. `q=0` is a refusal; `*` adds nothing the
 /// default does not.
 fn best_accepted(header: &str) -> Option<&'static str> {
-    let mut best: Option<(&'static str, f32)> = None;
-    for range in header.split(',') {
-        let mut parts = range.split(';');
-        let tag = parts.next().unwrap_or("").trim();
-        let q = parts
-            .filter_map(|p| p.trim().strip_prefix("q="))
-            .find_map(|q| q.trim().parse::<f32>().ok())
-            .unwrap_or(1.0);
-        let Some(code) = supported(tag) else { continue };
-        if q > 0.0 && best.is_none_or(|(_, b)| q > b) {
-            best = Some((code, q));
-        }
-    }
-    best.map(|(code, _)| code)
+    ranges_by_q(header).iter().find_map(|tag| supported(tag))
 }
 
 #[cfg(test)]
@@ -160,6 +238,18 @@ mod tests {
         assert_eq!(code(None, Some("")), "en");
         assert_eq!(code(None, Some("*")), "en");
         assert_eq!(code(None, Some("zh-Hant;q=abc, ;;,")), "en");
+    }
+
+    #[test]
+    fn content_languages_keep_what_the_viewer_does_not_speak() {
+        use super::ContentLanguages;
+        let c = ContentLanguages::choose(Some("ca"), Some("es;q=0.8, en, *;q=0.1, fr;q=0"));
+        assert_eq!(c.wanted, ["ca", "en", "es"]);
+        assert!(c.negotiated);
+        let c = ContentLanguages::choose(Some("pt-BR"), Some("de"));
+        assert_eq!(c.wanted, ["pt-BR", "pt"]);
+        assert!(!c.negotiated);
+        assert_eq!(ContentLanguages::choose(Some("<x>"), None).wanted, ["en"]);
     }
 
     #[test]

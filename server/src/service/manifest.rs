@@ -4,7 +4,7 @@
 
 use super::cap::{good_enough_level, Audience, CapReason, DeviceClass, LevelCap};
 use super::{AppState, Visitor};
-use crate::storage::{Licence, ModelKind, ModelRecord, TextureRef};
+use crate::storage::{Licence, ModelKind, ModelRecord, TextureRef, Translations};
 use serde::Serialize;
 use utoipa::ToSchema;
 use vitrine_mesh::export::glb_bin_bytes;
@@ -15,6 +15,14 @@ pub struct Manifest<'a> {
     version: u32,
     title: &'a str,
     description: &'a str,
+    /// BCP 47 tag of `title`, `description` and `rights.credit`, or null
+    /// when not stated.
+    language: Option<&'a str>,
+    /// The texts in other languages, per BCP 47 tag: `{"title",
+    /// "description", "credit"}`, each present only where it replaces the
+    /// default (the viewer shows the visitor's language, else the default).
+    #[schema(value_type = Object)]
+    translations: &'a Translations,
     /// `mesh`: the payloads are the mesh stream's base and batches
     /// (`codec/core/FORMAT.md`); `points`: a point cloud, the payloads are
     /// the point stream's header with its first level, then one level each
@@ -33,12 +41,31 @@ pub struct Manifest<'a> {
     /// Where load caps stop falling.
     good_enough_level: u32,
     levels: Vec<ManifestLevel>,
+    /// For a charted stream (`stream_format` 5): its part index
+    /// (`/api/compressions/{id}/parts`), for a viewer that refines the
+    /// charts in view further than the others; absent for a plain stream.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    #[schema(nullable = false)]
+    parts: Option<String>,
+    /// For a nested stream (`stream_format` 6): its part index, the same
+    /// endpoint with each part's phase and parent and the split entries.
+    /// Apart from `parts` because a viewer that reads `parts` refines flat
+    /// charts (format 5) and would misread a nested stream's.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    #[schema(nullable = false)]
+    nested_parts: Option<String>,
     /// Every level's quality against the original, when it was measured at
     /// ingest (`vitrine ingest --quality`, codec/quality/src/levels.rs);
     /// absent otherwise. The model page plots it.
     #[serde(skip_serializing_if = "Option::is_none")]
     #[schema(nullable = false)]
     quality: Option<Vec<LevelQuality>>,
+    /// The quality study's answers per level (`/api/study/{slug}/results`),
+    /// when a study was begun on this version; absent otherwise, so a page
+    /// never asks for results that cannot exist.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    #[schema(nullable = false)]
+    study_results: Option<String>,
     colour: Colour<'a>,
     /// Every image of the colour mapping (also under `colour`).
     textures: Vec<Texture<'a>>,
@@ -248,6 +275,8 @@ pub fn build<'a>(
         version: record.version,
         title: &record.title,
         description: &record.description,
+        language: record.texts.language.as_deref(),
+        translations: &record.texts.translations,
         kind: record.kind,
         compression_id: record.compression_id,
         stream_format: record.stream_format,
@@ -256,7 +285,16 @@ pub fn build<'a>(
         last_level: record.batch_count(),
         good_enough_level: good_enough_level(record, &state.config().caps),
         levels: levels(record, cap),
+        parts: (record.kind == ModelKind::Mesh
+            && record.stream_format == vitrine_codec::CHARTED_VERSION)
+            .then(|| format!("/api/compressions/{}/parts", record.compression_id)),
+        nested_parts: (record.kind == ModelKind::Mesh
+            && record.stream_format == vitrine_codec::NESTED_VERSION)
+            .then(|| format!("/api/compressions/{}/parts", record.compression_id)),
         quality: quality(record),
+        study_results: record
+            .has_study
+            .then(|| format!("/api/study/{}/results", record.slug)),
         colour: colour(record),
         textures: record.textures.iter().map(texture).collect(),
         visitor: ManifestVisitor {

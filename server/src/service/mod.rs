@@ -24,11 +24,15 @@ mod manifest;
 mod metrics;
 mod oembed;
 mod ops;
+mod parts;
 mod payload;
 mod routes;
 mod scene;
 mod servable;
 mod study;
+pub mod texts;
+mod tours;
+mod ui_strings;
 mod visitor;
 mod web;
 
@@ -36,6 +40,7 @@ pub use cache::CacheConfig;
 pub use error::AppError;
 pub use layers::RequestLimits;
 pub use routes::{openapi, openapi_json};
+pub use ui_strings::{UiStrings, UiStringsError};
 pub use visitor::{client_address, ClientAddr, PeerAddr, VisitorHints};
 
 use crate::storage::{sha256_hex, ModelRecord, Storage, TokenGrant, TokenScope};
@@ -71,6 +76,9 @@ pub struct ServiceConfig {
     /// The museum's name as sites that show its links give it: oEmbed's
     /// `provider_name`, the model page's `og:site_name`.
     pub site_name: String,
+    /// The museum's own words in place of the viewer's (`[ui.strings.pt]`
+    /// in the configuration file), carried by every page.
+    pub ui_strings: UiStrings,
 }
 
 impl Default for ServiceConfig {
@@ -86,6 +94,7 @@ impl Default for ServiceConfig {
             uploads: curator::UploadConfig::default(),
             trusted_proxies: Vec::new(),
             site_name: "Vitrine".into(),
+            ui_strings: UiStrings::default(),
         }
     }
 }

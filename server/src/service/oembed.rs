@@ -7,13 +7,14 @@
 
 use super::cache_headers;
 use super::error::{AppError, ErrorBody};
+use super::language::ContentLanguages;
 use super::servable::ServableModel;
 use super::visitor::VisitorHints;
-use super::web::{escape, public_base};
+use super::web::{escape, localized, public_base};
 use super::AppState;
 use crate::storage::{valid_slug, ModelRecord};
 use axum::extract::{RawQuery, State};
-use axum::http::HeaderMap;
+use axum::http::{header, HeaderMap, HeaderValue};
 use axum::response::{IntoResponse, Response};
 use axum::Json;
 use serde::{Deserialize, Serialize};
@@ -35,6 +36,10 @@ pub struct OembedQuery {
     maxheight: Option<u32>,
     /// `json` (the default); `xml` answers 501.
     format: Option<String>,
+    /// The language of the title and credit (a BCP 47 tag), with a
+    /// fallback to the model's own; absent: `Accept-Language`. The embed
+    /// opens in it too.
+    lang: Option<String>,
 }
 
 /// An oEmbed `rich` response: an `<iframe>` of `/embed/{slug}`.
@@ -98,19 +103,46 @@ pub async fn oembed(
     let base = public_base(&state, &headers);
     let (width, height) = fit(query.maxwidth, query.maxheight);
     let site = state.config().site_name.clone();
-    let mut response = Json(answer(&model.record, &base, site, width, height)).into_response();
+    let accept = headers
+        .get(header::ACCEPT_LANGUAGE)
+        .and_then(|v| v.to_str().ok());
+    let languages = ContentLanguages::choose(query.lang.as_deref(), accept);
+    let mut response = Json(answer(
+        &model.record,
+        &base,
+        site,
+        (width, height),
+        &languages,
+    ))
+    .into_response();
     cache_headers::anonymous(&mut response, cache_headers::ANONYMOUS);
+    if languages.negotiated {
+        response
+            .headers_mut()
+            .append(header::VARY, HeaderValue::from_static("Accept-Language"));
+    }
     Ok(response)
 }
 
-fn answer(record: &ModelRecord, base: &str, site: String, width: u32, height: u32) -> Oembed {
-    let src = format!("{base}/embed/{}", record.slug);
+fn answer(
+    record: &ModelRecord,
+    base: &str,
+    site: String,
+    (width, height): (u32, u32),
+    languages: &ContentLanguages,
+) -> Oembed {
+    let texts = localized(record, languages);
+    // The embed opens in the language the title was chosen for.
+    let src = match &languages.asked {
+        Some(lang) => format!("{base}/embed/{}?lang={lang}", record.slug),
+        None => format!("{base}/embed/{}", record.slug),
+    };
     let has_thumbnail = record.curation.thumbnail_sha256.is_some();
     Oembed {
         r#type: "rich",
         version: "1.0",
-        title: record.title.clone(),
-        author_name: record.curation.rights.credit.clone(),
+        title: texts.title.text.to_owned(),
+        author_name: texts.credit.map(|c| c.text.to_owned()),
         provider_name: site,
         provider_url: format!("{base}/"),
         cache_age: 300,
@@ -119,7 +151,7 @@ fn answer(record: &ModelRecord, base: &str, site: String, width: u32, height: u3
              style=\"border:0\" loading=\"lazy\" allow=\"fullscreen; xr-spatial-tracking\" \
              allowfullscreen></iframe>",
             escape(&src),
-            escape(&record.title)
+            escape(texts.title.text)
         ),
         width,
         height,

@@ -22,7 +22,7 @@ use serde::Deserialize;
 use std::sync::Arc;
 use utoipa::{IntoParams, ToSchema};
 
-const OCTET_STREAM: &str = "application/octet-stream";
+pub(super) const OCTET_STREAM: &str = "application/octet-stream";
 const PUBLIC_IMMUTABLE: &str = "public, max-age=31536000, immutable";
 /// Levels only a token unlocks: browsers may keep them, shared caches may not.
 const PRIVATE_IMMUTABLE: &str = "private, max-age=31536000, immutable";
@@ -302,7 +302,7 @@ pub async fn texture(
 }
 
 /// Ids are positive decimal integers; anything else is a client error.
-fn parse_id(text: &str, what: &str) -> Result<i64, AppError> {
+pub(super) fn parse_id(text: &str, what: &str) -> Result<i64, AppError> {
     let valid = !text.is_empty() && text.len() <= 18 && text.bytes().all(|b| b.is_ascii_digit());
     match text.parse::<i64>() {
         Ok(v) if valid && v > 0 => Ok(v),
@@ -329,7 +329,7 @@ pub(super) fn cache_control(record: &ModelRecord, level: u32) -> &'static str {
     }
 }
 
-fn etag(sha256: &str) -> HeaderValue {
+pub(super) fn etag(sha256: &str) -> HeaderValue {
     let short = &sha256[..sha256.len().min(32)];
     HeaderValue::from_str(&format!("\"{short}\""))
         .unwrap_or_else(|_| HeaderValue::from_static("\"invalid\""))
@@ -360,7 +360,7 @@ pub(super) fn not_modified_response(etag: HeaderValue, cache_control: &'static s
     (StatusCode::NOT_MODIFIED, headers).into_response()
 }
 
-fn payload_response(
+pub(super) fn payload_response(
     bytes: Bytes,
     etag: HeaderValue,
     cache_control: &'static str,

@@ -6,7 +6,8 @@ use super::curator::{admin, annotations, jobs, thumbnail, upload};
 use super::error::AppError;
 use super::web::{self, Viewer};
 use super::{
-    api, crawl, download, guard, iiif, oembed, ops, payload, study, AppState, ServiceConfig,
+    api, crawl, download, guard, iiif, oembed, ops, parts, payload, study, texts, tours, AppState,
+    ServiceConfig,
 };
 use axum::http::{header, HeaderValue};
 use axum::response::{IntoResponse, Response};
@@ -65,7 +66,7 @@ impl Modify for BearerToken {
 /// The whole service's routes; the viewer's build serves the pages when
 /// `web_dir` has one.
 pub fn all(config: &ServiceConfig) -> axum::Router<AppState> {
-    let viewer = Viewer::find(&config.web_dir);
+    let viewer = Viewer::find(&config.web_dir, &config.ui_strings);
     let (router, _) = list(viewer.as_ref()).split_for_parts();
     match viewer {
         Some(viewer) => router.fallback_service(viewer.files()),
@@ -87,12 +88,20 @@ fn list(viewer: Option<&Viewer>) -> OpenApiRouter<AppState> {
         .routes(routes!(thumbnail::thumbnail))
         .routes(routes!(annotations::list, annotations::create))
         .routes(routes!(annotations::update, annotations::delete))
+        .routes(routes!(tours::list))
+        .routes(routes!(tours::all, tours::create))
+        .routes(routes!(tours::update, tours::delete))
         .routes(routes!(jobs::list))
         .routes(routes!(jobs::job))
         .routes(routes!(admin::versions))
         .routes(routes!(admin::change))
+        .routes(routes!(texts::get, texts::put))
         .routes(routes!(payload::base))
         .routes(routes!(payload::batch))
+        .routes(routes!(parts::index))
+        .routes(routes!(parts::head))
+        .routes(routes!(parts::part))
+        .routes(routes!(parts::split))
         .routes(routes!(payload::texture))
         .routes(routes!(download::download))
         .routes(routes!(iiif::import::import))

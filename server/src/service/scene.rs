@@ -67,6 +67,12 @@ impl SceneFrame {
         })
     }
 
+    /// A point of the viewer's world frame (model coordinates already turned
+    /// upright: `web/src/frame.js`), in the scene's: only the unit differs.
+    pub fn upright_to_scene(self, p: [f64; 3]) -> [f64; 3] {
+        p.map(|v| v * self.decimal_scale)
+    }
+
     /// A point in scene coordinates, in the model's (the inverse of
     /// [`SceneFrame::to_scene`]: the rotation's transpose, then the unit).
     pub fn to_model(self, p: [f64; 3]) -> [f64; 3] {

@@ -7,12 +7,13 @@ use super::api::visible_models;
 use super::cache_headers;
 use super::curator::thumbnail;
 use super::error::{AppError, ErrorBody};
-use super::language::PageLanguage;
+use super::language::{ContentLanguages, PageLanguage};
 use super::servable::{PathParams, ServableModel, SlugParam};
 use super::study::StudySlug;
+use super::ui_strings::UiStrings;
 use super::visitor::{HintQuery, VisitorHints};
 use super::AppState;
-use crate::storage::{valid_slug, ModelKind, ModelRecord};
+use crate::storage::{valid_slug, Localized, ModelKind, ModelRecord};
 use axum::extract::{Request, State};
 use axum::http::{header, HeaderMap, HeaderValue};
 use axum::response::{Html, IntoResponse, Response};
@@ -20,6 +21,7 @@ use axum::routing::{get, get_service, MethodRouter};
 use serde_json::json;
 use std::convert::Infallible;
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 use tower::Service;
 use tower_http::services::ServeDir;
 use utoipa_axum::router::{UtoipaMethodRouter, UtoipaMethodRouterExt};
@@ -28,14 +30,17 @@ use utoipa_axum::router::{UtoipaMethodRouter, UtoipaMethodRouterExt};
 pub struct Viewer {
     dir: PathBuf,
     index: PathBuf,
+    /// The museum's own words, as each page carries them (`UiStrings::script`).
+    strings: Arc<str>,
 }
 
 impl Viewer {
-    pub fn find(dir: &Path) -> Option<Viewer> {
+    pub fn find(dir: &Path, strings: &UiStrings) -> Option<Viewer> {
         let index = dir.join("index.html");
         index.is_file().then(|| Viewer {
             dir: dir.to_owned(),
             index,
+            strings: strings.script().into(),
         })
     }
 
@@ -50,13 +55,15 @@ impl Viewer {
     /// path), its `<html lang dir>` in the visitor's language.
     pub fn page(&self) -> MethodRouter {
         let index = self.index.clone();
+        let strings = self.strings.clone();
         get(move |language: PageLanguage| {
             let index = index.clone();
+            let strings = strings.clone();
             async move {
                 let html = read_index(&index)
                     .await?
                     .ok_or_else(|| AppError::Internal(format!("{} is gone", index.display())))?;
-                Ok::<_, AppError>(html_response(&html, language))
+                Ok::<_, AppError>(html_response(&html, language, &strings))
             }
         })
     }
@@ -153,17 +160,21 @@ pub async fn model_page(
     State(state): State<AppState>,
     headers: HeaderMap,
     language: PageLanguage,
+    languages: ContentLanguages,
     model: Result<ServableModel, AppError>,
 ) -> Result<Response, AppError> {
     let viewer = read_index(&state.config().web_dir.join("index.html")).await?;
+    let strings = state.config().ui_strings.script();
     match (viewer, model) {
         (Some(html), Ok(model)) => {
-            let tags = open_graph(&state, &headers, &model.record);
+            let record = &model.record;
+            let texts = localized(record, &languages);
+            let tags = open_graph(&state, &headers, record, &texts);
             // The page's own title, as search results and tabs show it
             // before any script runs.
             let title = format!(
                 "<title>{} · {}</title>",
-                escape(&model.record.title),
+                escape(texts.title.text),
                 escape(&state.config().site_name)
             );
             let html = match (html.find("<title>"), html.find("</title>")) {
@@ -180,12 +191,13 @@ pub async fn model_page(
                 Some(at) => format!("{}{tags}{}", &html[..at], &html[at..]),
                 None => format!("{tags}{html}"),
             };
-            Ok(html_response(&html, language))
+            Ok(html_response(&html, language, &strings))
         }
         // The viewer shows its own message for a model it cannot open.
-        (Some(html), Err(_)) => Ok(html_response(&html, language)),
+        (Some(html), Err(_)) => Ok(html_response(&html, language, &strings)),
         (None, Ok(model)) => {
-            let tags = open_graph(&state, &headers, &model.record);
+            let texts = localized(&model.record, &languages);
+            let tags = open_graph(&state, &headers, &model.record, &texts);
             Ok(built_in_page(model, &tags))
         }
         (None, Err(e)) => Err(e),
@@ -221,8 +233,26 @@ pub(super) fn page_url(base: &str, slug: &str) -> String {
     format!("{base}/m/{slug}")
 }
 
-/// `og:` meta tags of a model.
-fn open_graph(state: &AppState, headers: &HeaderMap, record: &ModelRecord) -> String {
+/// A version's texts in the visitor's languages.
+pub(super) fn localized<'a>(
+    record: &'a ModelRecord,
+    languages: &ContentLanguages,
+) -> Localized<'a> {
+    record.texts.localize(
+        &record.title,
+        &record.description,
+        record.curation.rights.credit.as_deref(),
+        &languages.wanted,
+    )
+}
+
+/// `og:` meta tags of a model, its texts in the visitor's language.
+fn open_graph(
+    state: &AppState,
+    headers: &HeaderMap,
+    record: &ModelRecord,
+    texts: &Localized,
+) -> String {
     let base = public_base(state, headers);
     let page = page_url(&base, &record.slug);
     let mut tags = format!(
@@ -235,13 +265,20 @@ fn open_graph(state: &AppState, headers: &HeaderMap, record: &ModelRecord) -> St
          <meta property=\"og:description\" content=\"{}\">\n\
          <meta property=\"og:url\" content=\"{}\">\n",
         escape(&state.config().site_name),
-        escape(&record.title),
-        escape(&record.description),
+        escape(texts.title.text),
+        escape(texts.description.text),
         escape(&page),
         site = escape(&state.config().site_name),
-        description = escape(record.description.trim()),
+        description = escape(texts.description.text.trim()),
         page = escape(&page),
     );
+    if let Some(language) = texts.title.language {
+        // Open Graph writes a locale as ll_CC.
+        tags.push_str(&format!(
+            "<meta property=\"og:locale\" content=\"{}\">\n",
+            escape(&language.replace('-', "_"))
+        ));
+    }
     if record.curation.thumbnail_sha256.is_some() {
         tags.push_str(&format!(
             "<meta property=\"og:image\" content=\"{}\">\n\
@@ -261,7 +298,7 @@ fn open_graph(state: &AppState, headers: &HeaderMap, record: &ModelRecord) -> St
                 "{base}/api/oembed?{}",
                 serde_urlencoded::to_string([("url", page.as_str())]).unwrap_or_default()
             )),
-            escape(&record.title)
+            escape(texts.title.text)
         ));
     }
     if let Some(licence) = record.curation.rights.licence {
@@ -270,29 +307,30 @@ fn open_graph(state: &AppState, headers: &HeaderMap, record: &ModelRecord) -> St
             escape(licence.url)
         ));
     }
-    tags.push_str(&structured_data(record, &base));
+    tags.push_str(&structured_data(record, texts, &base));
     tags
 }
 
 /// The model as schema.org's `3DModel` (JSON-LD), with its credit and
 /// licence, so search engines can show them (and the GLB download, where
 /// every visitor may take it).
-fn structured_data(record: &ModelRecord, base: &str) -> String {
+fn structured_data(record: &ModelRecord, texts: &Localized, base: &str) -> String {
     let mut model = json!({
         "@context": "https://schema.org",
         "@type": "3DModel",
-        "name": record.title,
+        "name": tagged(texts.title.text, texts.title.language),
         "url": page_url(base, &record.slug),
     });
-    if !record.description.trim().is_empty() {
-        model["description"] = record.description.trim().into();
+    let description = texts.description.text.trim();
+    if !description.is_empty() {
+        model["description"] = tagged(description, texts.description.language);
     }
     if record.curation.thumbnail_sha256.is_some() {
         model["image"] = format!("{base}{}", thumbnail::url(&record.slug, record.version)).into();
     }
     let rights = &record.curation.rights;
-    if let Some(credit) = &rights.credit {
-        model["creditText"] = credit.as_str().into();
+    if let Some(credit) = texts.credit {
+        model["creditText"] = tagged(credit.text, credit.language);
     }
     if let Some(licence) = rights.licence {
         model["license"] = licence.url.into();
@@ -312,10 +350,25 @@ fn structured_data(record: &ModelRecord, base: &str) -> String {
     format!("<script type=\"application/ld+json\">{text}</script>\n")
 }
 
-/// The viewer's page in `language` (its `<html lang dir>`), with the
-/// headers every page has.
-fn html_response(html: &str, language: PageLanguage) -> Response {
-    let mut response = Html(language.apply(html)).into_response();
+/// A JSON-LD string value marked with its language where it is known
+/// (`{"@value", "@language"}`), so a search engine knows which language
+/// each text of the page is in.
+fn tagged(text: &str, language: Option<&str>) -> serde_json::Value {
+    match language {
+        Some(language) => json!({ "@value": text, "@language": language }),
+        None => text.into(),
+    }
+}
+
+/// The viewer's page in `language` (its `<html lang dir>`), the museum's
+/// own words (`strings`, a script element or nothing) before `</head>`,
+/// with the headers every page has.
+fn html_response(html: &str, language: PageLanguage, strings: &str) -> Response {
+    let html = match html.find("</head>") {
+        Some(at) if !strings.is_empty() => format!("{}{strings}{}", &html[..at], &html[at..]),
+        _ => html.to_owned(),
+    };
+    let mut response = Html(language.apply(&html)).into_response();
     response.headers_mut().insert(
         header::HeaderName::from_static("accept-ch"),
         HeaderValue::from_static("Sec-CH-UA-Mobile"),

@@ -54,6 +54,11 @@ macro_rules! sql_storage {
                     levels: Vec::new(),
                     mapping: None,
                     textures: Vec::new(),
+                    has_study: row.try_get("has_study").map_err(get)?,
+                    texts: $crate::storage::ModelTexts {
+                        language: row.try_get("language").map_err(get)?,
+                        translations: Default::default(),
+                    },
                     curation: Curation {
                         up_axis: match row.try_get::<Option<String>, _>("up_axis").map_err(get)? {
                             Some(name) => Some(UpAxis::parse(&name).ok_or_else(|| {
@@ -183,6 +188,7 @@ macro_rules! sql_storage {
                         });
                     }
                 }
+                record.texts.translations = self.translations_of(record.model_id).await?;
                 Ok(Some(record))
             }
         }
@@ -219,10 +225,14 @@ macro_rules! sql_storage {
                 use $crate::storage::sql::{narrow, LIST};
                 let c = Self::classify;
                 let rows = sqlx::query(LIST).fetch_all(&self.pool).await.map_err(c)?;
+                let mut titles = $crate::storage::TextStorage::listed_titles(self).await?;
                 rows.iter()
                     .map(|row| {
+                        let slug: String = row.try_get("slug").map_err(c)?;
                         Ok(ModelSummary {
-                            slug: row.try_get("slug").map_err(c)?,
+                            translations: titles.remove(&slug).unwrap_or_default(),
+                            language: row.try_get("language").map_err(c)?,
+                            slug,
                             title: row.try_get("title").map_err(c)?,
                             version: narrow(row.try_get("version").map_err(c)?, "model.version")?,
                             kind: Self::kind_from_row(row)?,
@@ -238,6 +248,7 @@ macro_rules! sql_storage {
                             )?,
                             has_thumbnail: row.try_get("has_thumbnail").map_err(c)?,
                             licence: row.try_get("licence").map_err(c)?,
+                            has_parts: row.try_get("has_parts").map_err(c)?,
                         })
                     })
                     .collect()
@@ -278,6 +289,62 @@ macro_rules! sql_storage {
                     .fetch_optional(&self.pool)
                     .await
                     .map_err(Self::classify)
+            }
+
+            async fn parts(&self, id: i64) -> $crate::storage::Result<Vec<PartRecord>> {
+                use sqlx::Row;
+                use $crate::storage::sql::narrow;
+                let c = Self::classify;
+                let rows = sqlx::query($crate::storage::sql::PARTS)
+                    .bind(id)
+                    .fetch_all(&self.pool)
+                    .await
+                    .map_err(c)?;
+                rows.iter()
+                    .map(|row| {
+                        let int = |name: &'static str| -> $crate::storage::Result<u32> {
+                            narrow(row.try_get::<i64, _>(name).map_err(c)?, name)
+                        };
+                        Ok(PartRecord {
+                            iteration: int("iteration")?,
+                            chart: int("chart")?,
+                            bytes: int("byte_len")?,
+                            inserted: int("inserted")?,
+                            error: row.try_get("error").map_err(c)?,
+                            phase: int("phase")?,
+                            parent: row
+                                .try_get::<Option<i64>, _>("parent")
+                                .map_err(c)?
+                                .map(|p| narrow(p, "parent"))
+                                .transpose()?,
+                        })
+                    })
+                    .collect()
+            }
+
+            async fn splits(&self, id: i64) -> $crate::storage::Result<Vec<SplitRecord>> {
+                use sqlx::Row;
+                use $crate::storage::sql::narrow;
+                let c = Self::classify;
+                let rows = sqlx::query($crate::storage::sql::SPLITS)
+                    .bind(id)
+                    .fetch_all(&self.pool)
+                    .await
+                    .map_err(c)?;
+                rows.iter()
+                    .map(|row| {
+                        let int = |name: &'static str| -> $crate::storage::Result<u32> {
+                            narrow(row.try_get::<i64, _>(name).map_err(c)?, name)
+                        };
+                        Ok(SplitRecord {
+                            iteration: int("iteration")?,
+                            parent: int("parent")?,
+                            first_child: int("first_child")?,
+                            children: int("children")?,
+                            bytes: int("byte_len")?,
+                        })
+                    })
+                    .collect()
             }
 
             async fn texture(&self, id: i64) -> $crate::storage::Result<Option<TexturePayload>> {

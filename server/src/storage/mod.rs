@@ -13,6 +13,8 @@ mod sql;
 mod sqlite;
 mod stage;
 mod study;
+mod texts;
+mod tours;
 mod types;
 
 pub use curator::CuratorStorage;
@@ -22,6 +24,10 @@ pub use study::{
     for_analysis, AnswerRecord, InvitationRecord, NewSession, SessionRecord, StudyRecord,
     StudyStorage, ViewEvent,
 };
+pub use texts::{
+    Localized, ModelTexts, Picked, TextField, TextStorage, Translation, Translations, VersionTexts,
+};
+pub use tours::{LanguageMap, NewTour, TourRecord, TourStep, TourStorage};
 pub use types::*;
 
 use async_trait::async_trait;
@@ -81,7 +87,9 @@ pub(crate) fn is_connection_error(e: &sqlx::Error) -> bool {
 
 /// The one interface the service and the ingest command use.
 #[async_trait]
-pub trait Storage: StudyStorage + CuratorStorage + Send + Sync + 'static {
+pub trait Storage:
+    StudyStorage + CuratorStorage + TourStorage + TextStorage + Send + Sync + 'static
+{
     /// Which backend, for logs and metrics: `"sqlite"` or `"postgres"`.
     fn backend(&self) -> &'static str;
 
@@ -112,6 +120,20 @@ pub trait Storage: StudyStorage + CuratorStorage + Send + Sync + 'static {
 
     /// Refinement batch `iteration` (1-based).
     async fn batch_payload(&self, compression_id: i64, iteration: u32) -> Result<Option<Vec<u8>>>;
+
+    /// A charted stream's parts, batch by batch and chart by chart; empty
+    /// for a plain stream or one ingested before parts were recorded.
+    async fn parts(&self, compression_id: i64) -> Result<Vec<PartRecord>> {
+        let _ = compression_id;
+        Ok(Vec::new())
+    }
+
+    /// A nested stream's split entries, batch by batch and parent by
+    /// parent; empty for any other stream.
+    async fn splits(&self, compression_id: i64) -> Result<Vec<SplitRecord>> {
+        let _ = compression_id;
+        Ok(Vec::new())
+    }
 
     async fn texture(&self, texture_id: i64) -> Result<Option<TexturePayload>>;
 

@@ -3,10 +3,13 @@
 use super::backend::sql_storage;
 use super::curator::curator_storage;
 use super::study::study_storage;
+use super::texts::text_storage;
+use super::tours::tour_storage;
 use super::{
     is_connection_error, AudiencePolicy, Bounds, ConnectOptions, Curation, LevelRecord,
-    MappingRecord, ModelKind, ModelRecord, ModelSummary, NewModel, NewToken, StagedModel, Storage,
-    StorageError, TexturePayload, TextureRef, TokenGrant, TokenScope, UpAxis,
+    MappingRecord, ModelKind, ModelRecord, ModelSummary, NewModel, NewToken, PartRecord,
+    SplitRecord, StagedModel, Storage, StorageError, TexturePayload, TextureRef, TokenGrant,
+    TokenScope, UpAxis,
 };
 use sqlx::postgres::{PgConnectOptions, PgPoolOptions};
 use sqlx::{PgPool, Postgres, Transaction};
@@ -69,3 +72,5 @@ impl PostgresStorage {
 sql_storage!(PostgresStorage, Postgres, "postgres", MIGRATOR);
 study_storage!(PostgresStorage, Postgres);
 curator_storage!(PostgresStorage, Postgres);
+tour_storage!(PostgresStorage, Postgres);
+text_storage!(PostgresStorage, Postgres);

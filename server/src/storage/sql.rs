@@ -12,8 +12,9 @@ macro_rules! record_select {
          m.good_enough_level, m.created_at, p.name AS policy_name, p.public_access, \
          p.public_max_vertex_fraction, p.public_full_resolution, p.token_full_resolution, p.downloads, \
          c.id AS compression_id, c.codec_version, c.quantization_bits, c.has_colour, c.mapping_id, \
-         tm.parameters AS mapping_parameters, m.up_axis, m.unit, m.bounds, m.credit, m.licence, \
-         th.sha256 AS thumbnail_sha256 \
+         tm.parameters AS mapping_parameters, m.up_axis, m.unit, m.bounds, m.credit, m.licence, m.language, \
+         th.sha256 AS thumbnail_sha256, \
+         EXISTS (SELECT 1 FROM study s WHERE s.model_id = m.id) AS has_study \
          FROM model m JOIN audience_policy p ON p.id = m.policy_id \
          JOIN compression c ON c.model_id = m.id \
          LEFT JOIN texture_mapping tm ON tm.id = c.mapping_id \
@@ -39,8 +40,9 @@ pub(super) const TEXTURES: &str = "SELECT t.id, t.kind, t.media_type, t.byte_len
      FROM texture_mapping tm \
      JOIN texture t ON t.id IN (tm.cell_texture_id, tm.colour_texture_id, tm.colour_low_texture_id) \
      WHERE tm.id = $1 ORDER BY t.id";
-pub(super) const LIST: &str = "SELECT m.slug, m.title, m.version, m.kind, m.created_at, p.public_access, c.batch_count, c.codec_version, m.licence, \
-     (th.model_id IS NOT NULL) AS has_thumbnail \
+pub(super) const LIST: &str = "SELECT m.slug, m.title, m.version, m.kind, m.created_at, p.public_access, c.batch_count, c.codec_version, m.licence, m.language, \
+     (th.model_id IS NOT NULL) AS has_thumbnail, \
+     EXISTS (SELECT 1 FROM stream_part sp WHERE sp.compression_id = c.id) AS has_parts \
      FROM model m JOIN audience_policy p ON p.id = m.policy_id JOIN compression c ON c.model_id = m.id \
      LEFT JOIN thumbnail th ON th.model_id = m.id \
      WHERE m.status = 'ready' \
@@ -65,8 +67,8 @@ pub(super) const MAX_VERSION: &str = "SELECT MAX(version) AS v FROM model WHERE 
 pub(super) const INSERT_MODEL: &str =
     "INSERT INTO model (slug, version, title, description, policy_id, \
      good_enough_level, source_name, source_vertices, source_faces, status, created_at, \
-     up_axis, unit, bounds, kind, credit, licence) \
-     VALUES ($1, $2, $3, $4, $5, $6, $7, $8, $9, 'ready', $10, $11, $12, $13, $14, $15, $16) \
+     up_axis, unit, bounds, kind, credit, licence, language) \
+     VALUES ($1, $2, $3, $4, $5, $6, $7, $8, $9, 'ready', $10, $11, $12, $13, $14, $15, $16, $17) \
      RETURNING id";
 pub(super) const INSERT_THUMBNAIL: &str = "INSERT INTO thumbnail \
      (model_id, media_type, width, height, byte_len, sha256, bytes, created_at) \
@@ -83,6 +85,18 @@ pub(super) const INSERT_TEXTURE: &str = "INSERT INTO texture \
 pub(super) const INSERT_MAPPING: &str = "INSERT INTO texture_mapping \
      (model_id, cell_texture_id, colour_texture_id, colour_low_texture_id, parameters, created_at) \
      VALUES ($1, $2, $3, $4, $5, $6) RETURNING id";
+pub(super) const INSERT_PART: &str = "INSERT INTO stream_part \
+     (compression_id, iteration, chart, byte_len, inserted, error, phase, parent) \
+     VALUES ($1, $2, $3, $4, $5, $6, $7, $8)";
+pub(super) const PARTS: &str =
+    "SELECT iteration, chart, byte_len, inserted, error, phase, parent FROM stream_part \
+     WHERE compression_id = $1 ORDER BY iteration, chart";
+pub(super) const INSERT_SPLIT: &str = "INSERT INTO stream_split \
+     (compression_id, iteration, parent, first_child, children, byte_len) \
+     VALUES ($1, $2, $3, $4, $5, $6)";
+pub(super) const SPLITS: &str =
+    "SELECT iteration, parent, first_child, children, byte_len FROM stream_split \
+     WHERE compression_id = $1 ORDER BY iteration, parent";
 pub(super) const INSERT_BATCH: &str = "INSERT INTO refinement_batch \
      (compression_id, iteration, vertices, faces, byte_len, sha256, bytes, hausdorff, rmse, roy_rmse) \
      VALUES ($1, $2, $3, $4, $5, $6, $7, $8, $9, $10)";

@@ -3,10 +3,13 @@
 use super::backend::sql_storage;
 use super::curator::curator_storage;
 use super::study::study_storage;
+use super::texts::text_storage;
+use super::tours::tour_storage;
 use super::{
     is_connection_error, AudiencePolicy, Bounds, ConnectOptions, Curation, LevelRecord,
-    MappingRecord, ModelKind, ModelRecord, ModelSummary, NewModel, NewToken, StagedModel, Storage,
-    StorageError, TexturePayload, TextureRef, TokenGrant, TokenScope, UpAxis,
+    MappingRecord, ModelKind, ModelRecord, ModelSummary, NewModel, NewToken, PartRecord,
+    SplitRecord, StagedModel, Storage, StorageError, TexturePayload, TextureRef, TokenGrant,
+    TokenScope, UpAxis,
 };
 use sqlx::sqlite::{SqliteConnectOptions, SqliteJournalMode, SqlitePoolOptions, SqliteSynchronous};
 use sqlx::{Sqlite, SqlitePool, Transaction};
@@ -86,3 +89,5 @@ impl SqliteStorage {
 sql_storage!(SqliteStorage, Sqlite, "sqlite", MIGRATOR);
 study_storage!(SqliteStorage, Sqlite);
 curator_storage!(SqliteStorage, Sqlite);
+tour_storage!(SqliteStorage, Sqlite);
+text_storage!(SqliteStorage, Sqlite);

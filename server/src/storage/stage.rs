@@ -44,6 +44,7 @@ macro_rules! stage_body {
             .bind($model.kind.name())
             .bind($model.rights.credit.clone())
             .bind($model.rights.licence.map(|l| l.id))
+            .bind($model.language.clone())
             .fetch_one(&mut *$tx)
             .await
             .map_err(conflict)?;
@@ -135,6 +136,32 @@ macro_rules! stage_body {
                 .bind(batch.metrics.map(|m| m.hausdorff).or(batch.hausdorff))
                 .bind(batch.metrics.map(|m| m.image_rmse))
                 .bind(batch.metrics.and_then(|m| m.roy_rmse))
+                .execute(&mut *$tx)
+                .await
+                .map_err(c)?;
+        }
+        for part in &comp.parts {
+            sqlx::query(INSERT_PART)
+                .bind(compression_id)
+                .bind(i64::from(part.iteration))
+                .bind(i64::from(part.chart))
+                .bind(i64::from(part.bytes))
+                .bind(i64::from(part.inserted))
+                .bind(part.error)
+                .bind(i64::from(part.phase))
+                .bind(part.parent.map(i64::from))
+                .execute(&mut *$tx)
+                .await
+                .map_err(c)?;
+        }
+        for split in &comp.splits {
+            sqlx::query(INSERT_SPLIT)
+                .bind(compression_id)
+                .bind(i64::from(split.iteration))
+                .bind(i64::from(split.parent))
+                .bind(i64::from(split.first_child))
+                .bind(i64::from(split.children))
+                .bind(i64::from(split.bytes))
                 .execute(&mut *$tx)
                 .await
                 .map_err(c)?;

@@ -3,9 +3,9 @@
 use serde::Serialize;
 
 pub use super::curator::{
-    parse_credit, parse_licence, AnnotationRecord, Bounds, JobRecord, JobState, Licence,
-    NewAnnotation, NewJob, Rights, ThumbnailPayload, UpAxis, VersionRecord, LICENCES,
-    MAX_CREDIT_BYTES,
+    parse_credit, parse_licence, AnnotationRecord, AnnotationText, AnnotationTranslations, Bounds,
+    JobRecord, JobState, Licence, NewAnnotation, NewJob, Rights, ThumbnailPayload, UpAxis,
+    VersionRecord, LICENCES, MAX_CREDIT_BYTES,
 };
 
 /// Who may fetch how much of a model (table `audience_policy`).
@@ -122,13 +122,15 @@ impl ModelKind {
     }
 
     /// Whether this build decodes streams of `version` for this kind (a
-    /// mesh: the plain format and the charted one).
+    /// mesh: the plain format, the charted one and the nested one).
     pub fn can_read(self, version: u8) -> bool {
         match self {
             ModelKind::Mesh => {
-                version == vitrine_codec::VERSION || version == vitrine_codec::CHARTED_VERSION
+                version == vitrine_codec::VERSION
+                    || version == vitrine_codec::CHARTED_VERSION
+                    || version == vitrine_codec::NESTED_VERSION
             }
-            ModelKind::Points => version == vitrine_points::stream::VERSION,
+            ModelKind::Points => vitrine_points::stream::VERSIONS.contains(&version),
         }
     }
 }
@@ -162,6 +164,10 @@ pub struct ModelRecord {
     pub curation: Curation,
     /// The mapping's images, by id.
     pub textures: Vec<TextureRef>,
+    /// The default language of the texts and their translations.
+    pub texts: super::ModelTexts,
+    /// A quality study was begun on this version (its results may be asked).
+    pub has_study: bool,
 }
 
 /// What an ingest records for curators and the viewer beside the stream:
@@ -213,6 +219,16 @@ pub struct ModelSummary {
     /// `vitrine models` lists it for a rights audit).
     #[serde(skip)]
     pub licence: Option<String>,
+    /// Its parts are recorded (`stream_part`): a charted stream ingested
+    /// before they were has none, and streams whole batches only.
+    #[serde(skip)]
+    pub has_parts: bool,
+    /// The BCP 47 tag of `title`, when stated.
+    #[serde(skip)]
+    pub language: Option<String>,
+    /// The translated titles (only `title` is read for the list).
+    #[serde(skip)]
+    pub translations: super::Translations,
 }
 
 impl ModelSummary {
@@ -329,6 +345,8 @@ pub struct NewModel {
     pub bounds: Option<Bounds>,
     /// Credit line and licence.
     pub rights: Rights,
+    /// The BCP 47 tag of the title, description and credit, if stated.
+    pub language: Option<String>,
     /// A picture rendered at ingest, stored in the same transaction.
     pub thumbnail: Option<NewThumbnail>,
 }
@@ -378,6 +396,50 @@ pub struct NewCompression {
     /// Header plus base chunk.
     pub base: NewLevel,
     pub batches: Vec<NewLevel>,
+    /// A charted stream's parts (table `stream_part`); empty otherwise.
+    pub parts: Vec<PartRecord>,
+    /// A nested stream's split entries (table `stream_split`); empty
+    /// otherwise.
+    pub splits: Vec<SplitRecord>,
+}
+
+/// One chart's part of a parted batch (table `stream_part`): what a viewer
+/// that refines where the visitor looks fetches instead of whole batches.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct PartRecord {
+    /// The batch (1-based), as `refinement_batch.iteration`.
+    pub iteration: u32,
+    pub chart: u32,
+    /// Bytes of the part alone, as served.
+    pub bytes: u32,
+    /// Vertices it inserts (0: the chart sits this batch out).
+    pub inserted: u32,
+    /// The largest distance, in model units, from a vertex it inserts to
+    /// the chart's coarser surface: what a viewer turns into screen pixels.
+    pub error: f64,
+    /// The chart's phase: 0 in a charted stream (format 5) and for a
+    /// nested stream's top charts (format 6).
+    pub phase: u32,
+    /// The chart's parent, by its position in phase `phase − 1` (format 6,
+    /// phase ≥ 1).
+    pub parent: Option<u32>,
+}
+
+/// One split entry of a nested stream (table `stream_split`): what a viewer
+/// fetches to cut a chart that has had all its phase's parts into its
+/// children.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct SplitRecord {
+    /// The batch whose head holds it: the first of the children's phase.
+    pub iteration: u32,
+    /// The chart split, by its position in the phase before.
+    pub parent: u32,
+    /// Its children: `first_child` … `first_child + children − 1` of the
+    /// batch's phase.
+    pub first_child: u32,
+    pub children: u32,
+    /// Bytes of the entry, as served.
+    pub bytes: u32,
 }
 
 /// Ids of a written model version.

@@ -29,6 +29,8 @@ impl BrokenStorage {
 #[async_trait]
 impl vitrine::storage::StudyStorage for BrokenStorage {}
 impl vitrine::storage::CuratorStorage for BrokenStorage {}
+impl vitrine::storage::TourStorage for BrokenStorage {}
+impl vitrine::storage::TextStorage for BrokenStorage {}
 
 #[async_trait]
 impl Storage for BrokenStorage {

@@ -12,6 +12,8 @@ mod harness;
 mod http;
 mod iiif;
 mod kill;
+mod nested_parts;
+mod parts;
 mod points;
 mod proxy;
 mod publishing;
@@ -20,6 +22,8 @@ mod slow;
 mod spec;
 mod story;
 mod study;
+mod texts;
+mod tours;
 mod uploads;
 mod viewer;
 
@@ -83,14 +87,19 @@ on_both_backends!(
     publishing::rights_served_and_carried,
     publishing::rights_and_placement_through_uploads,
     publishing::oembed_for_pasted_links,
+    texts::texts_in_the_visitors_language,
+    texts::annotations_in_several_languages,
     publishing::crawlers_find_public_models,
     curators::annotations_and_scopes,
     iiif::manifests_for_public_models,
     iiif::annotations_round_trip,
+    tours::tours_stored_versioned_and_in_the_manifest,
     uploads::uploads_as_jobs,
     curation::curation_in_manifest_and_thumbnail,
     points::points_streamed_under_caps,
     points::cloud_uploads,
+    parts::parts_served_under_caps,
+    nested_parts::nested_parts_served_under_caps,
 );
 
 /// `server/openapi.json` is the served description, committed for reviewers

@@ -40,7 +40,11 @@ async fn text(http: &reqwest::Client, url: &str) -> String {
 }
 
 /// The body of `GET url` as JSON, with a token when given.
-async fn json_of(http: &reqwest::Client, url: impl AsRef<str>, token: Option<&str>) -> Value {
+pub(crate) async fn json_of(
+    http: &reqwest::Client,
+    url: impl AsRef<str>,
+    token: Option<&str>,
+) -> Value {
     let mut request = http.get(url.as_ref());
     if let Some(token) = token {
         request = request.bearer_auth(token);
@@ -87,7 +91,7 @@ pub async fn rights_served_and_carried(db: TestDb) {
     assert_eq!(licence_of("stele"), "CC-BY-4.0", "{table}");
     assert_eq!(licence_of("plain"), "-", "{table}");
     assert!(
-        table.ends_with("1 public without a stated licence"),
+        table.contains("; 1 public without a stated licence;"),
         "{table}"
     );
     let curator = token(&db, TokenScope::Curator, None).await;

@@ -42,6 +42,8 @@ impl SlowStorage {
 #[async_trait]
 impl vitrine::storage::StudyStorage for SlowStorage {}
 impl vitrine::storage::CuratorStorage for SlowStorage {}
+impl vitrine::storage::TourStorage for SlowStorage {}
+impl vitrine::storage::TextStorage for SlowStorage {}
 
 #[async_trait]
 impl Storage for SlowStorage {

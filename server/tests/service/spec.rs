@@ -6,6 +6,8 @@
 
 mod curators;
 mod iiif;
+mod texts;
+mod tours;
 
 use super::broken::{BrokenStorage, Failure};
 use super::colour::tiny_mapping;
@@ -389,6 +391,8 @@ pub async fn responses_match_openapi(db: TestDb) {
     download_calls(&mut spec, &server, &db).await;
     curators::curator_calls(&mut spec, &server, &db).await;
     iiif::iiif_calls(&mut spec, &server, &db).await;
+    tours::tour_calls(&mut spec, &server, &db).await;
+    texts::text_calls(&mut spec, &server, &db).await;
     refusals(&mut spec, &db, &m).await;
     spec.assert_every_route_called();
 }
@@ -543,7 +547,12 @@ async fn study_calls(spec: &mut Spec, server: &TestServer, db: &TestDb) {
     let answer = json!({"improvement": "a-little", "sufficient": true, "shown_ms": [0, 0]});
     let event = json!({"at_ms": 5.0, "step": 1, "state": "pre", "kind": "camera",
         "camera": {"eye": [0, 0, 2], "target": [0, 0, 0], "up": [0, 1, 0], "fov": 50}, "zoom": 1.5});
-    spec.send(server, "get", "/api/study/open/results", None, None, 404)
+    // Begun, no answers yet: linked from the manifest, so not a 404.
+    let results = spec
+        .send(server, "get", "/api/study/open/results", None, None, 200)
+        .await;
+    assert_eq!(results.json()["valid_sessions"], 0);
+    spec.send(server, "get", "/api/study/missing/results", None, None, 404)
         .await;
     spec.send(server, "get", "/api/study/open", None, None, 403)
         .await;

@@ -228,6 +228,8 @@ pub async fn manifest_and_payloads_match_codec(db: TestDb) {
     assert_eq!(m["last_level"], last);
     assert_eq!(m["cap"]["level"], last, "{m}");
     assert_eq!(m["cap"]["reason"], Value::Null);
+    // No study begun: no results to ask for (issue 45).
+    assert!(m.get("study_results").is_none(), "{m}");
     let levels = m["levels"].as_array().unwrap();
     assert_eq!(levels.len(), index.header.levels.len());
     for (k, (level, header)) in levels.iter().zip(&index.header.levels).enumerate() {

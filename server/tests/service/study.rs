@@ -247,7 +247,16 @@ pub async fn scripted_participants(db: TestDb) {
     // p90 of {last - 1, last}.
     assert_eq!(r.good_enough_level, Some(last));
 
-    // The page's chart: the share of "sufficient" per level, public.
+    // The page's chart: the share of "sufficient" per level, public, and
+    // linked from the manifest (which links nothing for a model without a
+    // study: the page then never asks).
+    let manifest: Value = reqwest::get(server.url("/api/models/bust"))
+        .await
+        .unwrap()
+        .json()
+        .await
+        .unwrap();
+    assert_eq!(manifest["study_results"], "/api/study/bust/results");
     let results: Value = reqwest::get(server.url("/api/study/bust/results"))
         .await
         .unwrap()

@@ -136,3 +136,37 @@ fn invalid_configurations_exit_1_with_a_reason() {
     let o = check(&["--config", "/nonexistent/vitrine.toml"], &[]);
     assert_eq!(o.status.code(), Some(1));
 }
+
+/// `[ui.strings.<language>]`: a museum's own words for the viewer, accepted
+/// from the file (dotted keys or nested tables), refused with the setting
+/// named when the language or a key is not one the viewer has.
+#[test]
+fn the_museums_own_words_come_from_the_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let good = write(
+        dir.path(),
+        "site-name = \"Museu\"\n\
+         [ui.strings.en]\n\"page.allModels\" = \"← All stories\"\n\
+         [ui.strings.pt.page]\nallModels = \"← Todas as histórias\"\n",
+    );
+    let o = check(&["--config", &good], &[]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert_eq!(value(&o, "site-name"), "\"Museu\"");
+    for (text, named) in [
+        (
+            "[ui.strings.ja]\n\"page.allModels\" = \"x\"\n",
+            "`ui.strings.ja`",
+        ),
+        (
+            "[ui.strings.en]\n\"page all\" = \"x\"\n",
+            "`ui.strings.en.\"page all\"`",
+        ),
+        ("[ui]\nstrings = 3\n", "`ui.strings`"),
+    ] {
+        let bad = write(dir.path(), text);
+        let o = check(&["--config", &bad], &[]);
+        assert!(!o.status.success(), "{text}");
+        let stderr = String::from_utf8_lossy(&o.stderr);
+        assert!(stderr.contains(named), "{text}: {stderr}");
+    }
+}

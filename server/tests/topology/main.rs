@@ -15,3 +15,4 @@ mod cache_rules;
 mod coherence;
 mod config;
 mod forwarded;
+mod ui_strings;

@@ -53,7 +53,9 @@ export async function call(path, init = {}) {
     let message = `the server answered ${response.status}`;
     try {
       const body = await response.json();
+      // `{ error: code, message }`, or `{ error: { message } }`.
       if (body && typeof body.message === 'string') message = body.message;
+      else if (typeof body?.error?.message === 'string') message = body.error.message;
     } catch {
       // Not JSON: keep the status.
     }
@@ -100,4 +102,61 @@ export function changeVersion(slug, version, change) {
     headers: { 'Content-Type': 'application/json' },
     body: JSON.stringify(change),
   });
+}
+
+/**
+ * A version's title, description and credit: their language as given, and
+ * their translations by BCP 47 tag (a field left out falls back to the
+ * default text).
+ * @typedef {import('../content-language.js').ContentTranslation} Translation
+ * @typedef {{ language: string | null, title: string, description: string, credit: string | null,
+ *   translations: Record<string, Translation> }} VersionTexts
+ * @typedef {{ language: string | null, translations: Record<string, Translation> }} VersionTextsChange
+ */
+
+/** @param {string} slug @param {number} version @returns {Promise<VersionTexts>} */
+export function texts(slug, version) {
+  return call(`/api/admin/models/${slug}/versions/${version}/texts`);
+}
+
+/**
+ * Replaces the language of the default texts and every translation of the version.
+ * @param {string} slug @param {number} version @param {VersionTextsChange} change
+ * @returns {Promise<VersionTexts>}
+ */
+export function saveTexts(slug, version, change) {
+  return call(`/api/admin/models/${slug}/versions/${version}/texts`, {
+    method: 'PUT',
+    headers: { 'Content-Type': 'application/json' },
+    body: JSON.stringify(change),
+  });
+}
+
+/**
+ * @typedef {{ view: string, title: Record<string, string>, text: Record<string, string>, html?: Record<string, string> }} TourStep
+ * @typedef {{ id: number, version: number, title: Record<string, string>, steps: TourStep[] }} Tour
+ * @typedef {{ title: Record<string, string>, steps: TourStep[], version?: number }} TourInput
+ */
+
+/** Every tour of the model, of every version. @param {string} slug @returns {Promise<Tour[]>} */
+export function tours(slug) {
+  return call(`/api/admin/models/${slug}/tours`);
+}
+
+/**
+ * Creates (`id` null) or replaces a tour.
+ * @param {string} slug @param {number | null} id @param {TourInput} tour
+ * @returns {Promise<Tour>}
+ */
+export function saveTour(slug, id, tour) {
+  return call(id === null ? `/api/admin/models/${slug}/tours` : `/api/admin/models/${slug}/tours/${id}`, {
+    method: id === null ? 'POST' : 'PUT',
+    headers: { 'Content-Type': 'application/json' },
+    body: JSON.stringify(tour),
+  });
+}
+
+/** @param {string} slug @param {number} id */
+export function deleteTour(slug, id) {
+  return call(`/api/admin/models/${slug}/tours/${id}`, { method: 'DELETE' });
 }

@@ -5,13 +5,16 @@
  * title, description, audience policy, colour mode, unit, up axis, credit
  * line and licence, follow the ingest jobs (polled from /api/jobs, so they
  * resume after a reload; failures show the importer's message), and per
- * model list versions, withdraw or restore one, set its good-enough level
- * and change its credit and licence. Plain HTML controls with labels; the
+ * model list versions, withdraw or restore one, set its good-enough level,
+ * change its credit and licence, and edit its texts in other languages
+ * (texts.js). Plain HTML controls with labels; the
  * status lines are live regions.
  */
 
 import { t } from '../i18n/index.js';
 import * as api from './api.js';
+import { TAG_INPUT, TextsEditor, tagSuggestions } from './texts.js';
+import { TourEditor } from './tours.js';
 
 const POLICIES = ['exhibition', 'open', 'researchers', 'open-download', 'exhibition-download'];
 /** Each option's value and what it shows: the value itself, or a catalogue key for the empty default. */
@@ -23,7 +26,7 @@ const optionText = ([value, shown]) => (value === '' ? t(shown) : shown);
 /** The server's limit on a credit line, in bytes (maxlength counts characters: the server has the last word). */
 const CREDIT_MAX = 300;
 /** Form fields sent only when set: the server's defaults apply otherwise. */
-const OPTIONAL_FIELDS = ['colour', 'unit', 'up', 'credit', 'licence'];
+const OPTIONAL_FIELDS = ['language', 'colour', 'unit', 'up', 'credit', 'licence'];
 const STYLE = `
 .admin { max-width: 60rem; margin: 0 auto; padding: 1rem; line-height: 1.5; }
 .admin section { margin: 1.5rem 0; }
@@ -35,6 +38,11 @@ const STYLE = `
 .admin .error { color: #b00020; }
 .admin progress { width: 10rem; vertical-align: middle; }
 .admin .rights { margin: 0.3rem 0 0 1rem; }
+.admin .texts { margin: 0.5rem 0 0 1rem; }
+.admin .texts h3 { font-size: 1rem; margin: 0.5rem 0; }
+.admin .texts fieldset { margin: 0.8rem 0; }
+.admin .tour-viewer { display: block; width: 100%; height: 420px; margin: 0.5rem 0; }
+.admin .tour-steps li { margin: 0.8rem 0; }
 `;
 
 /**
@@ -118,6 +126,7 @@ export class AdminPage {
         el('section', { 'aria-labelledby': 'upload-h' }, [el('h2', { id: 'upload-h' }, [t('admin.upload.heading')]), this.form, this.uploadStatus]),
         el('section', { 'aria-labelledby': 'jobs-h' }, [el('h2', { id: 'jobs-h' }, [t('admin.jobs.heading')]), this.jobList]),
         el('section', { 'aria-labelledby': 'models-h' }, [el('h2', { id: 'models-h' }, [t('admin.models.heading')]), this.modelList]),
+        tagSuggestions(),
       ]),
     );
     this.tokenStatus.textContent = api.savedToken() ? t('admin.token.set') : t('admin.token.none');
@@ -144,6 +153,7 @@ export class AdminPage {
       field('slug', t('admin.field.slug'), el('input', { type: 'text', name: 'slug', required: '', pattern: '[a-z0-9]([a-z0-9-]{0,62}[a-z0-9])?' })),
       field('title', t('admin.field.title'), el('input', { type: 'text', name: 'title', required: '' })),
       field('description', t('admin.field.description'), el('textarea', { name: 'description', rows: '3' })),
+      field('language', t('admin.field.language'), el('input', { ...TAG_INPUT, name: 'language' })),
       field('policy', t('admin.field.policy'), policy),
       field('colour', t('admin.field.colour'), colour),
       field('unit', t('admin.field.unit'), unit),
@@ -249,6 +259,7 @@ export class AdminPage {
             el('a', { href: `/m/${m.slug}` }, [m.title]),
             ' ',
             this.button(t('admin.versions', { slug: m.slug }), () => this.showVersions(item, m.slug, versions)),
+            this.button(t('admin.tours', { slug: m.slug }), () => this.showTours(item, m.slug)),
             versions,
           ]);
           if (open.has(m.slug)) void this.showVersions(item, m.slug, versions);
@@ -260,6 +271,24 @@ export class AdminPage {
       this.modelList.replaceChildren(el('li', { class: 'error' }, [t('admin.models.failed', { reason: messageOf(e) })]));
     }
   }
+
+  /**
+   * The model's guided tours and their editor (tours.js), under its entry;
+   * the page's refresh leaves them alone (the model list is kept while the same).
+   * @param {HTMLElement} item @param {string} slug
+   */
+  async showTours(item, slug) {
+    let editor = this.tourEditors.get(slug);
+    if (!editor) {
+      editor = new TourEditor(slug);
+      this.tourEditors.set(slug, editor);
+    }
+    if (!item.contains(editor.root)) item.append(editor.root);
+    await editor.refresh();
+  }
+
+  /** @type {Map<string, TourEditor>} */
+  tourEditors = new Map();
 
   /**
    * @param {HTMLElement} item @param {string} slug @param {HTMLElement} list
@@ -307,11 +336,48 @@ export class AdminPage {
       this.button(t('admin.version.setLevel'), () => apply({ good_enough_level: level.value === '' ? null : Number(level.value) })),
       status,
       this.rightsForm(slug, v, licences, apply),
+      this.textsToggle(slug, v.version),
     ]);
     const editing = () => entry.setAttribute('data-editing', '');
     entry.addEventListener('input', editing);
     entry.addEventListener('change', editing);
+    // An open texts editor survives the list being written again, and holds off the page's polling.
+    const texts = this.textEditors.get(`${slug}/${v.version}`);
+    if (texts) {
+      entry.append(texts.root);
+      editing();
+    }
     return entry;
+  }
+
+  /** @type {Map<string, TextsEditor>} the texts editors opened, by slug and version */
+  textEditors = new Map();
+
+  /**
+   * The button that opens (and closes) a version's texts in other languages.
+   * @param {string} slug @param {number} version
+   */
+  textsToggle(slug, version) {
+    const key = `${slug}/${version}`;
+    const toggle = this.button(t('admin.texts.open', { version: String(version) }), async () => {
+      const entry = /** @type {HTMLElement} */ (toggle.closest('li'));
+      let editor = this.textEditors.get(key);
+      if (editor) {
+        editor.root.remove();
+        this.textEditors.delete(key);
+        entry.removeAttribute('data-editing');
+        toggle.setAttribute('aria-expanded', 'false');
+        return;
+      }
+      editor = new TextsEditor(slug, version);
+      this.textEditors.set(key, editor);
+      entry.setAttribute('data-editing', '');
+      entry.append(editor.root);
+      toggle.setAttribute('aria-expanded', 'true');
+      await editor.load();
+    });
+    toggle.setAttribute('aria-expanded', String(this.textEditors.has(key)));
+    return toggle;
   }
 
   /**

@@ -8,6 +8,10 @@
  * `data-i18n*` attributes and `localise(root)` fills them, again after each
  * change of language (`onLanguageChange`).
  *
+ * A museum may put its own words in place of any message, per language,
+ * from the service's configuration (`[ui.strings.pt]` in its TOML file):
+ * `setOverrides()` takes them, and `t()` prefers them to the catalogue.
+ *
  * The rule, which `test/i18n.test.mjs` enforces: no visible text, title,
  * label or alert in web/src outside these catalogues, every key in every
  * catalogue, and no key in a catalogue that English lacks.
@@ -32,6 +36,28 @@ import pt from './pt.js';
 
 /** @type {Record<LanguageCode, Catalogue>} */
 export const CATALOGUES = { en, pt, es, fr, de, it, ar };
+
+/** The museum's own words, by language and key (strings only). @type {Partial<Record<string, Record<string, string>>>} */
+let overrides = {};
+
+/**
+ * The museum's own words in place of the catalogues' (each language a map
+ * of key to text; anything that is not text is left out), then the page
+ * written again.
+ * @param {unknown} map
+ */
+export function setOverrides(map) {
+  /** @type {Record<string, Record<string, string>>} */
+  const kept = {};
+  if (map && typeof map === 'object') {
+    for (const [code, strings] of Object.entries(map)) {
+      if (!strings || typeof strings !== 'object') continue;
+      kept[code] = Object.fromEntries(Object.entries(strings).filter(([, text]) => typeof text === 'string'));
+    }
+  }
+  overrides = kept;
+  for (const listener of listeners) listener(current);
+}
 
 /** The language the page speaks now. @type {LanguageCode} */
 let current = DEFAULT_LANGUAGE;
@@ -87,7 +113,7 @@ export function onLanguageChange(listener) {
  */
 export function t(key, params = {}) {
   const f = formatsOf(current);
-  const message = CATALOGUES[current][key] ?? en[key] ?? key;
+  const message = overrides[current]?.[key] ?? CATALOGUES[current][key] ?? en[key] ?? key;
   const text =
     typeof message === 'string'
       ? message
@@ -138,7 +164,7 @@ export function formatDate(date, { time = false } = {}) {
 }
 
 /**
- * Fills the text of markup built once from its attributes: `data-i18n`
+ * Fills the text of markup built once (the root and what is in it) from its attributes: `data-i18n`
  * (text), `data-i18n-title`, `data-i18n-label` (aria-label),
  * `data-i18n-valuetext` (aria-valuetext), `data-i18n-placeholder`.
  * @param {ParentNode} root
@@ -153,6 +179,8 @@ export function localise(root) {
     ['data-i18n-placeholder', (el, text) => el.setAttribute('placeholder', text)],
   ];
   for (const [attribute, write] of slots) {
-    for (const el of root.querySelectorAll(`[${attribute}]`)) write(/** @type {HTMLElement} */ (el), t(/** @type {string} */ (el.getAttribute(attribute))));
+    // The root itself too: a pane built on its own carries its name on its outermost element.
+    const own = 'matches' in root && /** @type {Element} */ (root).matches(`[${attribute}]`) ? [/** @type {Element} */ (root)] : [];
+    for (const el of [...own, ...root.querySelectorAll(`[${attribute}]`)]) write(/** @type {HTMLElement} */ (el), t(/** @type {string} */ (el.getAttribute(attribute))));
   }
 }

@@ -8,7 +8,7 @@
  */
 
 import { LANGUAGES, STORAGE_KEY, chooseLanguage, supportedLanguage } from './languages.js';
-import { language, setLanguage } from './index.js';
+import { language, setLanguage, setOverrides } from './index.js';
 
 let started = false;
 
@@ -21,6 +21,7 @@ let started = false;
 export function startLanguage() {
   if (started) return;
   started = true;
+  setOverrides(servedOverrides());
   setLanguage(
     chooseLanguage({
       query: new URLSearchParams(location.search).get('lang'),
@@ -28,6 +29,22 @@ export function startLanguage() {
       preferred: [document.documentElement.lang, ...(navigator.languages ?? [navigator.language])],
     }),
   );
+}
+
+/**
+ * The museum's own words, as this server writes them into its pages
+ * (`<script type="application/json" id="vitrine-ui-strings">`); none on
+ * another site's page or when the element is missing or unreadable.
+ * @returns {unknown}
+ */
+function servedOverrides() {
+  const script = typeof document === 'undefined' ? null : document.getElementById('vitrine-ui-strings');
+  if (!script?.textContent) return null;
+  try {
+    return JSON.parse(script.textContent);
+  } catch {
+    return null;
+  }
 }
 
 /** @returns {string | null} */

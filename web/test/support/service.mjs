@@ -26,6 +26,8 @@ export const webDist = join(root, 'web', 'dist');
  * @property {string} [policy] exhibition, open or researchers
  * @property {boolean} [quality] measure every level at ingest (`vitrine ingest --quality`)
  * @property {string[]} [ingestArgs] more `vitrine ingest` arguments
+ * @property {string[][]} [texts] translations set after the ingest, each a language tag and
+ *   `vitrine texts` arguments: `[['pt', '--title', 'Toro', '--credit', '…']]`
  */
 
 /**
@@ -50,6 +52,9 @@ export async function startService({ models, serveArgs = [] }) {
     if (m.quality) ingest.push('--quality');
     if (m.ingestArgs) ingest.push(...m.ingestArgs);
     execFileSync(vitrine, ingest, { stdio: 'pipe', env });
+    for (const [language, ...args] of m.texts ?? []) {
+      execFileSync(vitrine, ['texts', '--db', db, '--slug', m.slug, '--language', language, ...args], { stdio: 'pipe', env });
+    }
   }
   // Chromium on SwiftShader keeps both cores of a small machine busy, which
   // the service would read as load and answer with load caps: tests that

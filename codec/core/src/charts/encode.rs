@@ -36,14 +36,14 @@ fn chart_reduction(vertices: usize) -> usize {
 /// Vertices from which a chart counts as large ([`chart_reduction`]).
 const LARGE_CHART: usize = 50_000;
 
-/// A chart after its fine layers.
-struct ChartLayers {
+/// A chart after its layers.
+pub(super) struct ChartLayers {
     /// Input vertex of each chart vertex (the chart's simplification input).
-    vertices: Vec<u32>,
+    pub vertices: Vec<u32>,
     /// Its coarse faces, in input vertex ids.
-    coarse: Vec<[u32; 3]>,
+    pub coarse: Vec<[u32; 3]>,
     /// Finest first.
-    layers: Vec<Layer>,
+    pub layers: Vec<Layer>,
 }
 
 /// Encodes a checked, quantized mesh as a charted stream of `charts`
@@ -99,6 +99,7 @@ pub(crate) fn encode_charted(
                 quantization,
                 options,
                 guard,
+                chart_reduction,
                 &mut scratch,
             )
         })
@@ -192,25 +193,63 @@ pub(crate) fn encode_charted(
         })
         .collect();
 
-    let mut vertex_order: Vec<u32> = plain
-        .vertex_order
-        .iter()
-        .map(|&c| coarse_vertices[c as usize])
-        .collect();
-    let mut levels = plain.levels;
-    let mut bytes = plain.chunks;
-    let mut vertices = level_vertices;
-    let mut face_count = faces.len();
+    let mut tail = Tail {
+        vertex_order: plain
+            .vertex_order
+            .iter()
+            .map(|&c| coarse_vertices[c as usize])
+            .collect(),
+        levels: plain.levels,
+        bytes: plain.chunks,
+        vertices: level_vertices,
+        faces: faces.len(),
+    };
     for j in 0..fine_levels {
         let mut payload = Vec::new();
         write_varint(&mut payload, charts as u32);
         if j == 0 {
             write_section(&mut payload, &labels_bytes);
         }
+        // A chart with fewer layers than the deepest sits out the coarsest levels.
+        let parts = fine.iter().zip(&chart_ids).map(|(chart, ids)| {
+            let layer = chart.layers.get(fine_levels - 1 - j);
+            (layer, chart.vertices.as_slice(), ids.as_slice())
+        });
+        tail.parted_batch(payload, CHARTED_VERSION, parts);
+    }
+    Ok(Some(tail.finish(
+        CHARTED_VERSION,
+        colours.is_some(),
+        quantization,
+    )))
+}
+
+/// A charted stream after its global batches, as the parted batches are
+/// appended to it.
+pub(super) struct Tail {
+    pub levels: Vec<LevelInfo>,
+    pub bytes: Vec<u8>,
+    /// The input vertex of each stream vertex, in stream order.
+    pub vertex_order: Vec<u32>,
+    /// Vertices and faces of the last level.
+    pub vertices: usize,
+    pub faces: usize,
+}
+
+impl Tail {
+    /// Appends a parted batch of `version` whose payload so far is
+    /// `payload` (its head), then each chart's part: its layer's two passes
+    /// in the chart's ids, or an empty part where the chart has no layer in
+    /// this batch. Each chart comes with its vertices' input ids and its ids.
+    pub(super) fn parted_batch<'a>(
+        &mut self,
+        mut payload: Vec<u8>,
+        version: u8,
+        charts: impl Iterator<Item = (Option<&'a Layer>, &'a [u32], &'a [u32])>,
+    ) {
         let mut added = 0;
-        for (chart, ids) in fine.iter().zip(&chart_ids) {
-            // A chart with fewer layers than the deepest sits out the coarsest levels.
-            let Some(layer) = chart.layers.get(fine_levels - 1 - j) else {
+        for (layer, vertices, ids) in charts {
+            let Some(layer) = layer else {
                 write_varint(&mut payload, 0);
                 continue;
             };
@@ -224,51 +263,61 @@ pub(crate) fn encode_charted(
                 .iter()
                 .chain(&layer.decimating.removed)
             {
-                vertex_order.push(chart.vertices[v as usize]);
+                self.vertex_order.push(vertices[v as usize]);
             }
             added += layer.cleaning.removed.len() + layer.decimating.removed.len();
         }
         let mut chunk = Vec::new();
         ChunkHeader {
             tag: PARTED_TAG,
-            version: CHARTED_VERSION,
-            level: levels.len() as u16,
-            vertices_before: vertices as u32,
-            vertices_after: (vertices + added) as u32,
-            faces_after: (face_count + 2 * added) as u32,
+            version,
+            level: self.levels.len() as u16,
+            vertices_before: self.vertices as u32,
+            vertices_after: (self.vertices + added) as u32,
+            faces_after: (self.faces + 2 * added) as u32,
             payload_len: payload.len() as u32,
         }
         .write(&mut chunk);
         chunk.extend_from_slice(&payload);
-        vertices += added;
-        face_count += 2 * added;
-        levels.push(LevelInfo {
-            vertices: vertices as u32,
-            faces: face_count as u32,
+        self.vertices += added;
+        self.faces += 2 * added;
+        self.levels.push(LevelInfo {
+            vertices: self.vertices as u32,
+            faces: self.faces as u32,
             bytes: chunk.len() as u32,
         });
-        bytes.extend_from_slice(&chunk);
+        self.bytes.extend_from_slice(&chunk);
     }
-    let header = Header {
-        version: CHARTED_VERSION,
-        has_colour: colours.is_some(),
-        quantization,
-        levels,
-    };
-    let mut stream = Vec::with_capacity(header.byte_len() + bytes.len());
-    header.write(&mut stream);
-    stream.extend_from_slice(&bytes);
-    Ok(Some(Encoded {
-        bytes: stream,
-        vertex_order,
-        header,
-    }))
+
+    /// The stream: its header, then every chunk.
+    pub(super) fn finish(
+        self,
+        version: u8,
+        has_colour: bool,
+        quantization: Quantization,
+    ) -> Encoded {
+        let header = Header {
+            version,
+            has_colour,
+            quantization,
+            levels: self.levels,
+        };
+        let mut stream = Vec::with_capacity(header.byte_len() + self.bytes.len());
+        header.write(&mut stream);
+        stream.extend_from_slice(&self.bytes);
+        Encoded {
+            bytes: stream,
+            vertex_order: self.vertex_order,
+            header,
+        }
+    }
 }
 
-/// Simplifies one chart (its faces in input ids) with its cut edges as
-/// borders; `scratch` is all `NONE` on entry and on return.
+/// Simplifies one chart (its faces in input ids) with the vertices `shared`
+/// marks (its cut) as borders, down to 1/`reduction(its vertices)` of its
+/// vertices; `scratch` is all `NONE` on entry and on return.
 #[allow(clippy::too_many_arguments)]
-fn chart_layers(
+pub(super) fn chart_layers(
     faces: &[[u32; 3]],
     shared: &[bool],
     positions: &[[i32; 3]],
@@ -276,6 +325,7 @@ fn chart_layers(
     quantization: Quantization,
     options: &EncodeOptions,
     guard: Option<&dyn PatchGuard>,
+    reduction: impl Fn(usize) -> usize,
     scratch: &mut [u32],
 ) -> Result<ChartLayers> {
     let mut vertices = Vec::new();
@@ -314,7 +364,7 @@ fn chart_layers(
         },
         vertices.iter().map(|&v| shared[v as usize]).collect(),
         options,
-        vertices.len() / chart_reduction(vertices.len()),
+        vertices.len() / reduction(vertices.len()),
         guard,
         |e| e,
         |_| {},

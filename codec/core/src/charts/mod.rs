@@ -16,6 +16,7 @@
 
 pub(crate) mod encode;
 mod labels;
+pub(crate) mod nested;
 mod partition;
 
 pub(crate) use labels::{decode_labels, encode_labels};

@@ -6,7 +6,9 @@ use std::ops::Range;
 
 use super::conquest::{PassInput, Scratch};
 use super::{read_pass, Level};
-use crate::charts::{canonical_level, chart_connectivity, cut, decode_labels, CanonicalLevel};
+use crate::charts::{
+    canonical_level, chart_connectivity, cut, decode_labels, CanonicalLevel, MAX_CHARTS,
+};
 use crate::format::Reader;
 use crate::gates::PassKind;
 use crate::room::{self, Growth};
@@ -25,9 +27,11 @@ pub(super) struct Charted {
     ranges: Vec<Range<usize>>,
     /// The decoder refines only some charts: `owned` and `ranges` hold theirs.
     some: bool,
+    /// A nested stream's phase (format 6): how many splits made the charts.
+    phase: usize,
 }
 
-struct Chart {
+pub(super) struct Chart {
     level: Level,
     scratch: Scratch,
     /// The level's id of each chart vertex.
@@ -48,8 +52,10 @@ pub struct ChartLevel<'a> {
     /// The chart's triangles, three chart vertex ids each.
     pub indices: &'a [u32],
     /// The same triangles in the level's vertex ids (empty for a chart the
-    /// decoder leaves to others).
+    /// decoder leaves to others, and in a [`crate::ChartView`]).
     pub level_indices: &'a [u32],
+    /// Quantized positions per chart vertex: exactly the encoder's input.
+    pub quantized: &'a [[i32; 3]],
     /// The chart's vertices before the last batch: the ones from here on
     /// are that batch's insertions, in order, and their level ids follow
     /// each other (those of earlier charts' insertions before them).
@@ -103,6 +109,7 @@ impl Charted {
             owned: Vec::new(),
             ranges: vec![0..0; count],
             some: false,
+            phase: 0,
         })
     }
 
@@ -118,6 +125,58 @@ impl Charted {
         })
     }
 
+    pub(super) fn phase(&self) -> usize {
+        self.phase
+    }
+
+    /// Splits every chart into the children `head` declares (format 6,
+    /// the first parted batch of a phase): for each chart in order, its
+    /// child count, and when over 1 the children's labels over its faces
+    /// in canonical order; `charts` children in all. A chart of one child
+    /// stays as it is. The merged level is not changed.
+    pub(super) fn split(&mut self, head: &[u8], charts: usize) -> Result<()> {
+        let mut r = Reader::new(head);
+        let mut children = Vec::with_capacity(charts.min(8 * self.charts.len()));
+        for parent in std::mem::take(&mut self.charts) {
+            let count = r.varint()? as usize;
+            if count == 0 || count > MAX_CHARTS || children.len() + count > charts {
+                return Err(Error::stream(format!(
+                    "a chart split into {count} children (of {charts} in the phase)"
+                )));
+            }
+            if count == 1 {
+                // The chart goes on as it is (not copied).
+                children.push(Chart {
+                    before_last: parent.level.vertex_count(),
+                    ..parent
+                });
+                continue;
+            }
+            for mut child in parent.children(count, r.section()?)? {
+                child.global = child
+                    .global
+                    .iter()
+                    .map(|&v| parent.global[v as usize])
+                    .collect();
+                children.push(child);
+            }
+        }
+        if children.len() != charts || r.remaining() != 0 {
+            return Err(Error::stream(
+                "a split declares a different number of charts than its batch",
+            ));
+        }
+        self.ranges = vec![0..0; charts];
+        self.charts = children;
+        self.phase += 1;
+        Ok(())
+    }
+
+    /// The charts, for a view that keeps them itself.
+    pub(super) fn into_charts(self) -> Vec<Chart> {
+        self.charts
+    }
+
     pub(super) fn chart_count(&self) -> usize {
         self.charts.len()
     }
@@ -129,6 +188,7 @@ impl Charted {
             positions: c.level.positions.as_flattened(),
             colours: c.level.colours.as_ref().map(|c| c.as_flattened()),
             indices: &c.level.conn.origin,
+            quantized: &c.level.positions_q,
             level_indices: if self.some {
                 &self.owned[range]
             } else {
@@ -239,6 +299,72 @@ impl Charted {
     }
 }
 
+/// Chart by chart, for a decoder whose charts refine each to its own depth
+/// ([`crate::ChartView`]).
+impl Charted {
+    /// Chart `k`'s vertices now.
+    pub(super) fn chart_vertices(&self, k: usize) -> usize {
+        self.charts[k].level.vertex_count()
+    }
+
+    /// The ids, in the level where charts begin, of chart `k`'s first
+    /// vertices (those the cut gave it); the rest are its own insertions.
+    pub(super) fn cut_ids(&self, k: usize) -> &[u32] {
+        &self.charts[k].global
+    }
+
+    /// Chart `k` in its own ids alone (no level ids: a view decoder's).
+    pub(super) fn view_chart(&self, k: usize) -> Option<ChartLevel<'_>> {
+        let c = self.charts.get(k)?;
+        Some(ChartLevel {
+            positions: c.level.positions.as_flattened(),
+            colours: c.level.colours.as_ref().map(|c| c.as_flattened()),
+            indices: &c.level.conn.origin,
+            quantized: &c.level.positions_q,
+            level_indices: &[],
+            new_from: c.before_last,
+        })
+    }
+
+    /// Applies chart `k`'s next part alone.
+    pub(super) fn apply_one(&mut self, k: usize, part: Part<'_>, growth: Growth) -> Result<()> {
+        self.charts[k].apply(part, growth)
+    }
+
+    /// A copy of every chart as it is now (the cut), to go back to.
+    pub(super) fn seeds(&self) -> Vec<ChartSeed> {
+        self.charts
+            .iter()
+            .map(|c| ChartSeed {
+                level: c.level.clone(),
+                global: c.global.clone(),
+            })
+            .collect()
+    }
+
+    /// Puts chart `k` back where `seed` left it, freeing what it had grown.
+    pub(super) fn restore(&mut self, k: usize, seed: &ChartSeed) {
+        self.charts[k] = Chart {
+            level: seed.level.clone(),
+            scratch: Scratch::default(),
+            global: seed.global.clone(),
+            before_last: seed.global.len(),
+        };
+    }
+}
+
+/// A chart as the cut made it: what a view decoder goes back to.
+pub(super) struct ChartSeed {
+    level: Level,
+    global: Vec<u32>,
+}
+
+impl ChartSeed {
+    pub(super) fn vertices(&self) -> usize {
+        self.level.vertex_count()
+    }
+}
+
 /// A level's faces and their charts, decoded before the cut (to tell the
 /// charts' sizes) and kept so the cut need not decode them again.
 pub(super) struct Labelled {
@@ -272,6 +398,67 @@ fn labelled_faces(
 }
 
 impl Chart {
+    /// The `count` children this chart splits into by `labels` (the coded
+    /// labels of its faces in canonical order; unused for one child, which
+    /// is the chart as it is), each with its vertices' ids in this chart
+    /// as its `global`.
+    pub(super) fn children(&self, count: usize, labels: &[u8]) -> Result<Vec<Chart>> {
+        if count == 1 {
+            let n = self.level.vertex_count();
+            return Ok(vec![Chart {
+                level: self.level.clone(),
+                scratch: Scratch::default(),
+                global: (0..n as u32).collect(),
+                before_last: n,
+            }]);
+        }
+        let canonical = canonical_level(&self.level.conn)?;
+        let labels = decode_labels(labels, &canonical.adjacency, count)?;
+        let cuts = cut(canonical.faces(), &labels, count, self.level.vertex_count());
+        let pick = |v: &u32| *v as usize;
+        let level = &self.level;
+        Ok(chart_connectivity(cuts, &labels, &canonical.adjacency)
+            .map_err(|e| Error::stream(format!("a chart is not a manifold: {e}")))?
+            .into_iter()
+            .map(|(global, conn)| Chart {
+                level: Level {
+                    conn,
+                    quantization: level.quantization,
+                    positions_q: global.iter().map(|v| level.positions_q[pick(v)]).collect(),
+                    positions: global.iter().map(|v| level.positions[pick(v)]).collect(),
+                    colours: level
+                        .colours
+                        .as_ref()
+                        .map(|colours| global.iter().map(|v| colours[pick(v)]).collect()),
+                },
+                scratch: Scratch::default(),
+                before_last: global.len(),
+                global,
+            })
+            .collect())
+    }
+
+    /// The chart as a view shows it (no level ids).
+    pub(super) fn view_level(&self) -> ChartLevel<'_> {
+        ChartLevel {
+            positions: self.level.positions.as_flattened(),
+            colours: self.level.colours.as_ref().map(|c| c.as_flattened()),
+            indices: &self.level.conn.origin,
+            quantized: &self.level.positions_q,
+            level_indices: &[],
+            new_from: self.before_last,
+        }
+    }
+
+    pub(super) fn vertex_count(&self) -> usize {
+        self.level.vertex_count()
+    }
+
+    /// The ids of the chart's first vertices where it was cut from.
+    pub(super) fn first_ids(&self) -> &[u32] {
+        &self.global
+    }
+
     /// Appends the chart's triangles in level ids to `out`; where they are.
     fn append_level_triangles(&self, out: &mut Vec<u32>) -> Range<usize> {
         let start = out.len();
@@ -285,7 +472,7 @@ impl Chart {
         start..out.len()
     }
 
-    fn apply(&mut self, part: Part<'_>, growth: Growth) -> Result<()> {
+    pub(super) fn apply(&mut self, part: Part<'_>, growth: Growth) -> Result<()> {
         self.before_last = self.level.vertex_count();
         let Some((cleaning, decimating, bytes)) = part else {
             return Ok(());

@@ -2,11 +2,15 @@
 
 mod charted;
 mod conquest;
+mod nested_view;
+mod view;
 
 use crate::base_mesh;
+use crate::charts::nested::MAX_PHASE_CHARTS;
 use crate::charts::MAX_CHARTS;
 use crate::format::{
-    ChunkHeader, Header, LevelInfo, Reader, BASE_TAG, BATCH_TAG, CHARTED_VERSION, PARTED_TAG,
+    ChunkHeader, Header, LevelInfo, Reader, BASE_TAG, BATCH_TAG, CHARTED_VERSION, NESTED_VERSION,
+    PARTED_TAG,
 };
 use crate::gates::{GateStatistics, PassKind};
 use crate::halfedge::Connectivity;
@@ -16,6 +20,8 @@ use crate::{Error, IndexedMesh, Result};
 pub use charted::ChartLevel;
 use charted::{read_part, Charted, Labelled};
 use conquest::{PassInput, Scratch};
+pub use nested_view::NestedView;
+pub use view::ChartView;
 
 /// Budget a decoder enforces before it allocates or grows anything.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -36,6 +42,7 @@ impl Default for Limits {
 }
 
 /// The mesh at the current level, kept as GPU-ready buffers.
+#[derive(Clone)]
 pub(crate) struct Level {
     pub conn: Connectivity,
     pub quantization: Quantization,
@@ -231,7 +238,7 @@ impl Decoder {
             return Err(version_mismatch(chunk.version, self.header.version));
         }
         let parted = chunk.tag == PARTED_TAG;
-        if parted && self.header.version != CHARTED_VERSION {
+        if parted && self.header.version < CHARTED_VERSION {
             return Err(Error::stream(format!(
                 "a parted batch in a version {} stream",
                 self.header.version
@@ -264,6 +271,9 @@ impl Decoder {
             return self.apply_parted(payload, info, (n, faces_now), expected);
         }
         let mut r = Reader::new(payload);
+        if self.header.version >= NESTED_VERSION {
+            read_precision(&mut r)?;
+        }
         let cleaning = read_pass(&mut r, PassKind::Cleaning)?;
         let decimating = read_pass(&mut r, PassKind::Decimating)?;
         if r.remaining() != 0 {
@@ -320,9 +330,11 @@ impl Decoder {
 
     /// The charts are cut and this decoder leaves some of them to others.
     fn refines_some(&self) -> bool {
-        self.charted
-            .as_ref()
-            .is_some_and(|c| (0..c.chart_count()).any(|k| self.refined & (1 << k) == 0))
+        self.header.version == CHARTED_VERSION
+            && self
+                .charted
+                .as_ref()
+                .is_some_and(|c| (0..c.chart_count()).any(|k| self.refined & (1 << k) == 0))
     }
 
     /// A parted batch (format 5): every chart's part, the charts cut first
@@ -336,6 +348,9 @@ impl Decoder {
         expected: usize,
     ) -> Result<()> {
         let mut r = Reader::new(payload);
+        if self.header.version >= NESTED_VERSION {
+            return self.apply_nested(r, info, now, expected);
+        }
         let charts = read_chart_count(&mut r)?;
         let cut = match &self.charted {
             Some(c) if c.chart_count() != charts => {
@@ -410,11 +425,98 @@ impl Decoder {
         Ok(())
     }
 
+    /// A parted batch of a nested stream (format 6), `r` just past its
+    /// chunk header: the phase's charts cut (phase 0) or split from the
+    /// previous phase's when this batch begins a phase, then every chart's
+    /// part; its counts are checked already (`now`: before it).
+    fn apply_nested(
+        &mut self,
+        mut r: Reader,
+        info: LevelInfo,
+        now: (usize, usize),
+        expected: usize,
+    ) -> Result<()> {
+        read_precision(&mut r)?;
+        let phase = r.varint()? as usize;
+        let charts = r.varint()? as usize;
+        if !(1..=MAX_PHASE_CHARTS).contains(&charts) {
+            return Err(Error::stream(format!("{charts} charts is out of range")));
+        }
+        let current = self.charted.as_ref().map(Charted::phase);
+        let begins = match current {
+            None if phase == 0 => true,
+            Some(p) if p == phase => false,
+            Some(p) if p + 1 == phase => true,
+            _ => {
+                return Err(Error::stream(format!(
+                    "a parted batch of phase {phase} after phase {current:?}"
+                )))
+            }
+        };
+        if !begins && self.chart_count() != charts {
+            return Err(Error::stream("a parted batch changes the number of charts"));
+        }
+        let head = if begins { Some(r.section()?) } else { None };
+        let mut parts = Vec::with_capacity(charts.min(r.remaining()));
+        for _ in 0..charts {
+            parts.push(read_part(r.section()?)?);
+        }
+        if r.remaining() != 0 {
+            return Err(Error::stream("trailing bytes after the batch's parts"));
+        }
+        let added: u64 = parts
+            .iter()
+            .flatten()
+            .map(|(c, d, _)| c.inserted as u64 + d.inserted as u64)
+            .sum();
+        if added != (info.vertices as usize - now.0) as u64 {
+            return Err(Error::stream(
+                "parts insert a different number of vertices than the batch",
+            ));
+        }
+        if info.faces as u64 != now.1 as u64 + 2 * added {
+            return Err(Error::stream(
+                "level table's face count disagrees with the batch",
+            ));
+        }
+        match (head, &mut self.charted) {
+            (Some(labels), None) => {
+                let c = Charted::cut(&self.level, labels, charts, None)?;
+                self.charted = Some(c);
+                // The charts hold the connectivity from now on.
+                self.level.conn = Connectivity {
+                    origin: Vec::new(),
+                    twin: Vec::new(),
+                    out: Vec::new(),
+                };
+            }
+            (Some(head), Some(c)) => {
+                if let Err(e) = c.split(head, charts) {
+                    self.broken = true;
+                    return Err(e);
+                }
+            }
+            (None, _) => {}
+        }
+        let growth = self.growth(now.0);
+        let charted = self.charted.as_mut().expect("cut above");
+        if let Err(e) = charted.apply(parts, growth, self.threads) {
+            self.broken = true;
+            return Err(e);
+        }
+        charted.merge(&mut self.level, growth);
+        self.applied = expected;
+        Ok(())
+    }
+
     /// The faces of each chart that a charted stream's first parted batch
     /// (`chunk_bytes`, not applied yet) will cut this level into: how a
     /// pool shares the charts out before any member applies it. The level
     /// is not changed; the labels decoded are kept for the cut.
     pub fn chart_sizes(&mut self, chunk_bytes: &[u8]) -> Result<Vec<usize>> {
+        if self.header.version != CHARTED_VERSION {
+            return Err(nested_pool_refused(self.header.version));
+        }
         if self.charted.is_some() {
             return Err(Error::stream("the charts are cut already"));
         }
@@ -445,6 +547,9 @@ impl Decoder {
     /// tells how big each chart will be before the first parted batch. Once
     /// it refines only some charts, the choice is final.
     pub fn refine_only(&mut self, charts: u64) -> Result<()> {
+        if self.header.version != CHARTED_VERSION {
+            return Err(nested_pool_refused(self.header.version));
+        }
         if self.refines_some() {
             return Err(Error::stream(
                 "this decoder refines some charts already: the choice is final",
@@ -518,6 +623,26 @@ impl Decoder {
     }
 }
 
+/// Why a pool member cannot take a share of a stream's charts: only
+/// version 5's flat charts are shared out (a nested stream's, version 6,
+/// are not yet; decode it on one worker).
+fn nested_pool_refused(version: u8) -> Error {
+    Error::stream(format!(
+        "sharing charts among decoders needs a version {CHARTED_VERSION} stream, not version {version}: decode it on one worker"
+    ))
+}
+
+/// A version 6 batch payload's first byte, the tangential step exponent
+/// of deferred precision (FORMAT.md): this build decodes only 0, exact.
+pub(crate) fn read_precision(r: &mut Reader) -> Result<()> {
+    match r.u8()? {
+        0 => Ok(()),
+        e => Err(Error::stream(format!(
+            "deferred precision is not decoded by this build (tangential step exponent {e})"
+        ))),
+    }
+}
+
 fn version_mismatch(chunk: u8, stream: u8) -> Error {
     Error::stream(format!(
         "chunk version mismatch: a version {chunk} chunk in a version {stream} stream"
@@ -525,7 +650,7 @@ fn version_mismatch(chunk: u8, stream: u8) -> Error {
 }
 
 /// A parted batch's payload begins with its number of charts.
-fn read_chart_count(r: &mut Reader) -> Result<usize> {
+pub(crate) fn read_chart_count(r: &mut Reader) -> Result<usize> {
     let charts = r.varint()? as usize;
     if !(2..=MAX_CHARTS).contains(&charts) {
         return Err(Error::stream(format!("{charts} charts is out of range")));

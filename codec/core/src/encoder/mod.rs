@@ -6,7 +6,8 @@ mod locality;
 
 use crate::base_mesh::{self, BaseMesh};
 use crate::format::{
-    write_section, write_varint, ChunkHeader, Header, LevelInfo, BASE_TAG, BATCH_TAG, VERSION,
+    write_section, write_varint, ChunkHeader, Header, LevelInfo, BASE_TAG, BATCH_TAG,
+    NESTED_VERSION, VERSION,
 };
 use crate::halfedge::{check_indices, connectivity, Connectivity};
 use crate::patch::MAX_VALENCE;
@@ -65,6 +66,13 @@ pub enum Charts {
     PerVertices(u32),
     /// This many charts (2..=64, fewer when the mesh has fewer faces).
     Count(u32),
+    /// Nested charts (format 6): a tree of charts whose shape follows the
+    /// mesh's size ([`crate::NestedShape::for_vertices`]), so that the
+    /// bytes before any chart's own part are a small global mesh.
+    Nested,
+    /// Nested charts of a given shape: `top` charts (2..=64), each split
+    /// into `fanout` children (1..=64) at each of `phases − 1` splits.
+    NestedShape { top: u8, fanout: u8, phases: u8 },
 }
 
 impl Charts {
@@ -94,6 +102,8 @@ impl Charts {
                 (vertices / per.max(1) as usize).min(crate::charts::MAX_CHARTS)
             }
             Charts::Count(k) => (k as usize).min(crate::charts::MAX_CHARTS),
+            // Not flat charts: [`Charts::Nested`] has its own shape.
+            Charts::Nested | Charts::NestedShape { .. } => 1,
         }
     }
 }
@@ -271,6 +281,46 @@ fn encode_guarded(
         BaseTarget::Fraction(f) => (mesh.positions.len() as f64 * f as f64) as usize,
     }
     .max(options.min_base_vertices as usize);
+    let shape = match options.charts {
+        Charts::Nested => Some(crate::charts::nested::Shape::for_vertices(
+            mesh.positions.len(),
+        )),
+        Charts::NestedShape {
+            top,
+            fanout,
+            phases,
+        } => Some(crate::charts::nested::Shape::new(
+            top.into(),
+            fanout.into(),
+            phases.into(),
+        )?),
+        _ => None,
+    };
+    if let Some(shape) = shape {
+        let nested = crate::charts::nested::encode_nested(
+            &positions,
+            &mesh.triangles,
+            mesh.colors.as_deref(),
+            quantization,
+            options,
+            shape,
+            target,
+            guard,
+            |e| connectivity(mesh).err().unwrap_or(e),
+        )?;
+        if let Some(encoded) = nested {
+            return Ok(encoded);
+        }
+        return plain(
+            mesh,
+            &positions,
+            quantization,
+            options,
+            target,
+            guard,
+            progress,
+        );
+    }
     let charts = options.charts.count(mesh.positions.len());
     if charts >= 2 {
         let charted = crate::charts::encode::encode_charted(
@@ -593,6 +643,10 @@ pub(crate) fn batch_chunks(
     let mut faces = base_faces;
     for (i, layer) in layers.iter().rev().enumerate() {
         let mut payload = Vec::new();
+        if version >= NESTED_VERSION {
+            // The tangential step exponent: 0, exact (FORMAT.md, "Deferred precision").
+            payload.push(0);
+        }
         write_pass(&mut payload, &layer.cleaning, new_id);
         write_pass(&mut payload, &layer.decimating, new_id);
         let added = layer.cleaning.removed.len() + layer.decimating.removed.len();

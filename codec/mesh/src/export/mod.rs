@@ -7,6 +7,7 @@ use std::io::Write;
 
 mod lod_glb;
 pub mod md2;
+mod md2_repair;
 mod md2_sample;
 mod normal_table;
 

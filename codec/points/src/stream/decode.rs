@@ -6,6 +6,7 @@ use vitrine_codec::{Error, Result};
 use super::attr::octahedral_decode;
 use super::format::{read_chunk, PointHeader};
 use super::models::{root_prediction, Attr, Models};
+use super::neighbourhood::Neighbourhood;
 use crate::PointCloud;
 
 /// Budgets for decoding untrusted streams.
@@ -42,6 +43,7 @@ struct Cell {
 pub struct PointDecoder {
     header: PointHeader,
     models: Models,
+    neighbourhood: Neighbourhood,
     level: usize,
     depth: u8,
     cells: Vec<Cell>,
@@ -78,6 +80,7 @@ impl PointDecoder {
         Ok(PointDecoder {
             header,
             models,
+            neighbourhood: Neighbourhood::default(),
             level: 0,
             depth: 0,
             cells: Vec::new(),
@@ -199,9 +202,22 @@ impl PointDecoder {
         while self.depth < last {
             let cells = std::mem::take(&mut self.cells);
             let mut next = Vec::with_capacity(cells.len().min(count as usize));
+            let v2 = self.header.version >= 2;
+            if v2 {
+                let depth = u32::from(self.depth);
+                self.neighbourhood
+                    .start_depth(depth, depth + 1 == u32::from(self.header.bits));
+            }
             for cell in &cells {
                 dec.check_overrun()?;
-                let mask = self.models.decode_mask(&mut dec, cell.class);
+                let mask = if v2 {
+                    let around = self.neighbourhood.around(cell.at);
+                    let mask = self.models.decode_mask_v2(&mut dec, &around, cell.class);
+                    self.neighbourhood.record(mask);
+                    mask
+                } else {
+                    self.models.decode_mask(&mut dec, cell.class)
+                };
                 let class = (mask.count_ones() - 1) as u8;
                 let mut first = true;
                 for k in 0..8u32 {

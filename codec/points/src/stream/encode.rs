@@ -4,8 +4,10 @@ use vitrine_codec::entropy::RangeEncoder;
 use vitrine_codec::{Error, Result};
 
 use super::attr::octahedral_encode;
-use super::format::{PointHeader, MAX_BITS};
+use super::context::morton;
+use super::format::{PointHeader, MAX_BITS, VERSION, VERSIONS};
 use super::models::{root_prediction, Attr, Models};
+use super::neighbourhood::Neighbourhood;
 use crate::PointCloud;
 
 /// How to encode.
@@ -22,6 +24,8 @@ pub struct EncodeOptions {
     pub normals: bool,
     /// Code the cloud's colours, when it has them.
     pub colours: bool,
+    /// Stream format version to write (1 or 2; 2 codes positions smaller).
+    pub version: u8,
 }
 
 impl Default for EncodeOptions {
@@ -32,6 +36,7 @@ impl Default for EncodeOptions {
             base_points: 4096,
             normals: true,
             colours: true,
+            version: VERSION,
         }
     }
 }
@@ -51,20 +56,6 @@ pub struct EncodedPoints {
     pub quantized: Vec<[u32; 3]>,
     /// Octahedral normals in stream order, when coded.
     pub normals: Option<Vec<[u16; 2]>>,
-}
-
-/// Morton key: x, y, z bits interleaved, x lowest.
-pub(crate) fn morton(q: [u32; 3]) -> u64 {
-    fn spread(v: u32) -> u64 {
-        let mut x = u64::from(v) & 0x1F_FFFF;
-        x = (x | x << 32) & 0x1F_0000_0000_FFFF;
-        x = (x | x << 16) & 0x1F_0000_FF00_00FF;
-        x = (x | x << 8) & 0x100F_00F0_0F00_F00F;
-        x = (x | x << 4) & 0x10C3_0C30_C30C_30C3;
-        x = (x | x << 2) & 0x1249_2492_4924_9249;
-        x
-    }
-    spread(q[0]) | spread(q[1]) << 1 | spread(q[2]) << 2
 }
 
 /// Quantization of a cloud's positions: the bounding cube's corner and the
@@ -96,6 +87,8 @@ fn level_depths(cells: &[usize], base_points: usize) -> Vec<u8> {
 }
 
 struct Cell {
+    /// Coordinates at the current depth.
+    at: [u32; 3],
     start: u32,
     end: u32,
     /// Parent's child count − 1.
@@ -124,6 +117,14 @@ pub fn encode(cloud: &PointCloud, opts: &EncodeOptions) -> Result<EncodedPoints>
         return Err(Error::Parameter(format!(
             "normal bits {} outside 4..=15",
             opts.normal_bits
+        )));
+    }
+    if !VERSIONS.contains(&opts.version) {
+        return Err(Error::Parameter(format!(
+            "point stream version {} (this encoder writes {} to {})",
+            opts.version,
+            VERSIONS.start(),
+            VERSIONS.end()
         )));
     }
     let bits = opts.bits;
@@ -162,6 +163,7 @@ pub fn encode(cloud: &PointCloud, opts: &EncodeOptions) -> Result<EncodedPoints>
         })
         .collect();
     let header = PointHeader {
+        version: opts.version,
         bits,
         normal_bits,
         has_colours: colours.is_some(),
@@ -175,7 +177,9 @@ pub fn encode(cloud: &PointCloud, opts: &EncodeOptions) -> Result<EncodedPoints>
     header.write(&mut bytes);
     let mut models = Models::new(normals.is_some(), colours.is_some());
     let mut order: Vec<u32> = Vec::with_capacity(n);
+    let mut neighbourhood = Neighbourhood::default();
     let mut cells = vec![Cell {
+        at: [0; 3],
         start: 0,
         end: n32,
         class: 7,
@@ -193,6 +197,9 @@ pub fn encode(cloud: &PointCloud, opts: &EncodeOptions) -> Result<EncodedPoints>
         while depth < u32::from(last) {
             let shift = 3 * (b - depth - 1);
             let mut next = Vec::with_capacity(cells.len() * 2);
+            if header.version >= 2 {
+                neighbourhood.start_depth(depth, depth + 1 == b);
+            }
             for cell in &cells {
                 let parent_rep = sorted[cell.start as usize].1;
                 let mut mask = 0u8;
@@ -208,7 +215,13 @@ pub fn encode(cloud: &PointCloud, opts: &EncodeOptions) -> Result<EncodedPoints>
                     children[k] = (s, e);
                     s = e;
                 }
-                models.encode_mask(&mut enc, cell.class, mask);
+                if header.version >= 2 {
+                    let around = neighbourhood.around(cell.at);
+                    models.encode_mask_v2(&mut enc, &around, cell.class, mask);
+                    neighbourhood.record(mask);
+                } else {
+                    models.encode_mask(&mut enc, cell.class, mask);
+                }
                 let class = (mask.count_ones() - 1) as u8;
                 let mut first = true;
                 for (k, &(s, e)) in children.iter().enumerate() {
@@ -222,7 +235,9 @@ pub fn encode(cloud: &PointCloud, opts: &EncodeOptions) -> Result<EncodedPoints>
                         models.encode_attr(&mut enc, a, p);
                     }
                     first = false;
+                    let k = k as u32;
                     next.push(Cell {
+                        at: [0, 1, 2].map(|a| cell.at[a] * 2 + ((k >> a) & 1)),
                         start: s,
                         end: e,
                         class,

@@ -2,7 +2,9 @@
 //!
 //! Positions are quantized to a cube of 2^bits cells per axis and coded as an
 //! octree in level order: each occupied cell's 8-bit child-occupancy mask,
-//! range-coded with adaptive models chosen by the parent's occupancy. Every
+//! range-coded with adaptive models chosen by the occupied neighbours the
+//! decoder already knows (version 2, `context.rs`) or, in version 1 streams
+//! and where no neighbour is occupied, by the parent's occupancy. Every
 //! occupied cell has a representative point; a cell's first occupied child
 //! keeps it and the others bring one new point each, so the points ordered
 //! by the depth at which they appear put one point per occupied cell of
@@ -16,12 +18,15 @@
 //! bit, in the stream's order.
 
 mod attr;
+mod context;
 mod decode;
 mod encode;
 mod format;
 mod models;
+mod neighbourhood;
+mod region;
 
 pub use attr::{octahedral_decode, octahedral_encode};
 pub use decode::{decode, DecodedPoints, Limits, PointDecoder};
 pub use encode::{encode, EncodeOptions, EncodedPoints};
-pub use format::{split, PointHeader, MAGIC, VERSION};
+pub use format::{split, PointHeader, MAGIC, VERSION, VERSIONS};

@@ -4,6 +4,7 @@
 use vitrine_codec::entropy::{BitModel, IntModel, RangeDecoder, RangeEncoder};
 
 use super::attr::{colour_apply, colour_residual};
+use super::context::{Around, CODED, CONTEXTS};
 
 /// Occupancy contexts: the parent's child count (1..=8) minus one.
 const PARENT_CLASSES: usize = 8;
@@ -32,6 +33,8 @@ pub(crate) struct Models {
     /// `PARENT_CLASSES` trees of 256 nodes: the mask's bits, lowest child
     /// first, each conditioned on the bits before it.
     occupancy: Vec<BitModel>,
+    /// Version 2: one model per neighbour context (`context.rs`).
+    neighbour_occupancy: Vec<BitModel>,
     duplicates: IntModel,
     normal: [IntModel; 2],
     colour: [IntModel; 3],
@@ -43,6 +46,7 @@ impl Models {
     pub fn new(has_normals: bool, has_colours: bool) -> Self {
         Models {
             occupancy: vec![BitModel::new(); PARENT_CLASSES * 256],
+            neighbour_occupancy: vec![BitModel::new(); CONTEXTS],
             duplicates: IntModel::new(),
             normal: [IntModel::new(), IntModel::new()],
             colour: [IntModel::new(), IntModel::new(), IntModel::new()],
@@ -79,6 +83,44 @@ impl Models {
             let bit = dec.decode_bit(&mut tree[node]);
             mask |= u8::from(bit) << k;
             node = node * 2 + usize::from(bit);
+        }
+        mask
+    }
+
+    /// Version 2: codes a non-empty child mask, each bit with the model of
+    /// its neighbour context.
+    pub fn encode_mask_v2(&mut self, enc: &mut RangeEncoder, around: &Around, class: u8, mask: u8) {
+        debug_assert!(mask != 0);
+        if around.is_empty() {
+            return self.encode_mask(enc, class, mask);
+        }
+        let contexts = around.contexts();
+        for k in 0..8 {
+            let so_far = mask & ((1u8 << k) - 1);
+            if k == 7 && so_far == 0 {
+                break;
+            }
+            let context = contexts[k] + CODED[k][usize::from(so_far)];
+            let model = &mut self.neighbour_occupancy[usize::from(context)];
+            enc.encode_bit(model, (mask >> k) & 1 == 1);
+        }
+    }
+
+    /// Decodes a mask coded by [`encode_mask_v2`](Self::encode_mask_v2);
+    /// never 0.
+    pub fn decode_mask_v2(&mut self, dec: &mut RangeDecoder<'_>, around: &Around, class: u8) -> u8 {
+        if around.is_empty() {
+            return self.decode_mask(dec, class);
+        }
+        let contexts = around.contexts();
+        let mut mask = 0u8;
+        for k in 0..8 {
+            if k == 7 && mask == 0 {
+                return 0x80;
+            }
+            let context = contexts[k] + CODED[k][usize::from(mask)];
+            let model = &mut self.neighbour_occupancy[usize::from(context)];
+            mask |= u8::from(dec.decode_bit(model)) << k;
         }
         mask
     }

@@ -10,6 +10,10 @@ use super::topology::{allows, Scratch};
 use super::working::{Merge, WorkingMesh};
 use super::{Collapse, Placement, SimplifyOptions};
 
+/// With quadric placement, the share of a pass's candidates (the cheapest)
+/// it may merge; the rest wait for the next pass.
+const PASS_QUANTILE: f64 = 0.5;
+
 pub(super) struct Pass<'a> {
     mesh: &'a mut WorkingMesh,
     collapse: Collapse,
@@ -19,6 +23,11 @@ pub(super) struct Pass<'a> {
     frozen: Vec<bool>,
     scratch: Scratch,
     ring: Vec<u32>,
+    /// The candidates' cheapest merges, when [`Pass::features_cheaper`]
+    /// has priced them already (the pass then does not price them again).
+    costs: Option<Vec<f64>>,
+    /// With quadric placement, the dearest merge this round may make.
+    cap: f64,
 }
 
 impl<'a> Pass<'a> {
@@ -38,6 +47,8 @@ impl<'a> Pass<'a> {
             frozen,
             scratch: Scratch::default(),
             ring: Vec::new(),
+            costs: None,
+            cap: f64::INFINITY,
         }
     }
 
@@ -48,21 +59,57 @@ impl<'a> Pass<'a> {
             .collect();
         let order: Vec<f64> = match self.placement {
             Placement::Seed => self.mesh.theta.clone(),
-            Placement::Quadric => {
-                let mut cost = vec![f64::INFINITY; self.mesh.positions.len()];
-                for &v in &candidates {
-                    cost[v as usize] = self.cheapest(v);
+            Placement::Quadric => match self.costs.take() {
+                Some(cost) => cost,
+                None => {
+                    let mut cost = vec![f64::INFINITY; self.mesh.positions.len()];
+                    for &v in &candidates {
+                        cost[v as usize] = self.cheapest(v);
+                    }
+                    cost
                 }
-                cost
-            }
+            },
         };
         candidates.sort_by(|&a, &b| {
             order[a as usize]
                 .total_cmp(&order[b as usize])
                 .then(a.cmp(&b))
         });
+        // With quadric placement a pass takes only its cheaper merges: the
+        // dearer ones wait for a pass where they may have become cheap or
+        // where nothing cheaper is left. Without the cap a pass merges every
+        // candidate the independent set allows, however dear (bunny at 10 %:
+        // the ears cut through, 4.2× quadric's Hausdorff distance).
+        let cap = match self.placement {
+            Placement::Seed => f64::INFINITY,
+            Placement::Quadric => {
+                let finite = candidates
+                    .iter()
+                    .filter(|&&v| order[v as usize].is_finite())
+                    .count();
+                let at = ((finite as f64 * PASS_QUANTILE) as usize).min(finite.saturating_sub(1));
+                candidates
+                    .get(at)
+                    .map_or(f64::INFINITY, |&v| order[v as usize])
+            }
+        };
+        let merges = self.merge(&candidates, &order, cap);
+        if merges == 0 && cap.is_finite() {
+            // Every cheap candidate was frozen or refused: the dear ones
+            // may go, rather than features being freed for want of merges.
+            return self.merge(&candidates, &order, f64::INFINITY);
+        }
+        merges
+    }
+
+    /// Merges the candidates in order, those costing at most `cap`.
+    fn merge(&mut self, candidates: &[u32], order: &[f64], cap: f64) -> usize {
+        self.cap = cap;
         let mut merges = 0;
-        for v in candidates {
+        for &v in candidates {
+            if order[v as usize] > cap {
+                break;
+            }
             let left = self.mesh.live_vertices.saturating_sub(self.target);
             if left == 0 {
                 break;
@@ -83,6 +130,45 @@ impl<'a> Pass<'a> {
             }
         }
         merges
+    }
+
+    /// Whether the protected vertices (θ above τ, off the borders) would now
+    /// merge more cheaply than the candidates: the median of their cheapest
+    /// merges under the candidates'. Then going on without them costs the
+    /// surface more than freeing some (bunny's ears were cut through while
+    /// a scan's noise, all above τ, stood untouched).
+    pub fn features_cheaper(&mut self) -> bool {
+        let mut costs = vec![f64::INFINITY; self.mesh.positions.len()];
+        let mut candidates = Vec::new();
+        let mut protected = Vec::new();
+        for v in 0..self.mesh.positions.len() as u32 {
+            if !self.mesh.removable(v, f64::INFINITY) {
+                continue;
+            }
+            let cost = self.cheapest(v);
+            let candidate = self.mesh.removable(v, self.threshold);
+            if candidate {
+                costs[v as usize] = cost;
+            }
+            if !cost.is_finite() {
+                continue;
+            }
+            if candidate {
+                candidates.push(cost);
+            } else {
+                protected.push(cost);
+            }
+        }
+        self.costs = Some(costs);
+        match (median(&mut protected), median(&mut candidates)) {
+            (Some(p), Some(c)) => p < c,
+            _ => false,
+        }
+    }
+
+    /// The mesh the pass works on.
+    pub fn mesh(&self) -> &WorkingMesh {
+        self.mesh
     }
 
     /// Live, unfrozen and removable (a merge may have raised its θ).
@@ -176,9 +262,21 @@ impl<'a> Pass<'a> {
     }
 
     /// Tries each merge in turn; applies the first the checks allow and
-    /// returns its survivor.
+    /// returns its survivor. With quadric placement, a merge dearer than
+    /// the round's cap is not made: a vertex whose cheap merges are refused
+    /// (they would fold a face) waits rather than taking a dear one (a
+    /// plate's crease vertex went across the plate's edge, 8 % of its
+    /// diagonal, where quadric simplification loses nothing).
     fn first_allowed(&mut self, merges: impl IntoIterator<Item = Merge>) -> Option<u32> {
+        // (A triangle collapse goes to the centroid, which the cap, priced
+        // on edge merges, does not measure.)
+        let capped = self.placement == Placement::Quadric
+            && self.collapse != Collapse::Triangle
+            && self.cap.is_finite();
         for m in merges {
+            if capped && self.cost(&m) > self.cap {
+                return None;
+            }
             if allows(self.mesh, &m, &mut self.scratch) {
                 self.mesh.apply(&m);
                 return Some(m.keep);
@@ -296,4 +394,14 @@ impl<'a> Pass<'a> {
             self.frozen[w as usize] = true;
         }
     }
+}
+
+/// The middle value (the upper one of an even count); `None` when empty.
+fn median(values: &mut [f64]) -> Option<f64> {
+    if values.is_empty() {
+        return None;
+    }
+    let middle = values.len() / 2;
+    let (_, m, _) = values.select_nth_unstable_by(middle, f64::total_cmp);
+    Some(*m)
 }

@@ -1,7 +1,8 @@
 //! Melax's progressive edge collapse (seed 003; SEEDS.md "003"), with what
 //! the seed lacks: a heap instead of a linear scan for the cheapest
 //! collapse, the link condition and flip rejection of [`crate::simplify`]
-//! (`collapse::topology`), borders locked, UV seams kept, and for an
+//! (`collapse::topology`), borders locked, UV seams kept (a seam vertex
+//! goes only along its seam, both sides at once), and for an
 //! animated model a cost that is the largest over its frames and one
 //! collapse order for all of them.
 //!
@@ -39,20 +40,34 @@ pub struct MelaxModel<'a> {
     /// At least one; every frame has the same number of positions.
     pub frames: &'a [Vec<[f32; 3]>],
     /// Per triangle, an id for each corner's texture coordinate (MD2's st
-    /// index): a vertex whose corners have several ids sits on a seam and
-    /// stays, and no collapse carries a coordinate across one.
+    /// index): a vertex whose corners have two ids sits on a seam and goes
+    /// only along it, one with three or more (seams meeting) stays, and no
+    /// collapse carries a coordinate across a seam.
     pub corner_uvs: Option<&'a [[u32; 3]]>,
     /// The crease term: [`MelaxCost::Sine`] unless the seed's own is wanted.
     pub cost: MelaxCost,
 }
 
 /// One collapse: `gone` moves into `keep`; its corners take texture
-/// coordinate `uv` (`keep`'s on that side).
+/// coordinate `uv` (`keep`'s on that side), except, along a seam, those
+/// with id `seam[0]`, which take `seam[1]` (`keep`'s on the other side).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct MelaxCollapse {
     pub gone: u32,
     pub keep: u32,
     pub uv: Option<u32>,
+    pub seam: Option<[u32; 2]>,
+}
+
+impl MelaxCollapse {
+    /// The texture coordinate a corner of `gone` with id `id` takes.
+    fn uv_of(&self, id: u32) -> u32 {
+        match (self.seam, self.uv) {
+            (Some([from, to]), _) if from == id => to,
+            (_, Some(uv)) => uv,
+            _ => id,
+        }
+    }
 }
 
 /// Every collapse Melax could make, cheapest first.
@@ -145,24 +160,31 @@ impl MelaxChain {
         if vertices < self.min_vertices() {
             return Err(Error::Unsupported(format!(
                 "Melax stops at {} of {} vertices (the rest are on borders or seams, \
-                 or their collapses would break the surface); {vertices} asked",
+                 or where seams meet, or their collapses would break the surface); \
+                 {vertices} asked",
                 self.min_vertices(),
                 self.vertices
             )));
         }
         let done = &self.collapses[..self.vertices - vertices];
-        // Where each collapsed vertex ends, and with which texture
-        // coordinate: later collapses first, so a survivor's own fate is
-        // known when a vertex collapsed into it is reached.
+        // Where each collapsed vertex ends: later collapses first, so a
+        // survivor's own fate is known when a vertex collapsed into it is
+        // reached.
         let mut root: Vec<u32> = (0..self.positions as u32).collect();
-        let mut uv_root: Vec<Option<u32>> = vec![None; self.positions];
-        let mut gone = vec![false; self.positions];
-        for c in done.iter().rev() {
-            let k = c.keep as usize;
-            root[c.gone as usize] = root[k];
-            uv_root[c.gone as usize] = if gone[k] { uv_root[k] } else { c.uv };
-            gone[c.gone as usize] = true;
+        let mut collapse_of = vec![u32::MAX; self.positions];
+        for (i, c) in done.iter().enumerate().rev() {
+            root[c.gone as usize] = root[c.keep as usize];
+            collapse_of[c.gone as usize] = i as u32;
         }
+        // A corner's texture coordinate follows its vertex's collapses one
+        // by one (along a seam, which side it is on decides).
+        let corner_uv = |mut v: u32, mut id: u32| {
+            while let Some(c) = done.get(collapse_of[v as usize] as usize) {
+                id = c.uv_of(id);
+                v = c.keep;
+            }
+            id
+        };
         let mut triangles = Vec::with_capacity(self.triangles.len());
         let mut corner_uvs = self.corner_uvs.as_ref().map(|_| Vec::new());
         for (f, t) in self.triangles.iter().enumerate() {
@@ -172,13 +194,7 @@ impl MelaxChain {
             }
             triangles.push(r);
             if let (Some(out), Some(uvs)) = (&mut corner_uvs, &self.corner_uvs) {
-                let uv: [u32; 3] = std::array::from_fn(|k| {
-                    let v = t[k] as usize;
-                    match uv_root[v] {
-                        Some(id) if gone[v] => id,
-                        _ => uvs[f][k],
-                    }
-                });
+                let uv: [u32; 3] = std::array::from_fn(|k| corner_uv(t[k], uvs[f][k]));
                 out.push(uv);
             }
         }

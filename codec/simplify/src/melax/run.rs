@@ -1,4 +1,4 @@
-//! The collapse loop: every vertex off the borders and seams proposes its
+//! The collapse loop: every vertex off the borders and seam junctions proposes its
 //! cheapest allowed collapse; a min-heap (lazy: stale entries carry an old
 //! stamp and are skipped) hands out the cheapest of all, which is checked
 //! again, applied to every frame, and the vertices whose faces changed
@@ -52,7 +52,7 @@ pub(super) struct Run {
     pub corner_uvs: Option<Vec<[u32; 3]>>,
     /// The crease term.
     kind: MelaxCost,
-    /// Borders and seam vertices never go.
+    /// Borders and seam junctions (three texture coordinates or more) never go.
     pub locked: Vec<bool>,
     stamp: Vec<u32>,
     heap: BinaryHeap<Entry>,
@@ -72,7 +72,7 @@ impl Run {
         let mut locked: Vec<bool> = first.border.clone();
         if let Some(uvs) = &corner_uvs {
             for (v, lock) in locked.iter_mut().enumerate() {
-                *lock |= is_seam(first, uvs, v as u32);
+                *lock |= uv_ids(first, uvs, v as u32) > 2;
             }
         }
         let mut run = Run {
@@ -113,14 +113,15 @@ impl Run {
         }
     }
 
-    fn apply(&mut self, gone: u32, keep: u32, uv: Option<u32>) -> MelaxCollapse {
+    fn apply(&mut self, gone: u32, keep: u32, uv: Option<UvMove>) -> MelaxCollapse {
         let first = &self.frames[0];
         first.neighbours(gone, &mut self.ring);
         if let (Some(uvs), Some(uv)) = (&mut self.corner_uvs, uv) {
             for &f in &first.faces_of[gone as usize] {
                 let t = first.triangles[f as usize];
                 if let Some(k) = t.iter().position(|&w| w == gone) {
-                    uvs[f as usize][k] = uv;
+                    let id = &mut uvs[f as usize][k];
+                    *id = uv.of(*id);
                 }
             }
         }
@@ -139,7 +140,12 @@ impl Run {
             self.propose(w);
         }
         self.ring = ring;
-        MelaxCollapse { gone, keep, uv }
+        MelaxCollapse {
+            gone,
+            keep,
+            uv: uv.map(|m| m.uv),
+            seam: uv.and_then(|m| m.seam),
+        }
     }
 
     /// Pushes `v`'s cheapest allowed collapse, if it has one.
@@ -172,9 +178,9 @@ impl Run {
 
     /// Whether `gone → keep` keeps the surface a manifold of the same
     /// topology (link condition), flips no face in any frame and keeps the
-    /// texture coordinates: `Some` of the id `gone`'s corners take (`None`
+    /// texture coordinates: `Some` of the ids `gone`'s corners take (`None`
     /// without texture coordinates).
-    fn allowed(&mut self, gone: u32, keep: u32) -> Option<Option<u32>> {
+    fn allowed(&mut self, gone: u32, keep: u32) -> Option<Option<UvMove>> {
         let first = &self.frames[0];
         if self.locked[gone as usize]
             || first.faces_of[gone as usize].is_empty()
@@ -183,7 +189,7 @@ impl Run {
             return None;
         }
         let uv = match &self.corner_uvs {
-            Some(uvs) => Some(seam_side(first, uvs, gone, keep)?),
+            Some(uvs) => Some(uv_move(first, uvs, gone, keep)?),
             None => None,
         };
         for m in &self.frames {
@@ -207,14 +213,75 @@ fn corner_uv(mesh: &WorkingMesh, uvs: &[[u32; 3]], f: u32, v: u32) -> Option<u32
     t.iter().position(|&w| w == v).map(|k| uvs[f as usize][k])
 }
 
-/// Whether `v`'s corners carry more than one texture coordinate: a seam
-/// (or a chart's border) runs through it.
-fn is_seam(mesh: &WorkingMesh, uvs: &[[u32; 3]], v: u32) -> bool {
-    let mut ids = mesh.faces_of[v as usize]
+/// How many texture coordinates `v`'s corners carry (3 standing for 3 or
+/// more): 1 inside a chart, 2 on a seam, more where seams meet.
+fn uv_ids(mesh: &WorkingMesh, uvs: &[[u32; 3]], v: u32) -> usize {
+    let mut ids: Vec<u32> = Vec::with_capacity(3);
+    for id in mesh.faces_of[v as usize]
         .iter()
-        .filter_map(|&f| corner_uv(mesh, uvs, f, v));
-    let first = ids.next();
-    ids.any(|id| Some(id) != first)
+        .filter_map(|&f| corner_uv(mesh, uvs, f, v))
+    {
+        if !ids.contains(&id) {
+            ids.push(id);
+            if ids.len() == 3 {
+                break;
+            }
+        }
+    }
+    ids.len()
+}
+
+/// The texture coordinates `gone`'s corners take when it moves into `keep`:
+/// `keep`'s on each corner's side of the seam (`seam` maps the ids of one
+/// side, `uv` is the other's or every corner's).
+#[derive(Clone, Copy, Debug)]
+pub(super) struct UvMove {
+    pub uv: u32,
+    pub seam: Option<[u32; 2]>,
+}
+
+impl UvMove {
+    /// The id a corner of `gone` with id `id` takes.
+    pub fn of(self, id: u32) -> u32 {
+        match self.seam {
+            Some([from, to]) if from == id => to,
+            _ => self.uv,
+        }
+    }
+}
+
+/// `gone → keep` with texture coordinates (issue 45: models with many UV
+/// islands could not reach 20 % while every seam vertex was locked). Inside
+/// a chart, `gone`'s corners take `keep`'s coordinate on `gone`'s side
+/// ([`seam_side`]). A seam vertex (two coordinates) may go only along the
+/// seam, into a neighbour across the seam edge: each side's corners take
+/// `keep`'s coordinate on that side, so the seam loses a vertex on both
+/// sides at once and no texture crosses it. A seam vertex never moves off
+/// its seam, and junctions are locked.
+fn uv_move(mesh: &WorkingMesh, uvs: &[[u32; 3]], gone: u32, keep: u32) -> Option<UvMove> {
+    if uv_ids(mesh, uvs, gone) == 1 {
+        return seam_side(mesh, uvs, gone, keep).map(|uv| UvMove { uv, seam: None });
+    }
+    let mut on_edge = mesh.faces_of[gone as usize]
+        .iter()
+        .copied()
+        .filter(|&f| mesh.triangles[f as usize].contains(&keep));
+    let (f, g) = (on_edge.next()?, on_edge.next()?);
+    let (a, b) = (
+        corner_uv(mesh, uvs, f, gone)?,
+        corner_uv(mesh, uvs, g, gone)?,
+    );
+    if a == b {
+        return None; // the edge is inside one side: it would pull the seam off
+    }
+    let (a_keep, b_keep) = (
+        corner_uv(mesh, uvs, f, keep)?,
+        corner_uv(mesh, uvs, g, keep)?,
+    );
+    Some(UvMove {
+        uv: a_keep,
+        seam: Some([b, b_keep]),
+    })
 }
 
 /// `keep`'s texture coordinate on the side of the edge where `gone` lies:

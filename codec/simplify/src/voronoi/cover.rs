@@ -68,6 +68,26 @@ pub(super) fn greedy_discs(
     centres
 }
 
+/// Marks the vertices within `radius` of `centres` as `covered`.
+/// `scratch` is an empty propagation, left empty.
+pub(super) fn mark_discs(
+    scratch: &mut Propagation<'_>,
+    centres: &[u32],
+    radius: f64,
+    covered: &mut [bool],
+) {
+    for &c in centres {
+        scratch.seed(c, 0, 0.0);
+    }
+    scratch.run(radius);
+    for &v in scratch.touched() {
+        if scratch.distance(v) < radius {
+            covered[v as usize] = true;
+        }
+    }
+    scratch.clear();
+}
+
 /// Farthest-point sampling on the diagram's own front: the vertex farthest
 /// from all sites becomes the next one (a vertex no site reaches, in a
 /// component of its own, first), until every vertex is within `radius`.
@@ -86,6 +106,10 @@ pub(super) fn farthest_points(
         .map(|&v| (ordered(front.distance(v)), Reverse(v)))
         .collect();
     front.take_changed();
+    let mut candidate = vec![false; front.surface().vertex_count()];
+    for &v in candidates {
+        candidate[v as usize] = true;
+    }
     let mut centres = Vec::new();
     while let Some((k, Reverse(v))) = heap.pop() {
         let d = front.distance(v);
@@ -99,7 +123,9 @@ pub(super) fn farthest_points(
         centres.push(v);
         front.run(f64::INFINITY);
         for w in front.take_changed() {
-            heap.push((ordered(front.distance(w)), Reverse(w)));
+            if candidate[w as usize] {
+                heap.push((ordered(front.distance(w)), Reverse(w)));
+            }
         }
     }
     front.track_changes(false);

@@ -10,15 +10,17 @@ use std::collections::HashSet;
 
 use vitrine_geodesic::Surface;
 
-/// Output faces as input vertex indices, in input face order.
+/// Output faces as input vertex indices, in input face order, and each
+/// one's cells (site labels).
 pub(super) fn dual_faces(
     surface: &Surface,
     labels: &[u32],
     site_vertex: &[u32],
     is_cone: impl Fn(u32) -> bool,
-) -> Vec<[u32; 3]> {
+) -> (Vec<[u32; 3]>, Vec<[u32; 3]>) {
     let mut seen = HashSet::new();
     let mut faces = Vec::new();
+    let mut cells = Vec::new();
     for t in surface.triangles() {
         let l = t.map(|v| labels[v as usize]);
         if l[0] == l[1] || l[1] == l[2] || l[0] == l[2] {
@@ -32,7 +34,8 @@ pub(super) fn dual_faces(
         key.sort_unstable();
         if seen.insert(key) {
             faces.push(face);
+            cells.push(l);
         }
     }
-    faces
+    (faces, cells)
 }

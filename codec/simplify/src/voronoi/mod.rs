@@ -11,8 +11,10 @@
 mod closed_ball;
 mod closure;
 mod cover;
+mod creases;
 mod curvature;
 mod dual;
+mod faces;
 mod search;
 
 use std::time::{Duration, Instant};
@@ -26,6 +28,7 @@ pub use vitrine_geodesic::Method as Distance;
 use closed_ball::Violation;
 use closure::Closed;
 pub use cover::Order;
+pub use creases::SHARP_DEGREES;
 
 /// The disc radius.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -45,6 +48,10 @@ pub struct VoronoiOptions {
     pub radius: Radius,
     /// Refinement rounds at most before giving up with an error.
     pub max_rounds: usize,
+    /// Edges whose faces' normals differ by this many degrees or more are
+    /// creases, whose vertices the cover takes first (`creases`); `None`
+    /// covers as the seed does.
+    pub sharp_degrees: Option<f64>,
 }
 
 impl Default for VoronoiOptions {
@@ -54,6 +61,7 @@ impl Default for VoronoiOptions {
             order: Order::Farthest,
             radius: Radius::Fraction(0.05),
             max_rounds: 500,
+            sharp_degrees: Some(SHARP_DEGREES),
         }
     }
 }
@@ -132,6 +140,8 @@ struct Diagram<'a> {
     closed: &'a Closed,
     options: &'a VoronoiOptions,
     curvature: Option<&'a [f64]>,
+    /// Each vertex's `creases` rank: the cover takes lower ranks first.
+    ranks: Vec<u8>,
     site_vertex: Vec<u32>,
     radius: Vec<f64>,
     front: Propagation<'a>,
@@ -153,6 +163,13 @@ impl<'a> Diagram<'a> {
             closed,
             options,
             curvature,
+            ranks: match options.sharp_degrees {
+                // A crease shorter than a disc's diameter is left to the cover.
+                Some(degrees) => {
+                    creases::crease_ranks(surface, closed.first_cone, degrees, 2.0 * r)
+                }
+                None => vec![creases::SMOOTH; surface.vertex_count()],
+            },
             site_vertex: (closed.first_cone..surface.vertex_count() as u32).collect(),
             radius: vec![0.0; surface.vertex_count() - closed.first_cone as usize],
             front: Propagation::new(surface, options.distance),
@@ -167,29 +184,42 @@ impl<'a> Diagram<'a> {
         stages.diagram = started.elapsed();
         let started = Instant::now();
         let (mut rounds, mut splits) = (0, 0);
-        let labels = loop {
+        let checks = faces::FaceChecks::new(surface, closed.first_cone);
+        let mut dual_time;
+        let faces = loop {
             let labels = diagram.labels();
-            let violations = closed_ball::violations(surface, &labels, diagram.site_vertex.len());
+            let mut violations =
+                closed_ball::violations(surface, &labels, diagram.site_vertex.len());
             if violations.is_empty() {
-                break labels;
+                let started = Instant::now();
+                let (faces, cells) =
+                    dual::dual_faces(surface, &labels, &diagram.site_vertex, |v| {
+                        closed.is_cone(v)
+                    });
+                dual_time = started.elapsed();
+                violations = checks.violations(&faces, &cells, &labels);
+                // A face whose cells cannot split any more stays as it is.
+                let members = Members::new(&labels, diagram.site_vertex.len());
+                violations.retain(|v| diagram.cell_to_split(v, &members).is_some());
+                if violations.is_empty() {
+                    break faces;
+                }
             }
             if rounds == options.max_rounds {
                 return Err(Error::Unsupported(format!(
-                    "the Voronoi diagram still breaks the closed-ball property after {rounds} \
-                     refinement rounds ({} violations)",
+                    "the Voronoi diagram still breaks the closed-ball property or folds after \
+                     {rounds} refinement rounds ({} violations)",
                     violations.len()
                 )));
             }
             splits += diagram.refine(&labels, &violations)?;
             rounds += 1;
         };
-        stages.refinement = started.elapsed();
+        stages.refinement = started.elapsed().saturating_sub(dual_time);
+        stages.dual = dual_time;
         let started = Instant::now();
-        let faces = dual::dual_faces(surface, &labels, &diagram.site_vertex, |v| {
-            closed.is_cone(v)
-        });
         let (mesh, origin) = compact(mesh, &faces);
-        stages.dual = started.elapsed();
+        stages.dual += started.elapsed();
         Ok(VoronoiSimplified {
             mesh,
             origin,
@@ -203,7 +233,8 @@ impl<'a> Diagram<'a> {
         })
     }
 
-    /// The used input vertices in the cover's order.
+    /// The used input vertices in the cover's order: crease corners, then
+    /// creases, then the rest (`creases`), each in the order's own.
     fn candidates(&self) -> Vec<u32> {
         let surface = &self.closed.surface;
         let mut c: Vec<u32> = (0..self.closed.first_cone)
@@ -212,22 +243,62 @@ impl<'a> Diagram<'a> {
         if let Some(k) = self.curvature {
             c.sort_by(|&a, &b| k[b as usize].abs().total_cmp(&k[a as usize].abs()));
         }
+        c.sort_by_key(|&v| self.ranks[v as usize]);
         c
     }
 
+    /// The creases are covered first with discs of r/2, so that a point of a
+    /// crease is nearer a site on it (within r/2) than any site off it (r
+    /// from those, so r/2 from the point at least): neighbouring crease
+    /// sites then share a Voronoi edge, and the dual joins them along the
+    /// crease rather than across a face.
     fn cover(&mut self, r: f64) {
         let candidates = self.candidates();
         let first = self.site_vertex.len() as u32;
+        let creases: Vec<u32> = candidates
+            .iter()
+            .copied()
+            .filter(|&v| self.ranks[v as usize] != creases::SMOOTH)
+            .collect();
         let centres = if self.options.order == Order::Farthest {
-            cover::farthest_points(&mut self.front, &candidates, r, first)
+            let mut centres = Vec::new();
+            for rank in [creases::CORNER, creases::CREASE] {
+                let pass: Vec<u32> = creases
+                    .iter()
+                    .copied()
+                    .filter(|&v| self.ranks[v as usize] == rank)
+                    .collect();
+                if !pass.is_empty() {
+                    let label = first + centres.len() as u32;
+                    let found = cover::farthest_points(&mut self.front, &pass, r / 2.0, label);
+                    centres.extend(found);
+                }
+            }
+            let label = first + centres.len() as u32;
+            centres.extend(cover::farthest_points(
+                &mut self.front,
+                &candidates,
+                r,
+                label,
+            ));
+            centres
         } else {
+            let mut near = vec![false; self.closed.surface.vertex_count()];
+            let mut centres = cover::greedy_discs(&mut self.scratch, &creases, r / 2.0, &mut near);
             let mut covered = vec![false; self.closed.surface.vertex_count()];
-            let centres = cover::greedy_discs(&mut self.scratch, &candidates, r, &mut covered);
+            cover::mark_discs(&mut self.scratch, &centres, r, &mut covered);
+            centres.extend(cover::greedy_discs(
+                &mut self.scratch,
+                &candidates,
+                r,
+                &mut covered,
+            ));
             for (i, &c) in centres.iter().enumerate() {
                 self.front.seed(c, first + i as u32, 0.0);
             }
             centres
         };
+        // A crease site's cell splits as the others do, from r.
         self.radius.extend(std::iter::repeat_n(r, centres.len()));
         self.site_vertex.extend(centres);
     }
@@ -290,6 +361,7 @@ impl<'a> Diagram<'a> {
 
     /// Re-covering follows the cover's order; "farthest" takes the
     /// vertices farthest from the site first.
+    /// Crease vertices come first here too.
     fn order(&self, vertices: &mut [u32]) {
         match (self.options.order, self.curvature) {
             (Order::Curvature, Some(k)) => {
@@ -300,6 +372,7 @@ impl<'a> Diagram<'a> {
             }
             _ => vertices.sort_unstable(),
         }
+        vertices.sort_by_key(|&v| self.ranks[v as usize]);
     }
 
     /// The cell a violation splits: the one in question, or the largest of

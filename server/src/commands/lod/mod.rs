@@ -3,7 +3,8 @@
 //! ⌊n·p/100⌋ vertices: one GLB with `MSFT_lod` and coverage hints, one GLB
 //! per level with `--split`, or one MD2 per level with `--format md2`. An
 //! MD2 input keeps its frames (morph targets and a LINEAR animation in GLB,
-//! every frame in MD2) and its texture coordinates (seams never collapse).
+//! every frame in MD2) and its texture coordinates (seams thin out only
+//! along themselves), after the same repair as every other import.
 //!
 //! GLB levels carry what the model has: its texture (an MD2's skin, a
 //! scan's base colour texture) as an embedded PNG with `TEXCOORD_0`, and
@@ -90,6 +91,14 @@ fn load(path: &Path) -> anyhow::Result<Source> {
         let bytes = std::fs::read(path).with_context(|| format!("reading {}", path.display()))?;
         let model = Md2::parse(&bytes, &ImportOptions::default())
             .with_context(|| format!("reading {}", path.display()))?;
+        // Repaired as every other import is, its frames and texture
+        // coordinates carried along.
+        let (model, repair) = model
+            .repaired()
+            .with_context(|| format!("repairing {}", path.display()))?;
+        if let Some(text) = describe_repair(&repair) {
+            eprintln!("repair: {text}");
+        }
         let frames = model.frames.iter().map(|f| f.positions()).collect();
         let triangles = model.mesh_triangles();
         // The same corner swap as the triangles (clockwise to counter-clockwise).

@@ -65,8 +65,8 @@ pub struct AdminSlug {
 #[derive(Deserialize, IntoParams)]
 #[into_params(parameter_in = Path)]
 pub struct AdminVersion {
-    slug: String,
-    version: u32,
+    pub(crate) slug: String,
+    pub(crate) version: u32,
 }
 
 /// A change to one version; absent fields are left as they are.

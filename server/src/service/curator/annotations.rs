@@ -9,13 +9,16 @@ use super::Curator;
 use crate::service::error::{AppError, ErrorBody};
 use crate::service::servable::{PathParams, ServableModel, SlugParam};
 use crate::service::AppState;
-use crate::storage::{valid_slug, AnnotationRecord, NewAnnotation};
+use crate::storage::{
+    valid_slug, AnnotationRecord, AnnotationText, AnnotationTranslations, NewAnnotation,
+};
 use axum::extract::rejection::JsonRejection;
 use axum::extract::State;
 use axum::http::StatusCode;
 use axum::response::{IntoResponse, Response};
 use axum::Json;
 use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
 use utoipa::{IntoParams, ToSchema};
 
 /// Longest title, in characters.
@@ -43,6 +46,10 @@ pub struct Annotation {
     view: Option<serde_json::Value>,
     /// BCP 47 tag of the title and text (`en`, `pt-BR`), or null when not stated.
     language: Option<String>,
+    /// The title and text in further languages, per BCP 47 tag: `{"title",
+    /// "text", "html"}` (the viewer shows the visitor's, else the above).
+    #[schema(value_type = Object)]
+    translations: AnnotationTranslations,
     /// Unix milliseconds.
     created_at: i64,
     updated_at: i64,
@@ -59,6 +66,7 @@ impl From<AnnotationRecord> for Annotation {
             normal: a.normal,
             view: a.view,
             language: a.language,
+            translations: a.translations,
             created_at: a.created_at_ms,
             updated_at: a.updated_at_ms,
         }
@@ -86,7 +94,26 @@ pub struct AnnotationInput {
     #[serde(default, deserialize_with = "super::admin::present")]
     #[schema(value_type = Option<String>)]
     language: Option<Option<String>>,
+    /// The title (1–200 characters) and Markdown text (at most 10,000) in
+    /// further languages, per BCP 47 tag: `{"pt": {"title": "…", "text":
+    /// "…"}}`, at most 20. Absent from a replacement: the annotation keeps
+    /// the translations it had; `{}` removes them.
+    #[serde(default)]
+    #[schema(value_type = Option<Object>)]
+    translations: Option<BTreeMap<String, TranslationInput>>,
 }
+
+/// An annotation's title and text in one further language, as typed.
+#[derive(Deserialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+pub struct TranslationInput {
+    title: String,
+    #[serde(default)]
+    text: String,
+}
+
+/// Most further languages of one annotation.
+pub const MAX_TRANSLATIONS: usize = 20;
 
 impl AnnotationInput {
     /// An annotation from elsewhere (a IIIF import), without a saved view.
@@ -104,7 +131,19 @@ impl AnnotationInput {
             normal,
             view: None,
             language: Some(language),
+            translations: None,
         }
+    }
+
+    /// With its title and text in further languages (`(tag, title, text)`).
+    pub fn with_translations(mut self, translations: Vec<(String, String, String)>) -> Self {
+        self.translations = Some(
+            translations
+                .into_iter()
+                .map(|(tag, title, text)| (tag, TranslationInput { title, text }))
+                .collect(),
+        );
+        self
     }
 
     /// Checks limits and numbers; renders the text.
@@ -115,16 +154,7 @@ impl AnnotationInput {
     /// [`AnnotationInput::validate`], the reason as text.
     pub fn checked(self) -> Result<NewAnnotation, String> {
         let bad = |m: String| Err(m);
-        let title = self.title.trim().to_owned();
-        if title.is_empty() {
-            return bad("title must not be empty".into());
-        }
-        if title.chars().count() > MAX_TITLE_CHARS {
-            return bad(format!("title is longer than {MAX_TITLE_CHARS} characters"));
-        }
-        if self.text.chars().count() > MAX_TEXT_CHARS {
-            return bad(format!("text is longer than {MAX_TEXT_CHARS} characters"));
-        }
+        let title = checked_text("", &self.title, &self.text)?;
         if !self
             .position
             .iter()
@@ -152,6 +182,8 @@ impl AnnotationInput {
             None | Some("") => None,
             Some(tag) => Some(parse_language(tag)?),
         };
+        let translations =
+            translations(self.translations.unwrap_or_default(), language.as_deref())?;
         Ok(NewAnnotation {
             html: markdown::render(&self.text),
             title,
@@ -160,8 +192,64 @@ impl AnnotationInput {
             normal,
             view,
             language,
+            translations,
         })
     }
+}
+
+/// A title (trimmed, 1–200 characters) and text (at most 10,000
+/// characters) checked; `which` names the language in the message.
+fn checked_text(which: &str, title: &str, text: &str) -> Result<String, String> {
+    let title = title.trim().to_owned();
+    if title.is_empty() {
+        return Err(format!("{which}title must not be empty"));
+    }
+    if title.chars().count() > MAX_TITLE_CHARS {
+        return Err(format!(
+            "{which}title is longer than {MAX_TITLE_CHARS} characters"
+        ));
+    }
+    if text.chars().count() > MAX_TEXT_CHARS {
+        return Err(format!(
+            "{which}text is longer than {MAX_TEXT_CHARS} characters"
+        ));
+    }
+    Ok(title)
+}
+
+/// The further languages checked and rendered: well-formed tags, none the
+/// annotation's own or given twice, at most [`MAX_TRANSLATIONS`].
+fn translations(
+    given: BTreeMap<String, TranslationInput>,
+    own: Option<&str>,
+) -> Result<AnnotationTranslations, String> {
+    if given.len() > MAX_TRANSLATIONS {
+        return Err(format!(
+            "{} translations, more than {MAX_TRANSLATIONS}",
+            given.len()
+        ));
+    }
+    let mut out = AnnotationTranslations::new();
+    for (tag, t) in given {
+        let tag = parse_language(tag.trim())?;
+        if own.is_some_and(|own| own.eq_ignore_ascii_case(&tag)) {
+            return Err(format!("{tag} is the annotation's own language"));
+        }
+        if out.keys().any(|k| k.eq_ignore_ascii_case(&tag)) {
+            return Err(format!("{tag} is given twice"));
+        }
+        let title = checked_text(&format!("the {tag} "), &t.title, &t.text)?;
+        let html = markdown::render(&t.text);
+        out.insert(
+            tag,
+            AnnotationText {
+                title,
+                text: t.text,
+                html,
+            },
+        );
+    }
+    Ok(out)
 }
 
 /// Longest language tag accepted (RFC 5646 §4.4.1 asks for at least 35).
@@ -286,13 +374,23 @@ pub async fn update(
     curator.check_model(&slug)?;
     existing(&state, &slug).await?;
     let keep_language = matches!(&input, Ok(Json(i)) if i.language.is_none());
+    let keep_translations = matches!(&input, Ok(Json(i)) if i.translations.is_none());
     let mut new = body(input)?;
-    if keep_language {
+    if keep_language || keep_translations {
         let stored = state.storage().annotations(&slug).await?;
-        new.language = stored
-            .into_iter()
-            .find(|a| a.id == id)
-            .and_then(|a| a.language);
+        let before = stored.into_iter().find(|a| a.id == id);
+        if keep_language {
+            new.language = before.as_ref().and_then(|a| a.language.clone());
+        }
+        if keep_translations {
+            new.translations = before.map(|a| a.translations).unwrap_or_default();
+        }
+    }
+    if let Some(own) = &new.language {
+        // The annotation's own language is not a translation of it (a kept
+        // language and a new list, or the other way round, may meet here).
+        new.translations
+            .retain(|tag, _| !tag.eq_ignore_ascii_case(own));
     }
     let stored = state.storage().update_annotation(&slug, id, &new).await?;
     Ok(Json(stored.ok_or(AppError::NotFound("annotation"))?.into()))

@@ -7,7 +7,7 @@
 pub mod admin;
 pub mod annotations;
 pub mod jobs;
-mod markdown;
+pub(crate) mod markdown;
 pub mod thumbnail;
 pub mod upload;
 

@@ -1,6 +1,6 @@
 //! `POST /api/models`: a curator uploads a scan as `multipart/form-data`
 //! (`file`, `slug`, `title`, optional `description`, `policy`, `colour`,
-//! `kind`, `unit`, `up`, `credit`, `licence`). A point cloud (a PLY without faces, LAS, LAZ) is stored as a
+//! `kind`, `unit`, `up`, `credit`, `licence`, `language`). A point cloud (a PLY without faces, LAS, LAZ) is stored as a
 //! point stream.
 //! The file is streamed to a spool file on disk, never held in memory; its
 //! name as sent never becomes a path (the spool file's name is generated
@@ -66,6 +66,9 @@ pub struct UploadForm {
     /// Licence or rights statement, an identifier from `GET /api/licences`
     /// (`CC-BY-4.0`, `CC0-1.0`, `InC`, …).
     licence: Option<String>,
+    /// The language of title, description and credit, a BCP 47 tag (`pt`,
+    /// `pt-BR`); translations are added in `/admin` afterwards.
+    language: Option<String>,
 }
 
 #[derive(Serialize, ToSchema)]
@@ -227,6 +230,7 @@ struct Fields {
     up: Option<String>,
     credit: Option<String>,
     licence: Option<String>,
+    language: Option<String>,
 }
 
 impl Fields {
@@ -242,10 +246,11 @@ impl Fields {
             "up" => &mut self.up,
             "credit" => &mut self.credit,
             "licence" => &mut self.licence,
+            "language" => &mut self.language,
             other => {
                 return Err(AppError::Unprocessable(format!(
                     "unknown form field {other:?} (file, slug, title, description, policy, \
-                     colour, kind, unit, up, credit, licence)"
+                     colour, kind, unit, up, credit, licence, language)"
                 )))
             }
         };
@@ -292,6 +297,10 @@ impl Fields {
         };
         meta.rights =
             Rights::parse(self.credit.as_deref(), self.licence.as_deref()).map_err(bad)?;
+        meta.language = match self.language.as_deref().map(str::trim) {
+            None | Some("") => None,
+            Some(tag) => Some(super::annotations::parse_language(tag).map_err(bad)?),
+        };
         let colour = match self.colour.as_deref() {
             None | Some("") => None,
             Some(name) => Some(name.parse::<ColourMode>().map_err(|_| {

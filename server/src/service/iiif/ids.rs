@@ -47,6 +47,15 @@ impl Ids<'_> {
         self.under(&format!("annotations/{id}"))
     }
 
+    /// A guided tour's Range (`iiif/tours.rs`), and its steps (from 1).
+    pub fn tour(&self, id: i64) -> String {
+        self.under(&format!("tours/{id}"))
+    }
+
+    pub fn tour_step(&self, id: i64, step: usize) -> String {
+        self.under(&format!("tours/{id}/steps/{step}"))
+    }
+
     /// Where the target of an imported annotation must end: this model's
     /// Scene on any host (behind a proxy the exporter may have known the
     /// site by another name).

@@ -124,6 +124,7 @@ fn annotations_of(items: &[Value], record: &ModelRecord) -> Result<Vec<NewAnnota
                 outward(record, position),
                 a.language,
             )
+            .with_translations(a.translations)
             .checked()
         });
         match checked {

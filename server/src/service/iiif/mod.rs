@@ -14,6 +14,7 @@
 mod ids;
 pub mod import;
 mod presentation;
+mod tours;
 mod values;
 mod web_annotation;
 
@@ -46,7 +47,8 @@ use std::sync::Arc;
         (status = 200, description = "IIIF Presentation 4 Manifest: a Scene painting the GLB of \
             the level every anonymous visitor may download (none when the policy offers no \
             download), the home camera and lights, the annotations as commenting Web \
-            Annotations; `Access-Control-Allow-Origin: *`, `Cache-Control: public, max-age=300`, \
+            Annotations, the version's guided tours as Ranges in `structures`; \
+            `Access-Control-Allow-Origin: *`, `Cache-Control: public, max-age=300`, \
             strong ETag", content_type = "application/ld+json", body = Object,
             headers(("ETag" = String), ("Cache-Control" = String))),
         (status = 304, description = "Not modified", headers(("ETag" = String), ("Cache-Control" = String))),
@@ -64,6 +66,10 @@ pub async fn manifest(
     let record = public_model(&state, &slug).await?;
     let base = public_base(&state, &headers);
     let annotations = state.storage().annotations(&record.slug).await?;
+    let tours = state
+        .storage()
+        .tours(&record.slug, Some(record.version))
+        .await?;
     let document = presentation::manifest(&presentation::ManifestInput {
         ids: Ids {
             base: &base,
@@ -72,6 +78,7 @@ pub async fn manifest(
         record: &record,
         level: anonymous_level(&record, &state.config().caps),
         annotations: &annotations,
+        tours: &tours,
         thumbnail: record
             .curation
             .thumbnail_sha256

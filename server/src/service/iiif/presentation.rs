@@ -8,15 +8,16 @@
 //! Scene coordinates are the GLB's world coordinates: +Y up, in metres
 //! ([`crate::service::scene`]), so the Model needs no transform.
 //!
-//! Text a model carries (title, description, credit) has no recorded
-//! language: it is keyed `none`, as Presentation's language maps ask for
-//! text of unknown language. Vitrine's own labels ("Attribution") are `en`.
+//! Text a model carries (title, description, credit) is keyed by the
+//! version's language and each translation's (issue 43); a version whose
+//! language was never stated keys its own text `none`, as Presentation's
+//! language maps ask for text of unknown language. Vitrine's own labels ("Attribution") are `en`.
 
 use super::ids::{self, Ids, CONTEXT};
-use super::values::{language_map, point_selector};
+use super::values::{language_map, language_maps, point_selector};
 use super::web_annotation;
 use crate::service::scene::SceneFrame;
-use crate::storage::{AnnotationRecord, Bounds, ModelRecord, Rights};
+use crate::storage::{AnnotationRecord, Bounds, ModelRecord, TextField, TourRecord};
 use serde_json::{json, Value};
 
 /// The viewer's vertical field of view, degrees (`web/src/camera.js`).
@@ -33,6 +34,8 @@ pub struct ManifestInput<'a> {
     /// to the public, and the Scene paints no Model (see [`manifest`]).
     pub level: Option<u32>,
     pub annotations: &'a [AnnotationRecord],
+    /// The guided tours of the version described (`tours.rs`: as Ranges).
+    pub tours: &'a [TourRecord],
     /// `/api/models/{slug}/thumbnail?v=…`, when the version has one.
     pub thumbnail: Option<String>,
 }
@@ -49,12 +52,12 @@ pub fn manifest(input: &ManifestInput<'_>) -> Value {
         "@context": CONTEXT,
         "id": ids.manifest(),
         "type": "Manifest",
-        "label": language_map(None, &record.title),
+        "label": title_map(record),
         "metadata": metadata(record),
         "homepage": [{
             "id": crate::service::web::page_url(base, &record.slug),
             "type": "Text",
-            "label": language_map(None, &record.title),
+            "label": title_map(record),
             "format": "text/html",
         }],
         "seeAlso": [{
@@ -74,13 +77,28 @@ pub fn manifest(input: &ManifestInput<'_>) -> Value {
     });
     let description = record.description.trim();
     if !description.is_empty() {
-        manifest["summary"] = language_map(None, description);
+        manifest["summary"] = language_maps(
+            record
+                .texts
+                .every(TextField::Description, description)
+                .map(|(l, t)| (l, t.trim())),
+        );
     }
-    rights(&mut manifest, &record.curation.rights);
+    if let Some(structures) =
+        super::tours::structures(ids, &SceneFrame::of(&record.curation), input.tours)
+    {
+        manifest["structures"] = structures;
+    }
+    rights(&mut manifest, record);
     if let Some(thumbnail) = &input.thumbnail {
         manifest["thumbnail"] = thumbnail_of(base, thumbnail);
     }
     manifest
+}
+
+/// The title in every language it is written in.
+fn title_map(record: &ModelRecord) -> Value {
+    language_maps(record.texts.every(TextField::Title, &record.title))
 }
 
 fn thumbnail_of(base: &str, path: &str) -> Value {
@@ -113,11 +131,12 @@ fn metadata(record: &ModelRecord) -> Value {
 /// `requiredStatement` is the credit; `rights` the licence's URI as IIIF
 /// asks for it: Creative Commons deeds by their machine-actionable `http`
 /// URIs (rightsstatements.org's already are).
-fn rights(manifest: &mut Value, rights: &Rights) {
+fn rights(manifest: &mut Value, record: &ModelRecord) {
+    let rights = &record.curation.rights;
     if let Some(credit) = &rights.credit {
         manifest["requiredStatement"] = json!({
             "label": language_map(Some("en"), "Attribution"),
-            "value": language_map(None, credit),
+            "value": language_maps(record.texts.every(TextField::Credit, credit)),
         });
     }
     if let Some(licence) = rights.licence {
@@ -142,7 +161,7 @@ fn scene(input: &ManifestInput<'_>) -> Value {
             "body": {
                 "id": format!("{}{}", ids.base, crate::service::download::url(&record.slug, level)),
                 "type": "Model",
-                "label": language_map(None, &record.title),
+                "label": title_map(record),
                 "format": "model/gltf-binary",
             },
             "target": scene_ref,
@@ -171,7 +190,7 @@ fn scene(input: &ManifestInput<'_>) -> Value {
     json!({
         "id": ids.scene(),
         "type": "Scene",
-        "label": language_map(None, &record.title),
+        "label": title_map(record),
         "items": [{
             "id": ids.painting("page"),
             "type": "AnnotationPage",

@@ -16,7 +16,7 @@
 //! plain text, a target that is not a point on this model's Scene.
 
 use super::ids::Ids;
-use super::values::{language_map, point_selector};
+use super::values::{language_maps, point_selector};
 use crate::service::scene::SceneFrame;
 use crate::storage::AnnotationRecord;
 use serde_json::{json, Map, Value};
@@ -28,27 +28,33 @@ pub fn page(ids: &Ids<'_>, frame: &SceneFrame, annotations: &[AnnotationRecord])
         .iter()
         .map(|a| {
             let language = a.language.as_deref();
+            let translated = a
+                .translations
+                .iter()
+                .map(|(tag, t)| (Some(tag.as_str()), t));
+            let titles = translated.clone().map(|(tag, t)| (tag, t.title.as_str()));
             let mut item = json!({
                 "id": ids.annotation(a.id),
                 "type": "Annotation",
                 "motivation": ["commenting"],
-                "label": language_map(language, &a.title),
+                "label": language_maps(std::iter::once((language, a.title.as_str())).chain(titles)),
                 "target": {
                     "type": "SpecificResource",
                     "source": scene,
                     "selector": [point_selector(frame.to_scene(a.position))],
                 },
             });
-            if !a.text.is_empty() {
-                let mut body = json!({
-                    "type": "TextualBody",
-                    "value": a.text,
-                    "format": "text/markdown",
-                });
-                if let Some(language) = language {
-                    body["language"] = language.into();
-                }
-                item["body"] = body;
+            // One text per language; several are alternatives of one
+            // another, a `Choice` (as IIIF's captions in several languages).
+            let mut bodies: Vec<Value> = std::iter::once((language, a.text.as_str()))
+                .chain(translated.map(|(tag, t)| (tag, t.text.as_str())))
+                .filter(|(_, text)| !text.is_empty())
+                .map(|(language, text)| textual_body(language, text))
+                .collect();
+            match bodies.len() {
+                0 => {}
+                1 => item["body"] = bodies.remove(0),
+                _ => item["body"] = json!({ "type": "Choice", "items": bodies }),
             }
             item
         })
@@ -58,6 +64,18 @@ pub fn page(ids: &Ids<'_>, frame: &SceneFrame, annotations: &[AnnotationRecord])
         "type": "AnnotationPage",
         "items": items,
     })
+}
+
+fn textual_body(language: Option<&str>, text: &str) -> Value {
+    let mut body = json!({
+        "type": "TextualBody",
+        "value": text,
+        "format": "text/markdown",
+    });
+    if let Some(language) = language {
+        body["language"] = language.into();
+    }
+    body
 }
 
 /// One annotation as read from an import, before Vitrine's own checks
@@ -72,6 +90,9 @@ pub struct Imported {
     pub text: String,
     /// The body's `language`, else the label's only language.
     pub language: Option<String>,
+    /// Further languages: `(tag, title, text)`, from a `Choice` of bodies
+    /// and the label's other languages.
+    pub translations: Vec<(String, String, String)>,
     /// Scene coordinates.
     pub point: [f64; 3],
 }
@@ -113,7 +134,12 @@ pub fn read(item: &Value, slug: &str) -> Result<Imported, String> {
         None => return Err("no type (an Annotation has \"type\": \"Annotation\")".into()),
     }
     check_motivation(item.get("motivation"))?;
-    let body = body_of(item.get("body"))?;
+    let mut bodies = bodies_of(item.get("body"))?.into_iter();
+    let body = bodies.next().unwrap_or(Body {
+        text: String::new(),
+        language: None,
+    });
+    let others: Vec<Body> = bodies.collect();
     let point = point_of(item.get("target").ok_or("no target")?, slug)?;
     let label = item.get("label").map(label_of).transpose()?;
     let language = body
@@ -122,26 +148,60 @@ pub fn read(item: &Value, slug: &str) -> Result<Imported, String> {
         .or_else(|| label.as_ref().and_then(only_language));
     let title = match label.as_ref().and_then(|l| pick(l, language.as_deref())) {
         Some(title) => title,
-        None => body
-            .text
-            .lines()
-            .map(str::trim)
-            .find(|line| !line.is_empty())
-            .map(|line| {
-                line.trim_start_matches('#')
-                    .trim()
-                    .chars()
-                    .take(crate::service::curator::annotations::MAX_TITLE_CHARS)
-                    .collect()
-            })
-            .ok_or("neither a label nor any text to title it with")?,
+        None => first_line(&body.text).ok_or("neither a label nor any text to title it with")?,
     };
+    let translations = translations_of(label.as_ref(), language.as_deref(), others)?;
     Ok(Imported {
         title,
         text: body.text,
         language,
+        translations,
         point,
     })
+}
+
+/// The further languages: each other body of a `Choice` (which must name
+/// its language), titled by the label in that language or its first line;
+/// then the label's other languages without a text.
+fn translations_of(
+    label: Option<&Map<String, Value>>,
+    own: Option<&str>,
+    others: Vec<Body>,
+) -> Result<Vec<(String, String, String)>, String> {
+    let titled = |tag: &str| label.and_then(|l| l.get(tag)).and_then(first_text);
+    let mut out: Vec<(String, String, String)> = Vec::new();
+    for body in others {
+        let tag = body
+            .language
+            .ok_or("a Choice's bodies after the first must each state their language")?;
+        let title = titled(&tag)
+            .or_else(|| first_line(&body.text))
+            .ok_or_else(|| format!("the {tag} text has no title and no line to take one from"))?;
+        out.push((tag, title, body.text));
+    }
+    for (tag, values) in label.into_iter().flatten() {
+        let known =
+            tag == "none" || own.is_some_and(|o| o == tag) || out.iter().any(|(t, _, _)| t == tag);
+        if let (false, Some(title)) = (known, first_text(values)) {
+            out.push((tag.clone(), title, String::new()));
+        }
+    }
+    Ok(out)
+}
+
+/// A text's first non-empty line, Markdown heading marks removed, cut to a
+/// title's length.
+fn first_line(text: &str) -> Option<String> {
+    text.lines()
+        .map(str::trim)
+        .find(|line| !line.is_empty())
+        .map(|line| {
+            line.trim_start_matches('#')
+                .trim()
+                .chars()
+                .take(crate::service::curator::annotations::MAX_TITLE_CHARS)
+                .collect()
+        })
 }
 
 /// Comments are what Vitrine's annotations are: `commenting` or
@@ -172,7 +232,9 @@ struct Body {
     language: Option<String>,
 }
 
-fn body_of(body: Option<&Value>) -> Result<Body, String> {
+/// The texts of an annotation: none, one, or a `Choice` of one per
+/// language (the first the annotation's own).
+fn bodies_of(body: Option<&Value>) -> Result<Vec<Body>, String> {
     let body = match body {
         None | Some(Value::Null) => None,
         Some(Value::Array(bodies)) => match bodies.as_slice() {
@@ -180,7 +242,7 @@ fn body_of(body: Option<&Value>) -> Result<Body, String> {
             [one] => Some(one),
             more => {
                 return Err(format!(
-                    "{} bodies: Vitrine keeps one text (in one language) per annotation",
+                    "{} bodies: Vitrine keeps one text per language, given as a Choice",
                     more.len()
                 ))
             }
@@ -188,11 +250,19 @@ fn body_of(body: Option<&Value>) -> Result<Body, String> {
         Some(one) => Some(one),
     };
     let Some(body) = body else {
-        return Ok(Body {
-            text: String::new(),
-            language: None,
-        });
+        return Ok(Vec::new());
     };
+    if body.get("type").and_then(Value::as_str) == Some("Choice") {
+        let items = match body.get("items") {
+            Some(Value::Array(items)) if !items.is_empty() => items,
+            _ => return Err("the Choice has no items".into()),
+        };
+        return items.iter().map(body_of).collect();
+    }
+    Ok(vec![body_of(body)?])
+}
+
+fn body_of(body: &Value) -> Result<Body, String> {
     let body = body.as_object().ok_or("the body is not a JSON object")?;
     match body.get("type").and_then(Value::as_str) {
         Some("TextualBody") | None => {}
@@ -250,19 +320,21 @@ fn only_language(label: &Map<String, Value>) -> Option<String> {
 
 /// The label's first text in `language`, else under `none`, else the first.
 fn pick(label: &Map<String, Value>, language: Option<&str>) -> Option<String> {
-    let first = |values: &Value| {
-        values
-            .as_array()?
-            .iter()
-            .filter_map(Value::as_str)
-            .find(|t| !t.trim().is_empty())
-            .map(str::to_owned)
-    };
     language
         .and_then(|l| label.get(l))
-        .and_then(first)
-        .or_else(|| label.get("none").and_then(first))
-        .or_else(|| label.values().find_map(first))
+        .and_then(first_text)
+        .or_else(|| label.get("none").and_then(first_text))
+        .or_else(|| label.values().find_map(first_text))
+}
+
+/// A language map entry's first non-blank text.
+fn first_text(values: &Value) -> Option<String> {
+    values
+        .as_array()?
+        .iter()
+        .filter_map(Value::as_str)
+        .find(|t| !t.trim().is_empty())
+        .map(str::to_owned)
 }
 
 /// The PointSelector of a target on this model's Scene.
@@ -348,9 +420,40 @@ mod tests {
                 title: "Marque d'outil".into(),
                 text: "Un *trait*".into(),
                 language: Some("fr".into()),
+                translations: vec![],
                 point: [0.5, 1.0, -2.25],
             }
         );
+    }
+
+    #[test]
+    fn a_choice_of_texts_gives_the_further_languages() {
+        let mut a = annotation("https://m.example/iiif/stele/scene");
+        a["label"]["pt"] = json!(["Marca de ferramenta"]);
+        a["label"]["de"] = json!(["Werkzeugspur"]);
+        let fr = a["body"].clone();
+        let pt = json!({ "type": "TextualBody", "value": "Um *traço*", "language": "pt" });
+        a["body"] = json!({ "type": "Choice", "items": [fr, pt] });
+        let read = read(&a, "stele").unwrap();
+        assert_eq!(read.language.as_deref(), Some("fr"));
+        assert_eq!(
+            read.translations,
+            vec![
+                (
+                    "pt".into(),
+                    "Marca de ferramenta".into(),
+                    "Um *traço*".into()
+                ),
+                ("de".into(), "Werkzeugspur".into(), String::new()),
+            ]
+        );
+        // A further text must say which language it is in.
+        a["body"]["items"][1]
+            .as_object_mut()
+            .unwrap()
+            .remove("language");
+        let err = super::read(&a, "stele").unwrap_err();
+        assert!(err.contains("state their language"), "{err}");
     }
 
     #[test]

@@ -37,6 +37,17 @@ macro_rules! curator_storage {
                         None => None,
                     },
                     language: row.try_get("language").map_err(get)?,
+                    translations: match row
+                        .try_get::<Option<String>, _>("translations")
+                        .map_err(get)?
+                    {
+                        Some(json) => serde_json::from_str(&json).map_err(|e| {
+                            StorageError::Corrupt(format!(
+                                "annotation {id} has unreadable translations: {e}"
+                            ))
+                        })?,
+                        None => Default::default(),
+                    },
                     created_at_ms: row.try_get("created_at").map_err(get)?,
                     updated_at_ms: row.try_get("updated_at").map_err(get)?,
                 })
@@ -115,6 +126,7 @@ macro_rules! curator_storage {
                     .bind(serde_json::json!(a.normal).to_string())
                     .bind(a.view.as_ref().map(|v| v.to_string()))
                     .bind(a.language.clone())
+                    .bind($crate::storage::curator::translations_json(&a.translations))
                     .bind($crate::storage::now_ms())
                     .fetch_one(&self.pool)
                     .await
@@ -140,6 +152,7 @@ macro_rules! curator_storage {
                     .bind(serde_json::json!(a.normal).to_string())
                     .bind(a.view.as_ref().map(|v| v.to_string()))
                     .bind(a.language.clone())
+                    .bind($crate::storage::curator::translations_json(&a.translations))
                     .bind($crate::storage::now_ms())
                     .execute(&self.pool)
                     .await
@@ -167,6 +180,7 @@ macro_rules! curator_storage {
                         .bind(serde_json::json!(a.normal).to_string())
                         .bind(a.view.as_ref().map(|v| v.to_string()))
                         .bind(a.language.clone())
+                        .bind($crate::storage::curator::translations_json(&a.translations))
                         .bind(now)
                         .fetch_one(&mut *tx)
                         .await

@@ -132,6 +132,8 @@ pub struct AnnotationRecord {
     pub view: Option<serde_json::Value>,
     /// BCP 47 tag of the title and text, when stated.
     pub language: Option<String>,
+    /// The title and text in further languages.
+    pub translations: AnnotationTranslations,
     pub created_at_ms: i64,
     pub updated_at_ms: i64,
 }
@@ -147,6 +149,26 @@ pub struct NewAnnotation {
     pub view: Option<serde_json::Value>,
     /// BCP 47 tag of the title and text, when stated.
     pub language: Option<String>,
+    /// The title and text in further languages, rendered.
+    pub translations: AnnotationTranslations,
+}
+
+/// An annotation's title and text in one further language.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize, utoipa::ToSchema)]
+pub struct AnnotationText {
+    pub title: String,
+    /// Markdown source.
+    pub text: String,
+    /// `text` rendered and sanitised.
+    pub html: String,
+}
+
+/// Per BCP 47 tag.
+pub type AnnotationTranslations = std::collections::BTreeMap<String, AnnotationText>;
+
+/// The column's JSON; `None` (NULL) when there are none.
+pub(crate) fn translations_json(t: &AnnotationTranslations) -> Option<String> {
+    (!t.is_empty()).then(|| serde_json::json!(t).to_string())
 }
 
 /// Where an upload's ingest stands.

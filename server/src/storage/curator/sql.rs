@@ -2,16 +2,17 @@
 //! types that decode alike; see `storage/sql.rs`).
 
 pub(crate) const ANNOTATIONS: &str = "SELECT id, model_slug, title, body, html, position, normal, \
-     saved_view, language, created_at, updated_at FROM annotation WHERE model_slug = $1 \
+     saved_view, language, translations, created_at, updated_at FROM annotation WHERE model_slug = $1 \
      ORDER BY id";
 pub(crate) const ANNOTATION: &str = "SELECT id, model_slug, title, body, html, position, normal, \
-     saved_view, language, created_at, updated_at FROM annotation \
+     saved_view, language, translations, created_at, updated_at FROM annotation \
      WHERE model_slug = $1 AND id = $2";
 pub(crate) const INSERT_ANNOTATION: &str = "INSERT INTO annotation \
-     (model_slug, title, body, html, position, normal, saved_view, language, created_at, \
-     updated_at) VALUES ($1, $2, $3, $4, $5, $6, $7, $8, $9, $9) RETURNING id";
+     (model_slug, title, body, html, position, normal, saved_view, language, translations, \
+     created_at, updated_at) VALUES ($1, $2, $3, $4, $5, $6, $7, $8, $9, $10, $10) RETURNING id";
 pub(crate) const UPDATE_ANNOTATION: &str = "UPDATE annotation SET title = $3, body = $4, \
-     html = $5, position = $6, normal = $7, saved_view = $8, language = $9, updated_at = $10 \
+     html = $5, position = $6, normal = $7, saved_view = $8, language = $9, translations = $10, \
+     updated_at = $11 \
      WHERE model_slug = $1 AND id = $2";
 pub(crate) const DELETE_ANNOTATION: &str =
     "DELETE FROM annotation WHERE model_slug = $1 AND id = $2";

@@ -1,0 +1,131 @@
+//! Bytes per component of the point stream for a cloud sampled on a mesh's
+//! triangles (area-weighted, seeded), as a positions-only scan arrives:
+//!
+//! ```sh
+//! cargo run --release -p vitrine-points --example point_bytes -- MESH [POINTS] [--write DIR]
+//! ```
+//! For 12 and 14 bits and each stream version, prints positions-only bytes,
+//! the bytes that normals (estimated as at ingest) add, encode and decode ms
+//! (median of 3), and (stderr) the time normal estimation takes. Colours: the
+//! sampled cloud has none (0 bytes). With
+//! `--write DIR`, writes DIR/NAME-POINTS.f32 (x y z little-endian f32) for
+//! the Draco comparison.
+
+use std::time::Instant;
+
+use vitrine_mesh::import::{import_path, ImportOptions};
+use vitrine_points::stream::{decode, encode, EncodeOptions, Limits};
+use vitrine_points::testing::{next, unit};
+use vitrine_points::{estimate_normals, PointCloud, DEFAULT_K};
+
+/// `n` points uniformly on the triangles (area-weighted), seeded.
+fn sample(positions: &[[f32; 3]], triangles: &[[u32; 3]], n: usize, seed: u64) -> Vec<[f32; 3]> {
+    let corner = |t: &[u32; 3], i: usize| positions[t[i] as usize].map(f64::from);
+    let mut cumulative = Vec::with_capacity(triangles.len());
+    let mut total = 0.0f64;
+    for t in triangles {
+        let (a, b, c) = (corner(t, 0), corner(t, 1), corner(t, 2));
+        let u = [0, 1, 2].map(|k| b[k] - a[k]);
+        let v = [0, 1, 2].map(|k| c[k] - a[k]);
+        let x = [
+            u[1] * v[2] - u[2] * v[1],
+            u[2] * v[0] - u[0] * v[2],
+            u[0] * v[1] - u[1] * v[0],
+        ];
+        total += 0.5 * (x[0] * x[0] + x[1] * x[1] + x[2] * x[2]).sqrt();
+        cumulative.push(total);
+    }
+    let mut s = seed;
+    (0..n)
+        .map(|_| {
+            let r = (next(&mut s) >> 11) as f64 / (1u64 << 53) as f64 * total;
+            let t = &triangles[cumulative
+                .partition_point(|&c| c < r)
+                .min(triangles.len() - 1)];
+            let (mut e1, mut e2) = (f64::from(unit(&mut s)), f64::from(unit(&mut s)));
+            if e1 + e2 > 1.0 {
+                (e1, e2) = (1.0 - e1, 1.0 - e2);
+            }
+            let (a, b, c) = (corner(t, 0), corner(t, 1), corner(t, 2));
+            [0, 1, 2].map(|k| (a[k] + e1 * (b[k] - a[k]) + e2 * (c[k] - a[k])) as f32)
+        })
+        .collect()
+}
+
+fn median_ms(mut f: impl FnMut()) -> f64 {
+    let mut t: Vec<f64> = (0..3)
+        .map(|_| {
+            let s = Instant::now();
+            f();
+            s.elapsed().as_secs_f64() * 1e3
+        })
+        .collect();
+    t.sort_by(f64::total_cmp);
+    t[1]
+}
+
+fn main() {
+    let mut args: Vec<String> = std::env::args().skip(1).collect();
+    let write = args.iter().position(|a| a == "--write").map(|i| {
+        let dir = args.get(i + 1).expect("--write DIR").clone();
+        args.drain(i..i + 2);
+        std::path::PathBuf::from(dir)
+    });
+    let path = args.first().expect("usage: point_bytes MESH [POINTS]");
+    let n: usize = args.get(1).map_or(300_000, |a| a.parse().expect("POINTS"));
+    let mesh = import_path(path.as_ref(), &ImportOptions::default()).expect("import");
+    let positions = sample(&mesh.positions, &mesh.triangles, n, 0x5eed);
+    let name = std::path::Path::new(path)
+        .file_stem()
+        .unwrap()
+        .to_string_lossy()
+        .to_string();
+    if let Some(dir) = &write {
+        let raw: Vec<u8> = positions
+            .iter()
+            .flatten()
+            .flat_map(|v| v.to_le_bytes())
+            .collect();
+        std::fs::write(dir.join(format!("{name}-{n}.f32")), raw).expect("write");
+    }
+    // What the ingest (and, for a stream without normals, the viewer's
+    // WebAssembly session) spends estimating them.
+    let started = Instant::now();
+    let normals = estimate_normals(&positions, DEFAULT_K);
+    eprintln!(
+        "estimate_normals: {:.0} ms",
+        started.elapsed().as_secs_f64() * 1e3
+    );
+    let bare = PointCloud::from_positions(positions);
+    let with_normals = PointCloud {
+        normals: Some(normals),
+        ..bare.clone()
+    };
+    println!("cloud\tpoints\tbits\tversion\tposition_bytes\tpos_bits_per_point\tnormal_bytes\tencode_ms\tdecode_ms");
+    for bits in [12u8, 14] {
+        for version in [1u8, 2] {
+            let opts = EncodeOptions {
+                bits,
+                version,
+                ..Default::default()
+            };
+            let pos = encode(&bare, &opts).expect("encode");
+            let d = decode(&pos.bytes, None, Limits::default()).expect("decode");
+            assert_eq!(d.quantized(), &pos.quantized[..], "round trip");
+            let encode_ms = median_ms(|| {
+                std::hint::black_box(encode(&bare, &opts).expect("encode"));
+            });
+            let decode_ms = median_ms(|| {
+                let d = decode(&pos.bytes, None, Limits::default()).expect("decode");
+                std::hint::black_box(d.point_count());
+            });
+            let all = encode(&with_normals, &opts).expect("encode");
+            println!(
+                "{name}\t{n}\t{bits}\tv{version}\t{}\t{:.2}\t{}\t{encode_ms:.0}\t{decode_ms:.0}",
+                pos.bytes.len(),
+                pos.bytes.len() as f64 * 8.0 / n as f64,
+                all.bytes.len() - pos.bytes.len(),
+            );
+        }
+    }
+}
