@@ -151,7 +151,12 @@ make_profile() { # once: the decode time of each level of the sample model
 
 pg_start() {
     runuser -u postgres -- "$pg_bin/pg_ctl" -D "$pg_data" -w -l "$work/pg/log" \
-        -o "-p $pg_port -k $work/pg -c listen_addresses=127.0.0.1 -c fsync=off" start >/dev/null
+        -o "-p $pg_port -k $work/pg -c listen_addresses=127.0.0.1 -c fsync=off" start >/dev/null || {
+        # The work directory goes with the exit trap: show why here.
+        echo "PostgreSQL did not start on port $pg_port; its log:" >&2
+        tail -n 30 "$work/pg/log" >&2 || true
+        return 1
+    }
 }
 pg_stop() { runuser -u postgres -- "$pg_bin/pg_ctl" -D "$pg_data" -m fast -w stop >/dev/null; }
 

@@ -19,7 +19,7 @@
 # 503 + Retry-After, recovery without restarting Vitrine), leak (a
 # researcher's manifest never reaches a public visitor through the cache).
 #
-# Environment: VISITORS (5000; short 300), TOPO_PG_PORT (55432), TOPO_PORT
+# Environment: VISITORS (5000; short 300), TOPO_PG_PORT (25533), TOPO_PORT
 # (18200: nginx; +1, +2 the instances), NO_BUILD (use the built binaries),
 # KEEP_WORK (keep the work directory), COHERENCE_BOUND_S (5), BIN_DIR
 # (target/release: where vitrine and vitrine-load are).
@@ -61,7 +61,10 @@ bound=${COHERENCE_BOUND_S:-5}
 work=$(mktemp -d /tmp/vitrine-topology.XXXXXX)
 chmod 755 "$work"
 port=${TOPO_PORT:-18200}
-pg_port=${TOPO_PG_PORT:-55432}
+# Below the kernel's ephemeral range (32768–60999): stop 49's CI could not
+# start PostgreSQL on 55432, most likely because a client socket of an
+# earlier step held that port (faults.sh met the same on 55434).
+pg_port=${TOPO_PG_PORT:-25533}
 ports=($((port + 1)) $((port + 2)))
 proxy=http://127.0.0.1:$port
 results=$work/topology.md
@@ -92,7 +95,12 @@ code() { curl -s -o /dev/null -w '%{http_code}' "$@"; }
 # PostgreSQL of our own.
 pg_start() {
     runuser -u postgres -- "$pg_bin/pg_ctl" -D "$pg_data" -w -l "$work/pg/log" \
-        -o "-p $pg_port -k $work/pg -c listen_addresses=127.0.0.1 -c fsync=off -c max_connections=200" start >/dev/null
+        -o "-p $pg_port -k $work/pg -c listen_addresses=127.0.0.1 -c fsync=off -c max_connections=200" start >/dev/null || {
+        # The work directory goes with the exit trap: show why here.
+        echo "PostgreSQL did not start on port $pg_port; its log:" >&2
+        tail -n 30 "$work/pg/log" >&2 || true
+        return 1
+    }
 }
 pg_stop() { runuser -u postgres -- "$pg_bin/pg_ctl" -D "$pg_data" -m fast -w stop >/dev/null; }
 mkdir -p "$work/pg"
