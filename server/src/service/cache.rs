@@ -1,12 +1,15 @@
 //! In-memory caches, so a crowd on one model does not hit the database per request.
 //!
 //! Payloads (immutable: base meshes and batches) sit in a cache bounded by a
-//! byte budget. Model records, token grants and the model list (which carry
+//! byte budget, a charted stream's part and split rows (as immutable) in
+//! one bounded by rows. Model records, token grants and the model list (which carry
 //! policies, so they may change) expire after a TTL. Concurrent misses on one
 //! key share a single database read (moka's `entry().or_try_insert_with`).
 
 use super::metrics::Metrics;
-use crate::storage::{ModelRecord, ModelSummary, StorageError, TokenGrant};
+use crate::storage::{
+    ModelRecord, ModelSummary, PartRecord, SplitRecord, StorageError, TokenGrant,
+};
 use bytes::Bytes;
 use moka::future::Cache;
 use std::future::Future;
@@ -50,6 +53,26 @@ impl Payload {
     }
 }
 
+/// A charted or nested stream's part and split rows, as stored at ingest:
+/// every part request of a nested stream reads them (the layout of a batch
+/// needs the one before's phase and chart count), so a close-up crowd would
+/// otherwise query them once per part.
+#[derive(Debug, Default)]
+pub struct PartRows {
+    pub parts: Vec<PartRecord>,
+    pub splits: Vec<SplitRecord>,
+}
+
+impl PartRows {
+    fn weight(&self) -> u32 {
+        u32::try_from(self.parts.len() + self.splits.len() + 1).unwrap_or(u32::MAX)
+    }
+}
+
+/// Rows of [`PartRows`] kept, all streams together: a 20 M-vertex nested
+/// stream has some 20,000.
+const MAX_PART_ROWS: u64 = 2_000_000;
+
 /// Sizes and lifetimes.
 #[derive(Clone, Debug, PartialEq)]
 pub struct CacheConfig {
@@ -76,6 +99,8 @@ pub struct Caches {
     pub(super) by_compression: Cache<i64, Option<Arc<ModelRecord>>>,
     pub(super) tokens: Cache<String, Option<TokenGrant>>,
     pub(super) list: Cache<(), Arc<Vec<ModelSummary>>>,
+    /// By compression id; never stale (a compression's rows never change).
+    pub(super) part_rows: Cache<i64, Arc<PartRows>>,
 }
 
 impl Caches {
@@ -99,6 +124,10 @@ impl Caches {
             by_compression: records(config.max_records, ttl),
             tokens: records(config.max_records, ttl),
             list: records(1, ttl),
+            part_rows: Cache::builder()
+                .max_capacity(MAX_PART_ROWS)
+                .weigher(|_: &i64, rows: &Arc<PartRows>| rows.weight())
+                .build(),
         }
     }
 

@@ -17,6 +17,7 @@
 //! parted batch's phase and chart count from the part rows
 //! (`vitrine_codec::NestedLayout::parse_after`), never loading that batch.
 
+use super::cache::{through, PartRows};
 use super::error::{AppError, ErrorBody, LevelCappedBody};
 use super::payload::{
     cache_control, level_bytes, not_modified, not_modified_response, parse_id, payload_response,
@@ -30,6 +31,7 @@ use axum::http::{HeaderMap, HeaderValue};
 use axum::response::{IntoResponse, Response};
 use axum::Json;
 use serde::{Deserialize, Serialize};
+use std::sync::Arc;
 use utoipa::{IntoParams, ToSchema};
 use vitrine_codec::{NestedLayout, PartedLayout, NESTED_VERSION};
 
@@ -167,7 +169,8 @@ pub async fn index(
     let id = parse_id(&id, "compression id")?;
     let record = state.record_by_compression(id).await?;
     let ServableModel { record, .. } = ServableModel::decide(&state, record, &hints).await?;
-    let rows = state.storage().parts(id).await?;
+    let stored = part_rows(&state, id).await?;
+    let rows = &stored.parts;
     let (Some(first), Some(charts), Some(phases)) = (
         rows.iter().map(|p| p.iteration).min(),
         rows.iter()
@@ -179,11 +182,7 @@ pub async fn index(
         return Err(AppError::NotFound("parts"));
     };
     let nested = record.stream_format == NESTED_VERSION;
-    let splits = if nested {
-        state.storage().splits(id).await?
-    } else {
-        Vec::new()
-    };
+    let splits: &[_] = if nested { &stored.splits } else { &[] };
     let index = PartIndex {
         compression_id: id,
         charts,
@@ -192,7 +191,7 @@ pub async fn index(
         head_url: format!("/api/compressions/{id}/batches/{first}/head"),
         part_url: format!("/api/compressions/{id}/batches/{{level}}/parts/{{chart}}"),
         parts: rows
-            .into_iter()
+            .iter()
             .map(|p| PartEntry {
                 level: p.iteration,
                 chart: p.chart,
@@ -206,7 +205,7 @@ pub async fn index(
         split_url: nested
             .then(|| format!("/api/compressions/{id}/batches/{{level}}/splits/{{parent}}")),
         splits: splits
-            .into_iter()
+            .iter()
             .map(|s| SplitEntry {
                 level: s.iteration,
                 parent: s.parent,
@@ -429,6 +428,25 @@ async fn serve_piece(
     ))
 }
 
+/// A compression's part and split rows, through the cache.
+async fn part_rows(state: &AppState, id: i64) -> Result<Arc<PartRows>, AppError> {
+    let storage = state.storage();
+    let load = async {
+        Ok(Arc::new(PartRows {
+            parts: storage.parts(id).await?,
+            splits: storage.splits(id).await?,
+        }))
+    };
+    Ok(through(
+        &state.caches().part_rows,
+        state.metrics(),
+        "parts",
+        id,
+        load,
+    )
+    .await?)
+}
+
 /// The phase and chart count of the parted batch before `iteration`, from
 /// the part rows; `None` when `iteration` is the first parted batch.
 async fn previous_parted(
@@ -436,8 +454,9 @@ async fn previous_parted(
     id: i64,
     iteration: u32,
 ) -> Result<Option<(usize, usize)>, AppError> {
-    let rows = state.storage().parts(id).await?;
+    let rows = part_rows(state, id).await?;
     let before: Vec<_> = rows
+        .parts
         .iter()
         .filter(|p| p.iteration + 1 == iteration)
         .collect();

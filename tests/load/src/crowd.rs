@@ -93,6 +93,7 @@ fn crowd_config(args: &CrowdArgs) -> CrowdConfig {
             .sigterm_pid
             .map(|p| (p, Duration::from_secs_f64(args.sigterm_after_s))),
         sequential: false,
+        close_up: args.mix.close_up,
     }
 }
 

@@ -10,6 +10,7 @@
 //! ```
 //! See tests/README.md and scripts/load.sh, scripts/faults.sh.
 
+mod close_up;
 mod crowd;
 mod faults;
 mod hostile;
@@ -59,6 +60,11 @@ struct Mix {
     /// refining further when the cap has risen (0: stop at the first cap).
     #[arg(long, default_value_t = 30.0)]
     stay_s: f64,
+    /// Each visitor looks closely at one region of a charted or nested
+    /// stream and fetches only its parts once the charts begin, as the
+    /// viewer's `?refine=view` does (streams without parts: whole batches).
+    #[arg(long)]
+    close_up: bool,
 }
 
 #[derive(Subcommand)]

@@ -122,6 +122,7 @@ impl Scenarios<'_> {
             stay: Duration::from_secs_f64(mix.stay_s.max(0.0)),
             sigterm: None,
             sequential,
+            close_up: mix.close_up,
         }
     }
 

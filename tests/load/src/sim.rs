@@ -10,6 +10,7 @@
 //! wait and refines further once the cap has risen, for as long as it stays
 //! (`CrowdConfig::stay`). Any other failure ends the visit.
 
+use crate::close_up::{ClosePath, PartIndex};
 use crate::http::Conn;
 use anyhow::{Context, Result};
 use reqwest::Client;
@@ -189,6 +190,10 @@ pub struct CrowdConfig {
     pub sigterm: Option<(u32, Duration)>,
     /// Only the first visitor of each (device, audience) pair, one after another.
     pub sequential: bool,
+    /// Visitors look closely at one region each and fetch only its parts
+    /// once the charts begin (`close_up.rs`), as the viewer's
+    /// `?refine=view` does; streams without parts are refined whole.
+    pub close_up: bool,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -197,6 +202,10 @@ pub enum Kind {
     Texture,
     Base,
     Batch,
+    /// A charted stream's part index (close-ups).
+    PartIndex,
+    /// A head, part or split entry of a parted batch (close-ups).
+    Part,
 }
 
 /// One HTTP request as the visitor saw it.
@@ -416,7 +425,12 @@ impl Visit {
     }
 
     async fn decode_wait(&self, level: usize, device: Device) {
-        let ms = self.profile.decode_ms.get(level).copied().unwrap_or(0.0);
+        self.decode_wait_share(level, device, 1.0).await;
+    }
+
+    /// [`Self::decode_wait`] for `share` of the level's decoding.
+    async fn decode_wait_share(&self, level: usize, device: Device, share: f64) {
+        let ms = share * self.profile.decode_ms.get(level).copied().unwrap_or(0.0);
         let factor = match device {
             Device::Desktop => 1.0,
             Device::Tablet => self.config.tablet_factor,
@@ -449,7 +463,10 @@ impl Visit {
             page.result.failure = Some("manifest lists fewer levels than its cap".into());
             return (page.result, page.reqs);
         }
-        if self.textures(&mut page, &manifest).await && self.base(&mut page, &urls[0], t0).await {
+        if self.textures(&mut page, &manifest).await
+            && self.base(&mut page, &urls[0], t0).await
+            && self.close_up(&mut page, &manifest).await
+        {
             self.refine_while_staying(&mut page, &path, &manifest, urls, t0)
                 .await;
         }
@@ -481,6 +498,7 @@ impl Visit {
             arrived,
             device,
             sizes: Vec::new(),
+            close: None,
         }
     }
 
@@ -537,6 +555,50 @@ impl Visit {
             }
         }
         true
+    }
+
+    /// A close-up visitor's path through the parts (`close_up.rs`): the
+    /// part index, fetched once; false when it fails. Nothing for a
+    /// visitor who refines whole batches or a stream without parts.
+    async fn close_up(&self, page: &mut Page, manifest: &serde_json::Value) -> bool {
+        let link = manifest["nested_parts"]
+            .as_str()
+            .or(manifest["parts"].as_str());
+        let (true, Some(link)) = (self.config.close_up, link) else {
+            return true;
+        };
+        let who = page.result.who;
+        let f = self
+            .fetch_retrying(
+                &mut page.conn,
+                Kind::PartIndex,
+                link,
+                true,
+                who,
+                &mut page.reqs,
+            )
+            .await;
+        page.reqs.push(f.req);
+        if f.req.status != 200 {
+            page.fail(&f, "part index");
+            return false;
+        }
+        let path = f
+            .body
+            .as_deref()
+            .ok_or_else(|| "an empty part index".to_owned())
+            .and_then(|b| serde_json::from_slice::<PartIndex>(b).map_err(|e| e.to_string()))
+            .and_then(|index| index.close_path(jitter(who, 4242)));
+        match path {
+            Ok(path) => {
+                page.close = Some(path);
+                true
+            }
+            Err(e) => {
+                page.result.failure = Some(format!("part index: {e}"));
+                false
+            }
+        }
     }
 
     /// The base mesh, fetched and decoded: level 0 on screen.
@@ -652,6 +714,17 @@ impl Visit {
         let who = page.result.who;
         let mut prefetch: Option<tokio::task::JoinHandle<Prefetch>> = None;
         for k in from..=page.result.target as usize {
+            if let Some((step, bytes)) = page.close_step(k) {
+                if let Some(stop) = self.fetch_close_step(page, k, &step).await {
+                    return stop;
+                }
+                // Decoding one region's parts: the level's time in proportion.
+                let whole = page.sizes.get(k).copied().unwrap_or(0).max(1);
+                let share = (bytes as f64 / whole as f64).min(1.0);
+                self.decode_wait_share(k, page.device, share).await;
+                page.result.level_ms.push(t0.elapsed().as_secs_f64() * 1e3);
+                continue;
+            }
             let f = match prefetch.take() {
                 Some(handle) => match handle.await {
                     Ok((f, c, retried)) => {
@@ -690,13 +763,29 @@ impl Visit {
                 ));
                 return Stop::Failed;
             }
-            if k < page.result.target as usize {
+            if k < page.result.target as usize && page.close_step(k + 1).is_none() {
                 prefetch = Some(self.prefetch(page, urls[k + 1].clone()));
             }
             self.decode_wait(k, page.device).await;
             page.result.level_ms.push(t0.elapsed().as_secs_f64() * 1e3);
         }
         Stop::AtCap
+    }
+
+    /// A close-up's URLs for level `k`, one after another: the stop, if
+    /// one answer stops refinement.
+    async fn fetch_close_step(&self, page: &mut Page, k: usize, urls: &[String]) -> Option<Stop> {
+        let who = page.result.who;
+        for url in urls {
+            let f = self
+                .fetch_retrying(&mut page.conn, Kind::Part, url, false, who, &mut page.reqs)
+                .await;
+            page.reqs.push(f.req);
+            if let Some(stop) = page.refused_or_failed(&f, k) {
+                return Some(stop);
+            }
+        }
+        None
     }
 
     /// Fetches `url` on the page's connection in a task of its own, while
@@ -735,9 +824,18 @@ struct Page {
     device: Device,
     /// Each level's payload size in the first manifest.
     sizes: Vec<u64>,
+    /// A close-up visitor's path through the parts.
+    close: Option<ClosePath>,
 }
 
 impl Page {
+    /// What a close-up fetches for level `k` (URLs, bytes); `None` for a
+    /// whole batch.
+    fn close_step(&self, k: usize) -> Option<(Vec<String>, u64)> {
+        let path = self.close.as_ref()?;
+        path.steps.get(k.checked_sub(path.first_level)?).cloned()
+    }
+
     fn fail(&mut self, f: &Fetched, what: &str) {
         self.result.failure = Some(
             f.error
