@@ -61,6 +61,8 @@ impl Payload {
 pub struct PartRows {
     pub parts: Vec<PartRecord>,
     pub splits: Vec<SplitRecord>,
+    /// The index as served (`parts::index`), serialized on first use.
+    pub index_json: std::sync::OnceLock<Bytes>,
 }
 
 impl PartRows {
