@@ -1,0 +1,206 @@
+// @ts-check
+// End-to-end: view-dependent refinement of a nested stream (format 6, issue
+// 41). A 40 k-vertex sphere cut into a tree of charts (4 top charts, each
+// split in 2, 3 phases), served by the real `vitrine serve`; the page opens
+// zoomed onto the front of the sphere with `?refine=view`. The chart under
+// the camera reaches the last phase at its final depth, bit for bit the
+// whole decoder's chart; the charts behind stay coarser; fewer bytes than
+// the whole stream; resident vertices within the budget, also a budget
+// small enough to make the viewer fold subtrees back.
+import { after, before, test } from 'node:test';
+import assert from 'node:assert/strict';
+import { readFileSync } from 'node:fs';
+import { launch } from '../test/support/browser.mjs';
+import { startService } from '../test/support/service.mjs';
+import { wasmPath } from '../test/support/fixtures.mjs';
+import { VitrineCodec } from '../src/codec.js';
+
+/** @typedef {import('playwright-core').Page} Page */
+/** @typedef {import('../src/nested-refinement.js').NestedState} NestedState */
+
+/** Zoomed onto the sphere's front, 0.5 above its surface (view-state.js: target, distance, yaw, pitch). */
+const CAMERA = 'camera=0,0,1,0.5,0,0';
+
+/** @type {Awaited<ReturnType<typeof startService>>} */
+let service;
+/** @type {Awaited<ReturnType<typeof launch>>} */
+let browser;
+/** @type {any} */
+let manifest;
+
+before(async () => {
+  service = await startService({
+    models: [{ slug: 'tree', title: 'Nested sphere', kind: 'sphere', kiloVertices: 40, colour: true, ingestArgs: ['--charts', 'nested:4,2,3'] }],
+  });
+  browser = await launch({ width: 640, height: 480 });
+  manifest = await (await fetch(`${service.url}/api/models/tree`)).json();
+  assert.equal(manifest.stream_format, 6);
+  assert.ok(manifest.nested_parts, 'the manifest links the nested part index');
+  assert.equal(manifest.parts, undefined);
+});
+
+after(async () => {
+  await browser?.close();
+  await service?.stop();
+});
+
+/**
+ * Opens the model page and records every failed request and console error.
+ * @param {string} query
+ * @param {string} [view] the page's fragment (view-state.js)
+ */
+async function open(query, view = CAMERA) {
+  const page = await browser.context.newPage();
+  /** @type {string[]} */
+  const problems = [];
+  page.on('pageerror', (e) => problems.push(`page error: ${e.message}`));
+  page.on('console', (m) => {
+    if (m.type() === 'error') problems.push(`console: ${m.text()}`);
+  });
+  page.on('requestfailed', (r) => problems.push(`failed: ${r.url()}`));
+  page.on('response', (r) => {
+    if (r.status() >= 400) problems.push(`${r.status()}: ${r.url()}`);
+  });
+  /** @type {string[]} */
+  const requests = [];
+  page.on('request', (r) => requests.push(r.url()));
+  const started = Date.now();
+  await page.goto(`${service.url}/m/tree?${query}${view ? `#${view}` : ''}`);
+  return { page, problems, started, requests };
+}
+
+/** @param {Page} page @returns {Promise<NestedState & { status: string, message?: string }>} */
+async function settled(page) {
+  await page.waitForFunction(
+    () => {
+      const v = /** @type {any} */ (document.querySelector('vitrine-viewer'))?.viewer;
+      const p = v?.partsState();
+      // Settled, and the union posted last on screen (its level: the finest chart's).
+      return v?.state.status === 'error' || (p && p.settled && v.state.shownLevel >= p.level);
+    },
+    undefined,
+    { timeout: 40_000, polling: 100 },
+  );
+  return page.evaluate(() => {
+    const v = /** @type {any} */ (document.querySelector('vitrine-viewer')).viewer;
+    return { ...v.partsState(), status: v.state.status, message: v.state.message };
+  });
+}
+
+/**
+ * Every chart held, as the page holds it.
+ * @param {Page} page
+ * @param {number[][]} depths the state's
+ * @returns {Promise<{ phase: number, chart: number, depth: number, positions: number[], indices: number[] }[]>}
+ */
+function pageCharts(page, depths) {
+  return page.evaluate(async (depths) => {
+    const v = /** @type {any} */ (document.querySelector('vitrine-viewer')).viewer;
+    const out = [];
+    for (const [phase, charts] of depths.entries()) {
+      for (const [chart, depth] of charts.entries()) {
+        if (depth < 0) continue;
+        const c = await v.partChart(chart, phase);
+        out.push({ phase, chart, depth: c.depth, positions: Array.from(c.positions), indices: Array.from(c.indices) });
+      }
+    }
+    return out;
+  }, depths);
+}
+
+/** The whole stream decoded in Node: every batch, as a uniform viewer would. */
+async function wholeDecoder() {
+  const codec = await VitrineCodec.instantiate(readFileSync(wasmPath));
+  /** @param {string} path */
+  const get = async (path) => new Uint8Array(await (await fetch(new URL(path, `${service.url}/api/models/tree`))).arrayBuffer());
+  const decoder = codec.decoder(await get(manifest.levels[0].url));
+  for (const level of manifest.levels.slice(1)) decoder.apply(await get(level.url));
+  return { codec, decoder };
+}
+
+/** @param {number[]} positions @param {(x: number, y: number, z: number) => boolean} where */
+function some(positions, where) {
+  for (let i = 0; i < positions.length; i += 3) if (where(positions[i], positions[i + 1], positions[i + 2])) return true;
+  return false;
+}
+
+/** @param {Page} page @param {number} distance */
+async function zoomTo(page, distance) {
+  await page.evaluate((distance) => {
+    const v = /** @type {any} */ (document.querySelector('vitrine-viewer')).viewer;
+    v.camera.state = { target: [0, 0, 1], distance, yaw: 0, pitch: 0 };
+    v.renderer.requestFrame();
+    v.cameraMoved();
+  }, distance);
+}
+
+test('the chart under the camera goes down to the last phase, the ones behind stay coarse, bit for bit the whole decoder', async () => {
+  const { page, problems, started } = await open('refine=view');
+  const state = await settled(page);
+  const elapsed = Date.now() - started;
+  assert.equal(state.status === 'error', false, String(state.message));
+  assert.equal(state.kind, 'nested');
+  assert.ok(state.phases >= 3, `${state.phases} phases`);
+  const whole = manifest.levels.reduce((/** @type {number} */ n, /** @type {{ bytes: number }} */ l) => n + l.bytes, 0);
+  console.log(
+    `nested: settled in ${elapsed} ms; charts held per phase ${state.residentCharts.join(' ')} of ${state.charts.join(' ')}, ` +
+      `shown ${state.shownCharts.join(' ')}; ${state.resident} vertices resident (budget ${state.budget}); ` +
+      `${state.bytesFetched} of ${whole} bytes`,
+  );
+  const last = state.phases - 1;
+  const charts = await pageCharts(page, state.depths);
+  // The leaf under the camera's target (0, 0, 1).
+  const front = charts.find((c) => c.phase === last && some(c.positions, (x, y, z) => Math.hypot(x, y, z - 1) < 0.05));
+  assert.ok(front, 'a chart of the last phase holds the point the camera looks at');
+  assert.equal(front.depth, state.finalDepth, 'the chart in view reaches the final depth');
+  // Charts held wholly behind the sphere: none of the last phase at its final depth.
+  const behind = charts.filter((c) => !some(c.positions, (_x, _y, z) => z > 0.1));
+  assert.ok(behind.length > 0, 'some charts held lie behind the sphere');
+  for (const c of behind) assert.ok(c.phase < last || c.depth < state.finalDepth, `a chart behind stays coarser (phase ${c.phase}, depth ${c.depth})`);
+  assert.ok(
+    state.depths[last].some((d) => d < 0),
+    'some leaves are never made',
+  );
+  assert.ok(state.resident <= state.budget);
+  assert.ok(state.bytesFetched < whole, `${state.bytesFetched} bytes fetched, the whole stream is ${whole}`);
+  // Bit for bit the chart a whole decoder makes at the last level.
+  const { codec, decoder } = await wholeDecoder();
+  const theirs = decoder.chartView(front.chart).positions.slice();
+  assert.deepEqual(Buffer.from(new Float32Array(front.positions).buffer), Buffer.from(theirs.buffer), 'its positions are the whole decoder chart');
+  const e = codec.exports;
+  const ptr = e.chart_buffer_ptr(decoder.handle, front.chart, 2);
+  const len = e.chart_buffer_len(decoder.handle, front.chart, 2);
+  const indices = new Uint32Array(e.memory.buffer.slice(ptr, ptr + 4 * len));
+  assert.deepEqual(Array.from(indices), front.indices, 'its triangles are the whole decoder chart');
+  decoder.free();
+  assert.deepEqual(problems, []);
+  await page.close();
+});
+
+test('a small vertex budget: subtrees folded back, never more resident than the budget', async () => {
+  // From the home view, the whole sphere refines until the budget is spent.
+  const probe = await open('refine=view', '');
+  const home = await settled(probe.page);
+  await probe.page.close();
+  const budget = Math.round(home.resident * 0.8);
+  const { page, problems } = await open(`refine=view&vertex-budget=${budget}`, '');
+  const first = await settled(page);
+  assert.equal(first.budget, budget);
+  assert.ok(first.resident <= budget, `${first.resident} resident, budget ${budget}`);
+  // Right up to the front: the charts under the camera want more than the
+  // rest would miss folded back, so the rest fold.
+  await zoomTo(page, 0.03);
+  await page.waitForFunction(() => /** @type {any} */ (document.querySelector('vitrine-viewer')).viewer.partsState().evictions > 0, undefined, {
+    timeout: 20_000,
+    polling: 100,
+  });
+  const second = await settled(page);
+  console.log(
+    `nested, budget ${budget}: ${first.resident} resident at home (shown per phase ${first.shownCharts.join(' ')}), ` +
+      `${second.resident} up close (shown ${second.shownCharts.join(' ')}), ${second.evictions} subtrees folded back`,
+  );
+  assert.ok(second.resident <= budget, `${second.resident} resident, budget ${budget}`);
+  assert.ok(second.evictions > 0);
+  assert.deepEqual(problems, []);
+  await page.close();
+});
