@@ -107,7 +107,9 @@ pub extern "C" fn nested_layout_declare(level: u32, phase: u32, charts: u32, spl
             .collect()
     });
     if children.len() != splits as usize {
-        return fail(format!("{splits} children counts expected in the input buffer"));
+        return fail(format!(
+            "{splits} children counts expected in the input buffer"
+        ));
     }
     let declared = LAYOUTS.with(|l| {
         let previous = l.borrow().last().map(|p| (p.phase, p.parts.len()));

@@ -112,7 +112,7 @@ fn a_leaf_through_the_abi_is_the_full_decoders() {
 }
 
 /// Every chart's quantized positions, colours and triangles, phase by phase.
-fn snapshot(view: u32) -> Vec<(usize, usize, Vec<[u32; 3]>, Vec<u8>, Vec<u32>)> {
+fn snapshot(view: u32) -> Vec<(usize, usize, Vec<[i32; 3]>, Vec<u8>, Vec<u32>)> {
     with_view(view, |v| {
         let mut charts = Vec::new();
         for phase in 0..v.phase_count() {
@@ -191,7 +191,12 @@ fn a_view_declared_from_the_index_is_the_one_from_whole_batches() {
             .collect();
         put(&children);
         let charts = parts.len() as u32;
-        let n = nested_layout_declare(level as u32, parts[0].phase as u32, charts, splits.len() as u32);
+        let n = nested_layout_declare(
+            level as u32,
+            parts[0].phase as u32,
+            charts,
+            splits.len() as u32,
+        );
         assert_eq!(n, charts as i32, "level {level}");
     }
     let from_index = nested_new(declared, put(&head));
@@ -203,7 +208,11 @@ fn a_view_declared_from_the_index_is_the_one_from_whole_batches() {
     // A phase's split entries lie in its first batch's head, before its parts.
     let mut splits_done = 0;
     for part in &table.parts {
-        while let Some(split) = table.splits.get(splits_done).filter(|s| s.level <= part.level) {
+        while let Some(split) = table
+            .splits
+            .get(splits_done)
+            .filter(|s| s.level <= part.level)
+        {
             let entry = &stream[split.bytes.clone()];
             let (phase, parent) = (split.phase as u32 - 1, split.parent as u32);
             for view in [from_batches, from_index] {
@@ -219,7 +228,11 @@ fn a_view_declared_from_the_index_is_the_one_from_whole_batches() {
     }
     assert_eq!(splits_done, table.splits.len());
     let ours = snapshot(from_index);
-    assert_eq!(ours.iter().filter(|c| c.0 == 2).count(), 8, "every leaf decoded");
+    assert_eq!(
+        ours.iter().filter(|c| c.0 == 2).count(),
+        8,
+        "every leaf decoded"
+    );
     assert_eq!(ours, snapshot(from_batches));
     assert_eq!(nested_resident(from_index), nested_resident(from_batches));
     // The leaves are the full decoder's bit for bit.
