@@ -6,7 +6,8 @@
 // the camera reaches the last phase at its final depth, bit for bit the
 // whole decoder's chart; the charts behind stay coarser; fewer bytes than
 // the whole stream; resident vertices within the budget, also a budget
-// small enough to make the viewer fold subtrees back.
+// small enough to make the viewer fold subtrees back; a phone capped below
+// the last level fetches nothing past its cap.
 import { after, before, test } from 'node:test';
 import assert from 'node:assert/strict';
 import { readFileSync } from 'node:fs';
@@ -21,6 +22,9 @@ import { VitrineCodec } from '../src/codec.js';
 /** Zoomed onto the sphere's front, 0.5 above its surface (view-state.js: target, distance, yaw, pitch). */
 const CAMERA = 'camera=0,0,1,0.5,0,0';
 
+/** A phone's cap here: the sphere's last level (41 k vertices) is past it, the one before is not. */
+const PHONE_MAX_VERTICES = 20_000;
+
 /** @type {Awaited<ReturnType<typeof startService>>} */
 let service;
 /** @type {Awaited<ReturnType<typeof launch>>} */
@@ -31,6 +35,8 @@ let manifest;
 before(async () => {
   service = await startService({
     models: [{ slug: 'tree', title: 'Nested sphere', kind: 'sphere', kiloVertices: 40, colour: true, ingestArgs: ['--charts', 'nested:4,2,3'] }],
+    // A phone is capped one level short of the last (the third test).
+    serveArgs: ['--phone-max-vertices', String(PHONE_MAX_VERTICES)],
   });
   browser = await launch({ width: 640, height: 480 });
   manifest = await (await fetch(`${service.url}/api/models/tree`)).json();
@@ -200,6 +206,26 @@ test('a small vertex budget: subtrees folded back, never more resident than the 
   );
   assert.ok(second.resident <= budget, `${second.resident} resident, budget ${budget}`);
   assert.ok(second.evictions > 0);
+  assert.deepEqual(problems, []);
+  await page.close();
+});
+
+test('a phone capped below the last level: no part or split entry past the cap, the cap announced', async () => {
+  const { page, problems, requests } = await open('refine=view&device=phone');
+  await settled(page);
+  await page.waitForFunction(() => /** @type {any} */ (document.querySelector('vitrine-viewer')).viewer.state.status === 'capped', undefined, {
+    timeout: 10_000,
+  });
+  const state = await settled(page);
+  const phone = await (await fetch(`${service.url}/api/models/tree?device=phone`)).json();
+  const cap = phone.cap.level;
+  assert.ok(cap < phone.last_level, `the phone is capped (${cap} of ${phone.last_level})`);
+  assert.equal(state.status, 'capped');
+  assert.equal(state.level, cap, 'the chart in view refines up to the cap');
+  assert.equal(state.deepestPhase, state.phases - 1);
+  const levels = requests.map((url) => Number(url.match(/\/batches\/(\d+)/)?.[1] ?? 0));
+  assert.ok(Math.max(...levels) <= cap, 'nothing past the cap is requested');
+  assert.ok(requests.some((url) => /\/splits\//.test(url)), 'split entries were fetched');
   assert.deepEqual(problems, []);
   await page.close();
 });
