@@ -10,11 +10,9 @@
 // the last level fetches nothing past its cap.
 import { after, before, test } from 'node:test';
 import assert from 'node:assert/strict';
-import { readFileSync } from 'node:fs';
 import { launch } from '../test/support/browser.mjs';
 import { startService } from '../test/support/service.mjs';
-import { wasmPath } from '../test/support/fixtures.mjs';
-import { VitrineCodec } from '../src/codec.js';
+import { lookAt, openRecorded, settledParts, some, wholeDecoder } from '../test/support/refinement.mjs';
 
 /** @typedef {import('playwright-core').Page} Page */
 /** @typedef {import('../src/nested-refinement.js').NestedState} NestedState */
@@ -51,46 +49,20 @@ after(async () => {
 });
 
 /**
- * Opens the model page and records every failed request and console error.
+ * Opens the model page, recording every failed request and console error.
  * @param {string} query
  * @param {string} [view] the page's fragment (view-state.js)
  */
 async function open(query, view = CAMERA) {
-  const page = await browser.context.newPage();
-  /** @type {string[]} */
-  const problems = [];
-  page.on('pageerror', (e) => problems.push(`page error: ${e.message}`));
-  page.on('console', (m) => {
-    if (m.type() === 'error') problems.push(`console: ${m.text()}`);
-  });
-  page.on('requestfailed', (r) => problems.push(`failed: ${r.url()}`));
-  page.on('response', (r) => {
-    if (r.status() >= 400) problems.push(`${r.status()}: ${r.url()}`);
-  });
-  /** @type {string[]} */
-  const requests = [];
-  page.on('request', (r) => requests.push(r.url()));
+  const { page, problems, requests } = await openRecorded(browser.context);
   const started = Date.now();
   await page.goto(`${service.url}/m/tree?${query}${view ? `#${view}` : ''}`);
   return { page, problems, started, requests };
 }
 
 /** @param {Page} page @returns {Promise<NestedState & { status: string, message?: string }>} */
-async function settled(page) {
-  await page.waitForFunction(
-    () => {
-      const v = /** @type {any} */ (document.querySelector('vitrine-viewer'))?.viewer;
-      const p = v?.partsState();
-      // Settled, and the union posted last on screen (its level: the finest chart's).
-      return v?.state.status === 'error' || (p && p.settled && v.state.shownLevel >= p.level);
-    },
-    undefined,
-    { timeout: 40_000, polling: 100 },
-  );
-  return page.evaluate(() => {
-    const v = /** @type {any} */ (document.querySelector('vitrine-viewer')).viewer;
-    return { ...v.partsState(), status: v.state.status, message: v.state.message };
-  });
+function settled(page) {
+  return settledParts(page, 40_000);
 }
 
 /**
@@ -112,32 +84,6 @@ function pageCharts(page, depths) {
     }
     return out;
   }, depths);
-}
-
-/** The whole stream decoded in Node: every batch, as a uniform viewer would. */
-async function wholeDecoder() {
-  const codec = await VitrineCodec.instantiate(readFileSync(wasmPath));
-  /** @param {string} path */
-  const get = async (path) => new Uint8Array(await (await fetch(new URL(path, `${service.url}/api/models/tree`))).arrayBuffer());
-  const decoder = codec.decoder(await get(manifest.levels[0].url));
-  for (const level of manifest.levels.slice(1)) decoder.apply(await get(level.url));
-  return { codec, decoder };
-}
-
-/** @param {number[]} positions @param {(x: number, y: number, z: number) => boolean} where */
-function some(positions, where) {
-  for (let i = 0; i < positions.length; i += 3) if (where(positions[i], positions[i + 1], positions[i + 2])) return true;
-  return false;
-}
-
-/** @param {Page} page @param {number} distance */
-async function zoomTo(page, distance) {
-  await page.evaluate((distance) => {
-    const v = /** @type {any} */ (document.querySelector('vitrine-viewer')).viewer;
-    v.camera.state = { target: [0, 0, 1], distance, yaw: 0, pitch: 0 };
-    v.renderer.requestFrame();
-    v.cameraMoved();
-  }, distance);
 }
 
 test('the chart under the camera goes down to the last phase, the ones behind stay coarse, bit for bit the whole decoder', async () => {
@@ -169,7 +115,7 @@ test('the chart under the camera goes down to the last phase, the ones behind st
   console.log(`nested: ${state.bytesFetched - indexBytes} bytes of the stream fetched, ${indexBytes} of the part index; leaves at depths ${state.depths[last].join(' ')}`);
   assert.ok(state.bytesFetched < whole, `${state.bytesFetched} bytes fetched, the whole stream is ${whole}`);
   // Bit for bit the chart a whole decoder makes at the last level.
-  const { codec, decoder } = await wholeDecoder();
+  const { codec, decoder } = await wholeDecoder(`${service.url}/api/models/tree`, manifest);
   const theirs = decoder.chartView(front.chart).positions.slice();
   assert.deepEqual(Buffer.from(new Float32Array(front.positions).buffer), Buffer.from(theirs.buffer), 'its positions are the whole decoder chart');
   const e = codec.exports;
@@ -194,7 +140,7 @@ test('a small vertex budget: subtrees folded back, never more resident than the 
   assert.ok(first.resident <= budget, `${first.resident} resident, budget ${budget}`);
   // Right up to the front: the charts under the camera want more than the
   // rest would miss folded back, so the rest fold.
-  await zoomTo(page, 0.03);
+  await lookAt(page, [0, 0, 1], 0.03);
   await page.waitForFunction(() => /** @type {any} */ (document.querySelector('vitrine-viewer')).viewer.partsState().evictions > 0, undefined, {
     timeout: 20_000,
     polling: 100,

@@ -21,6 +21,7 @@ import { PARTS_IN_FLIGHT, assess, boundingSphere, evictionOrder, normalCone, par
  * @property {number[]} depths parts applied per chart
  * @property {number} finalDepth
  * @property {number} firstLevel the first parted batch's level: a chart at depth d is at level firstLevel − 1 + d
+ * @property {number} level the finest level a chart reached (the union's, as posted)
  * @property {number} resident vertices held, all charts together
  * @property {number} budget
  * @property {number} bytesFetched payload bytes of this load: base, global batches, part index, head and parts
@@ -287,6 +288,7 @@ export class PartRefinement {
         depths: this.#charts.map((c) => c.depth),
         finalDepth: this.parts.finalDepth,
         firstLevel: this.firstLevel,
+        level: this.#level(),
         resident,
         budget: this.options.budget,
         bytesFetched: this.#bytes,

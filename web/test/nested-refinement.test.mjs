@@ -11,25 +11,18 @@
 // budget holds, folding subtrees back.
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
-import { existsSync, readFileSync } from 'node:fs';
-import { NestedView, VitrineCodec, splitStream } from '../src/codec.js';
-import { OrbitCamera, multiply } from '../src/camera.js';
+import { NestedView, splitStream } from '../src/codec.js';
 import { NestedRefinement } from '../src/nested-refinement.js';
 import { nestedTable } from '../src/nested-selection.js';
-import { boundingSphere } from '../src/part-selection.js';
-import { fixture, wasmPath } from './support/fixtures.mjs';
+import { fixture } from './support/fixtures.mjs';
+import { cameraOn, loadCodec, refinementSink } from './support/refinement.mjs';
 
 /** @typedef {import('../src/reconstruction.js').LevelMessage} LevelMessage */
 /** @typedef {import('../src/nested-refinement.js').NestedState} NestedState */
 
-async function codec() {
-  assert.ok(existsSync(wasmPath), `build the wasm first: ${wasmPath}`);
-  return VitrineCodec.instantiate(readFileSync(wasmPath));
-}
-
 /**
  * A parted batch's layout as `nested_layout` gives it (codec/wasm/src/nested.rs).
- * @param {VitrineCodec} c
+ * @param {import('../src/codec.js').VitrineCodec} c
  * @param {Uint8Array} batch
  */
 function layout(c, batch) {
@@ -49,7 +42,7 @@ function layout(c, batch) {
  * The fixture as the service would serve it: its global batches decoded,
  * a part index (errors halving with each level of a phase, `inserted`
  * measured by walking the whole tree once) and every piece's bytes.
- * @param {VitrineCodec} c
+ * @param {import('../src/codec.js').VitrineCodec} c
  */
 function opened(c) {
   const { base, batches } = splitStream(fixture('nested-torus').stream);
@@ -102,37 +95,14 @@ function opened(c) {
 }
 
 /**
- * A camera close to a chart, looking at it from outside the model.
- * @param {Float32Array} positions the chart's
- * @returns {import('../src/part-selection.js').PartCamera}
- */
-function cameraOn(positions) {
-  const { centre } = boundingSphere(positions);
-  const c = new OrbitCamera({ min: [-2, -2, -2], max: [2, 2, 2] }, 1);
-  const out = Math.hypot(...centre) || 1;
-  const yaw = Math.atan2(centre[0], centre[2]);
-  const pitch = Math.asin(Math.max(-1, Math.min(1, centre[1] / out)));
-  c.state = { target: centre, distance: 0.05, yaw, pitch };
-  return { eye: c.basis().eye, clip: Array.from(multiply(c.projection(1), c.view())), pixelsPerRadian: 1000 / c.fovY };
-}
-
-/**
  * Runs a refinement until it settles; returns its messages and a vertex
  * store as the renderer's (vertex-store.js: positions from `firstVertex` on).
  * @param {{ budget: number }} options
  */
 async function refine({ budget }) {
-  const c = await codec();
-  const { view, whole, index, bytes, vertices } = opened(c);
-  let store = new Float32Array(0);
-  /** @type {LevelMessage | null} */
-  let last = null;
-  /** @type {NestedState | null} */
-  let state = null;
-  /** @type {string[]} */
-  const errors = [];
-  /** @type {(() => void) | null} */
-  let wake = null;
+  const { view, whole, index, bytes, vertices } = opened(await loadCodec());
+  /** @type {ReturnType<typeof refinementSink<NestedState>>} */
+  const sink = refinementSink();
   /** @param {string} key */
   const serve = async (key) => {
     await new Promise((resolve) => setTimeout(resolve, 1));
@@ -149,38 +119,18 @@ async function refine({ budget }) {
     wireframe: false,
     fetchPart: (part) => serve(`p ${part.level} ${part.chart}`),
     fetchSplit: (split) => serve(`s ${split.level} ${split.parent}`),
-    post: (message) => {
-      if (message.type !== 'level') return;
-      const first = /** @type {number} */ (message.firstVertex);
-      const grown = new Float32Array(Math.max(store.length, 3 * message.vertices));
-      grown.set(store);
-      grown.set(message.positions, 3 * first);
-      store = grown;
-      last = message;
-    },
-    tell: (message) => {
-      if (message.type === 'parts') state = message.state;
-      else errors.push(JSON.stringify(message));
-      wake?.();
-    },
+    post: sink.post,
+    tell: sink.tell,
   });
   /** @param {import('../src/part-selection.js').PartCamera} camera */
-  const settle = async (camera) => {
-    state = null;
-    refinement.setCamera(camera);
-    for (let i = 0; i < 1000 && !(/** @type {NestedState | null} */ (state)?.settled); i++) {
-      await new Promise((resolve) => {
-        wake = () => resolve(undefined);
-        setTimeout(resolve, 20);
-      });
-    }
-    return /** @type {NestedState | null} */ (state);
-  };
+  const settle = (camera) => sink.settle(() => refinement.setCamera(camera));
   // Close to a point of the surface: the first vertex of a top chart.
-  await settle(cameraOn(view.chart(0, 0).positions.subarray(0, 3)));
-  /** The store and the last union posted, now. */
-  const posted = () => ({ store, last: /** @type {LevelMessage} */ (/** @type {unknown} */ (last)) });
-  return { refinement, view, whole, state: /** @type {NestedState | null} */ (state), errors, settle, posted };
+  const state = await settle(cameraOn(view.chart(0, 0).positions.subarray(0, 3)));
+  const posted = () => {
+    const { store, last } = sink.posted();
+    return { store, last: /** @type {LevelMessage} */ (last) };
+  };
+  return { refinement, view, whole, state, errors: sink.errors, settle, posted };
 }
 
 /**

@@ -111,8 +111,11 @@ fn a_leaf_through_the_abi_is_the_full_decoders() {
     assert_eq!(nested_phases(view), 0);
 }
 
-/// Every chart's quantized positions, colours and triangles, phase by phase.
-fn snapshot(view: u32) -> Vec<(usize, usize, Vec<[i32; 3]>, Vec<u8>, Vec<u32>)> {
+/// A chart held: its phase, position, quantized positions, colours and triangles.
+type ChartSnapshot = (usize, usize, Vec<[i32; 3]>, Vec<u8>, Vec<u32>);
+
+/// Every chart held, phase by phase.
+fn snapshot(view: u32) -> Vec<ChartSnapshot> {
     with_view(view, |v| {
         let mut charts = Vec::new();
         for phase in 0..v.phase_count() {
