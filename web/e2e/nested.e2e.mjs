@@ -7,7 +7,8 @@
 // whole decoder's chart; the charts behind stay coarser; fewer bytes than
 // the whole stream; resident vertices within the budget, also a budget
 // small enough to make the viewer fold subtrees back; a phone capped below
-// the last level fetches nothing past its cap.
+// the last level fetches nothing past its cap; without `?refine=view` the
+// stream decodes uniformly.
 import { after, before, test } from 'node:test';
 import assert from 'node:assert/strict';
 import { launch } from '../test/support/browser.mjs';
@@ -172,6 +173,22 @@ test('a phone capped below the last level: no part or split entry past the cap, 
   const levels = requests.map((url) => Number(url.match(/\/batches\/(\d+)/)?.[1] ?? 0));
   assert.ok(Math.max(...levels) <= cap, 'nothing past the cap is requested');
   assert.ok(requests.some((url) => /\/splits\//.test(url)), 'split entries were fetched');
+  assert.deepEqual(problems, []);
+  await page.close();
+});
+
+test('without ?refine=view a nested stream decodes batch by batch to the last level, as any stream', async () => {
+  const { page, problems, requests } = await open('', '');
+  await page.waitForFunction(() => /** @type {any} */ (document.querySelector('vitrine-viewer'))?.viewer?.state.status === 'complete', undefined, {
+    timeout: 30_000,
+  });
+  const state = await page.evaluate(() => {
+    const v = /** @type {any} */ (document.querySelector('vitrine-viewer')).viewer;
+    return { shownLevel: v.state.shownLevel, parts: v.partsState() };
+  });
+  assert.equal(state.shownLevel, manifest.last_level);
+  assert.equal(state.parts, null, 'no refinement by parts');
+  assert.ok(!requests.some((url) => /\/parts|\/splits\/|\/head$/.test(new URL(url).pathname)), 'neither the part index nor any piece is fetched');
   assert.deepEqual(problems, []);
   await page.close();
 });
