@@ -268,6 +268,8 @@ export class NestedRefinement {
       for (const w of wanted) {
         if (this.#inFlight >= PARTS_IN_FLIGHT) break;
         const node = /** @type {Node} */ (w.node);
+        // Room made for a step before this one may have folded this chart away.
+        if (this.#nodes[node.phase][node.chart] !== node) continue;
         const adds = w.kind === 'part' ? w.part.inserted : Math.ceil(node.vertices * (1 + SPLIT_MARGIN));
         if (!this.#makeRoom(w, adds, camera)) continue;
         started = true;
