@@ -92,6 +92,9 @@ try {
   console.log(`  zoom to the final depth   ${finalMs === null ? 'not reached' : `${(finalMs / 1000).toFixed(1)} s`}`);
   console.log(`  resident at most          ${maxResident} vertices (budget ${closeup.budget}); ${closeup.evictions} subtrees folded back`);
   console.log(`  charts shown per phase    ${closeup.shownCharts.join(' ')} of ${closeup.charts.join(' ')}`);
+  const leaves = closeup.depths[closeup.phases - 1];
+  const atFinal = leaves.filter((/** @type {number} */ d) => d === closeup.finalDepth).length;
+  console.log(`  leaves at the final depth ${atFinal} of ${leaves.length} (depths ${leaves.join(' ')} of ${closeup.finalDepth})`);
 } finally {
   await browser.close();
   await service.stop();
