@@ -9,6 +9,7 @@
 // DevTools network emulation at `--mbits` (default 10 Mbit/s; 0: loopback).
 // Keep meshes to 2 M vertices or fewer on a small machine.
 //   node bench/nested-closeup.mjs MESH [--charts nested:2,2,5] [--target x,y,z] [--distance 0.05] [--budget N] [--mbits 10]
+// (`--distance`: the camera's from the target, as a share of the model's diagonal)
 import { parseArgs } from 'node:util';
 import { launch } from '../test/support/browser.mjs';
 import { startService } from '../test/support/service.mjs';
@@ -57,7 +58,7 @@ try {
   const target = values.target
     ? values.target.split(',').map(Number)
     : [(bounds.min[0] + bounds.max[0]) / 2, (bounds.min[1] + bounds.max[1]) / 2, bounds.max[2]];
-  const distance = values.distance ? Number(values.distance) : size * 0.05;
+  const distance = size * (values.distance ? Number(values.distance) : 0.05);
   let maxResident = overview.resident;
   const zoomed = performance.now();
   await page.evaluate(
@@ -85,7 +86,7 @@ try {
     if (performance.now() - zoomed > 600_000) throw new Error('the close-up did not settle in 10 minutes');
   }
   const mb = (/** @type {number} */ n) => `${(n / 1e6).toFixed(2)} MB`;
-  console.log(`nested close-up of ${mesh} (${values.charts}; ${manifest.levels.at(-1).vertices} vertices, ${mbits > 0 ? `${mbits} Mbit/s` : 'loopback'}):`);
+  console.log(`nested close-up of ${mesh} (${values.charts}; ${manifest.levels.at(-1).vertices} vertices, ${mbits > 0 ? `${mbits} Mbit/s` : 'loopback'}; ${distance.toPrecision(3)} from ${target.map((v) => v.toPrecision(3)).join(', ')}):`);
   console.log(`  whole stream              ${mb(whole)}`);
   console.log(`  overview settled          ${(overviewMs / 1000).toFixed(1)} s, ${mb(overview.bytesFetched)} (${((100 * overview.bytesFetched) / whole).toFixed(1)} %)`);
   console.log(`  after the close-up        ${mb(closeup.bytesFetched)} (${((100 * closeup.bytesFetched) / whole).toFixed(1)} %), ${mb(closeup.bytesFetched - overview.bytesFetched)} for the zoom`);
