@@ -15,10 +15,12 @@
  * once, without a fetch.
  *
  * Why the union stays watertight: a phase's cut is frozen in its charts
- * and in all their descendants, and no part joins or moves two vertices of
- * a cut, so a chart and its neighbour share every vertex and edge of their
- * common border bit for bit whatever phase and depth each is shown at
- * (codec/core/src/decoder/nested_view.rs). The border vertices of each
+ * and in all their descendants (no later part inserts on it, moves it or
+ * joins two of its vertices), so a chart and its neighbour share every
+ * vertex and edge of their common border bit for bit whatever phase and
+ * depth each is shown at (codec/core/src/decoder/nested_view.rs;
+ * test/nested-refinement.test.mjs checks that the union of charts of
+ * several phases is closed). The border vertices of each
  * chart, found once from its triangles when it is made, are welded by
  * position across the charts shown: one normal each, summed over the
  * charts that hold them, so the shading is continuous too.
