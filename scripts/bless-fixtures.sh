@@ -74,4 +74,8 @@ fixture sphere sphere --kilo-vertices 1 --noise 0.002
 # A charted stream (format 5): four charts, each decoded on its own.
 encode_args=(--charts 4)
 fixture charted-torus torus --kilo-vertices 3 --colour --noise 0.003
+# A nested stream (format 6): 2 top charts, each split in 2 twice (3 phases),
+# for the viewer's nested refinement (web/test/nested-refinement.test.mjs).
+encode_args=(--charts nested:2,2,3)
+fixture nested-torus torus --kilo-vertices 2 --colour --noise 0.003
 encode_args=()

@@ -8,11 +8,9 @@
 // enough to make the viewer give charts back.
 import { after, before, test } from 'node:test';
 import assert from 'node:assert/strict';
-import { readFileSync } from 'node:fs';
 import { launch } from '../test/support/browser.mjs';
 import { startService } from '../test/support/service.mjs';
-import { wasmPath } from '../test/support/fixtures.mjs';
-import { VitrineCodec } from '../src/codec.js';
+import { lookAt, openRecorded, settledParts, some, wholeDecoder } from '../test/support/refinement.mjs';
 
 /** @typedef {import('playwright-core').Page} Page */
 /** @typedef {import('../src/part-refinement.js').PartsState} PartsState */
@@ -48,25 +46,12 @@ after(async () => {
 });
 
 /**
- * Opens the model page and records every failed request and console error.
+ * Opens the model page, recording every failed request and console error.
  * @param {string} query
  * @param {string} [view] the page's fragment (view-state.js)
  */
 async function open(query, view = CAMERA) {
-  const page = await browser.context.newPage();
-  /** @type {string[]} */
-  const problems = [];
-  page.on('pageerror', (e) => problems.push(`page error: ${e.message}`));
-  page.on('console', (m) => {
-    if (m.type() === 'error') problems.push(`console: ${m.text()}`);
-  });
-  page.on('requestfailed', (r) => problems.push(`failed: ${r.url()}`));
-  page.on('response', (r) => {
-    if (r.status() >= 400) problems.push(`${r.status()}: ${r.url()}`);
-  });
-  /** @type {string[]} */
-  const requests = [];
-  page.on('request', (r) => requests.push(r.url()));
+  const { page, problems, requests } = await openRecorded(browser.context);
   // Each change of depth, timed from the navigation (the element's vitrine-parts event).
   await page.addInitScript(() => {
     const log = /** @type {[number, number[]][]} */ ([]);
@@ -79,21 +64,8 @@ async function open(query, view = CAMERA) {
 }
 
 /** @param {Page} page @returns {Promise<PartsState & { status: string }>} */
-async function settled(page) {
-  await page.waitForFunction(
-    () => {
-      const v = /** @type {any} */ (document.querySelector('vitrine-viewer'))?.viewer;
-      const p = v?.partsState();
-      // Settled, and the union posted last on screen (its level: the deepest chart's).
-      return v?.state.status === 'error' || (p && p.settled && v.state.shownLevel >= p.firstLevel - 1 + Math.max(...p.depths));
-    },
-    undefined,
-    { timeout: 30_000, polling: 100 },
-  );
-  return page.evaluate(() => {
-    const v = /** @type {any} */ (document.querySelector('vitrine-viewer')).viewer;
-    return { ...v.partsState(), status: v.state.status, message: v.state.message };
-  });
+function settled(page) {
+  return settledParts(page);
 }
 
 /**
@@ -112,22 +84,6 @@ function pageCharts(page, charts) {
     }
     return out;
   }, charts);
-}
-
-/** The whole stream decoded in Node: every batch, as a uniform viewer would. */
-async function wholeDecoder() {
-  const codec = await VitrineCodec.instantiate(readFileSync(wasmPath));
-  /** @param {string} path */
-  const get = async (path) => new Uint8Array(await (await fetch(new URL(path, `${service.url}/api/models/ball`))).arrayBuffer());
-  const decoder = codec.decoder(await get(manifest.levels[0].url));
-  for (const level of manifest.levels.slice(1)) decoder.apply(await get(level.url));
-  return decoder;
-}
-
-/** @param {number[]} positions @param {(x: number, y: number, z: number) => boolean} where */
-function some(positions, where) {
-  for (let i = 0; i < positions.length; i += 3) if (where(positions[i], positions[i + 1], positions[i + 2])) return true;
-  return false;
 }
 
 test('the charts in view refine to the final level, the ones behind stay coarse, bit for bit the whole decoder', async () => {
@@ -154,7 +110,7 @@ test('the charts in view refine to the final level, the ones behind stay coarse,
   assert.ok(state.resident <= state.budget);
   assert.ok(state.bytesFetched < whole, `${state.bytesFetched} bytes fetched, the whole stream is ${whole}`);
   // Bit for bit the chart a whole decoder makes at the last level.
-  const decoder = await wholeDecoder();
+  const { decoder } = await wholeDecoder(`${service.url}/api/models/ball`, manifest);
   const mine = new Float32Array(charts[front].positions);
   const theirs = decoder.chartView(front).positions.slice();
   assert.deepEqual(Buffer.from(mine.buffer), Buffer.from(theirs.buffer), 'the chart in view is the whole decoder chart');
@@ -172,12 +128,7 @@ test('a small vertex budget: charts given back, never more resident than the bud
   assert.ok(first.resident <= budget, `${first.resident} resident, budget ${budget}`);
   // Right up to the front: the charts under the camera want more than the
   // rest would miss at the cut, so the rest give their vertices back.
-  await page.evaluate(() => {
-    const v = /** @type {any} */ (document.querySelector('vitrine-viewer')).viewer;
-    v.camera.state = { target: [0, 0, 1], distance: 0.03, yaw: 0, pitch: 0 };
-    v.renderer.requestFrame();
-    v.cameraMoved();
-  });
+  await lookAt(page, [0, 0, 1], 0.03);
   await page.waitForFunction(() => /** @type {any} */ (document.querySelector('vitrine-viewer')).viewer.partsState().evictions > 0, undefined, {
     timeout: 15_000,
     polling: 100,

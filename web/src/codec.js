@@ -265,10 +265,47 @@ export class StreamDecoder {
     return new PartView(this.codec, view);
   }
 
+  /**
+   * Turns this decoder (its global batches applied) into a view of a nested
+   * stream's tree of charts (format 6), from what the part index says of
+   * each parted batch and the first one's head: no whole batch is needed.
+   * This decoder is spent.
+   * @param {Uint8Array} head the first parted batch's head (the index's `head_url`)
+   * @param {NestedBatch[]} batches every parted batch, in stream order
+   * @returns {NestedView}
+   */
+  intoNested(head, batches) {
+    const e = this.codec.exports;
+    e.nested_layouts_clear();
+    for (const b of batches) {
+      this.codec.input(new Uint8Array(Uint32Array.from(b.children).buffer));
+      if (e.nested_layout_declare(b.level, b.phase, b.charts, b.children.length) < 0) {
+        const error = this.codec.lastError();
+        e.nested_layouts_clear();
+        throw error;
+      }
+    }
+    this.codec.input(head);
+    const view = e.nested_new(this.handle, head.length);
+    if (view === 0) throw this.codec.lastError();
+    return new NestedView(this.codec, view);
+  }
+
   free() {
     this.codec.exports.decoder_free(this.handle);
   }
 }
+
+/**
+ * One parted batch of a nested stream as a part index tells it: its level,
+ * phase and chart count, and, when it begins a phase after the first, each
+ * chart of the phase before's number of children (in order; else empty).
+ * @typedef {object} NestedBatch
+ * @property {number} level
+ * @property {number} phase
+ * @property {number} charts
+ * @property {number[]} children
+ */
 
 /**
  * A parted batch's layout: its level, the head a view starts from and each
@@ -384,6 +421,129 @@ export class PartView {
 
   free() {
     this.codec.exports.view_free(this.handle);
+  }
+}
+
+/** Kind of {@link NestedView} buffer: the ids of a chart's first vertices where it was cut from. */
+const FIRST_IDS = 4;
+
+/**
+ * A nested stream's tree of charts (format 6, codec/core's NestedView):
+ * charts are named by their phase and their position in it; each refines
+ * by its own parts, and one that has had all its phase's parts splits into
+ * its children of the next phase. A parent stays as it was when it splits;
+ * dropping a chart drops its descendants. Charts shown at different depths
+ * share their borders bit for bit.
+ */
+export class NestedView {
+  /**
+   * @param {VitrineCodec} codec
+   * @param {number} handle
+   */
+  constructor(codec, handle) {
+    this.codec = codec;
+    this.handle = handle;
+  }
+
+  phaseCount() {
+    return this.codec.exports.nested_phases(this.handle);
+  }
+
+  /** @param {number} phase */
+  chartCount(phase) {
+    return this.codec.exports.nested_charts(this.handle, phase);
+  }
+
+  /** Parts each chart of a phase has in all. @param {number} phase */
+  phaseBatches(phase) {
+    return this.codec.exports.nested_phase_batches(this.handle, phase);
+  }
+
+  /** A chart's parent in the phase before (-1 in phase 0). @param {number} phase @param {number} chart */
+  parent(phase, chart) {
+    return this.codec.exports.nested_parent(this.handle, phase, chart);
+  }
+
+  /**
+   * A chart's children in the phase after, as [first, end) (empty in the last phase).
+   * @param {number} phase
+   * @param {number} chart
+   * @returns {[number, number]}
+   */
+  children(phase, chart) {
+    const e = this.codec.exports;
+    const first = e.nested_first_child(this.handle, phase, chart);
+    return [first, first + e.nested_children(this.handle, phase, chart)];
+  }
+
+  /** Parts applied to a chart in its phase; -1 while it is not in the view. @param {number} phase @param {number} chart */
+  depth(phase, chart) {
+    return this.codec.exports.nested_depth(this.handle, phase, chart);
+  }
+
+  /** Vertices held, all charts together, each counting its own copy. */
+  residentVertices() {
+    return this.codec.exports.nested_resident(this.handle);
+  }
+
+  /**
+   * Applies a chart's next part of its phase (empty: it sits the batch
+   * out); a part that fails part-way removes the chart.
+   * @param {number} phase
+   * @param {number} chart
+   * @param {Uint8Array} part
+   */
+  applyPart(phase, chart, part) {
+    this.codec.input(part);
+    if (this.codec.exports.nested_apply_part(this.handle, phase, chart, part.length) !== 0) throw this.codec.lastError();
+  }
+
+  /**
+   * Splits a chart that has had all its phase's parts into its children, by its split entry.
+   * @param {number} phase
+   * @param {number} chart
+   * @param {Uint8Array} entry
+   */
+  split(phase, chart, entry) {
+    this.codec.input(entry);
+    if (this.codec.exports.nested_split(this.handle, phase, chart, entry.length) !== 0) throw this.codec.lastError();
+  }
+
+  /** Drops a chart of phase >= 1 and its descendants. @param {number} phase @param {number} chart */
+  drop(phase, chart) {
+    this.codec.exports.nested_drop(this.handle, phase, chart);
+  }
+
+  /**
+   * One chart as copies: positions, colours, triangles in its own ids, and
+   * the ids of its first vertices where it was cut from (its parent's, or
+   * in phase 0 the level where the charts begin).
+   * @param {number} phase
+   * @param {number} chart
+   * @returns {{ positions: Float32Array, colours: Uint8Array | null, indices: Uint32Array, firstIds: Uint32Array }}
+   */
+  chart(phase, chart) {
+    const e = this.codec.exports;
+    /** @param {number} kind @param {number} size */
+    const copy = (kind, size) => {
+      const ptr = e.nested_buffer_ptr(this.handle, phase, chart, kind);
+      const len = e.nested_buffer_len(this.handle, phase, chart, kind);
+      return ptr === 0 && len === 0 ? null : e.memory.buffer.slice(ptr, ptr + len * size);
+    };
+    const positions = copy(POSITIONS, 4);
+    const colours = copy(COLOURS, 1);
+    const indices = copy(INDICES, 4);
+    const firstIds = copy(FIRST_IDS, 4);
+    return {
+      positions: new Float32Array(positions ?? 0),
+      colours: colours ? new Uint8Array(colours) : null,
+      indices: new Uint32Array(indices ?? 0),
+      firstIds: new Uint32Array(firstIds ?? 0),
+    };
+  }
+
+  free() {
+    this.codec.exports.nested_free(this.handle);
   }
 }
 

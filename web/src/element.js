@@ -21,7 +21,7 @@
  * shared view (the fragment of a share link: view-state.js) and
  * `iiif-content` at a IIIF Content State (content-state.js); `tour` and
  * `step` open a guided tour at a step (from 1; tour.js). `refine="view"` refines a
- * charted stream chart by chart where the camera looks, within `vertex-budget`
+ * charted or nested stream chart by chart where the camera looks, within `vertex-budget`
  * vertices (default by device; README, "View-dependent refinement");
  * `refine="uniform"`, the default, batch by batch.
  */

@@ -5,32 +5,15 @@
  * each chart refines by its own parts as the camera asks (part-selection.js),
  * and the union of the charts goes to the renderer as a level.
  *
- * The renderer's vertex store is append-only (vertex-store.js): a chart that
- * changed is appended whole at the end, the others keep their place, and
- * the indices of every chart point at its newest copy. When the stale
- * copies outweigh the live ones, every chart is sent again from the end of
- * the global level's vertices, which stay: that level remains a valid
- * stand-in while the view moves (motion.js), and no union ever becomes one
- * (`standIn: false`), since its vertices may be written over. Until the
- * union sent again is uploaded, the one on screen may read some of its
- * vertices: a frame or two of wrong triangles after such a compaction.
- * Cut vertices are duplicated across charts, bit for bit the same
- * positions: their normals are summed over every chart that holds them, so
- * the shading is continuous across chart borders, as the mesh is.
+ * The union goes to the renderer as chart-union.js does it for every
+ * view-dependent refinement: charts that changed appended to the store,
+ * cut vertices welded by position so the shading is continuous across
+ * chart borders. A charted stream's cut is fixed, so it is welded once.
  */
 
+import { ChartUnion, weldByPosition } from './chart-union.js';
 import { DecodeError } from './codec.js';
-import { accumulateNormals, edgeIndices, packNormals } from './geometry.js';
 import { PARTS_IN_FLIGHT, assess, boundingSphere, evictionOrder, normalCone, partTable, wantedParts } from './part-selection.js';
-
-/**
- * The union is posted at most every PUBLISH_MS while parts arrive, and
- * less often as it grows (one more millisecond per {@link PUBLISH_VERTICES_PER_MS}
- * vertices: 460 ms at 4 M): each post uploads all its triangles again, and
- * the renderer drops an upload that a newer post overtakes.
- */
-const PUBLISH_MS = 60;
-const PUBLISH_VERTICES_PER_MS = 10_000;
 
 /**
  * @typedef {object} PartsState what the page reads (viewer.partsState())
@@ -38,6 +21,7 @@ const PUBLISH_VERTICES_PER_MS = 10_000;
  * @property {number[]} depths parts applied per chart
  * @property {number} finalDepth
  * @property {number} firstLevel the first parted batch's level: a chart at depth d is at level firstLevel − 1 + d
+ * @property {number} level the finest level a chart reached (the union's, as posted)
  * @property {number} resident vertices held, all charts together
  * @property {number} budget
  * @property {number} bytesFetched payload bytes of this load: base, global batches, part index, head and parts
@@ -85,25 +69,20 @@ const PUBLISH_VERTICES_PER_MS = 10_000;
 export class PartRefinement {
   /** @type {Chart[]} */
   #charts;
-  /** Cut vertices: per chart, pairs of (chart id, weld group). @type {Uint32Array[]} */
-  #shared;
-  #groups = 0;
+  /** Cut vertices, welded once: the cut never changes. @type {import('./chart-union.js').Weld} */
+  #weld;
   /** @type {import('./part-selection.js').PartCamera | null} */
   #camera = null;
   #inFlight = 0;
   /** Vertices the parts on their way will add. */
   #reserved = 0;
-  #sent;
-  /** The global level's vertices, never written over. */
-  #kept;
   #bytes;
   #evictions = 0;
-  /** @type {ReturnType<typeof setTimeout> | null} */
-  #timer = null;
-  #changed = false;
   #stopped = false;
   /** @type {boolean[]} */
   #visible;
+  /** @type {ChartUnion} */
+  #union;
 
   /** @param {PartRefinementOptions} options */
   constructor(options) {
@@ -112,8 +91,6 @@ export class PartRefinement {
     this.parts = partTable(options.index);
     this.firstLevel = options.index.first_level;
     this.capLevel = options.capLevel;
-    this.#sent = options.sentVertices;
-    this.#kept = options.sentVertices;
     this.#bytes = options.bytesFetched;
     this.view.setVertexBudget(options.budget);
     const count = this.view.chartCount();
@@ -123,36 +100,19 @@ export class PartRefinement {
       return { depth: 0, cutVertices: positions.length / 3, sphere: boundingSphere(positions), cone: normalCone(positions, indices), busy: false, yielded: false, positions, colours, indices, base: -1 };
     });
     this.#visible = new Array(count).fill(true);
-    this.#shared = this.#weld();
-    this.#publish();
-  }
-
-  /**
-   * Cut vertices, found by position at the cut: a position held by several
-   * charts is one vertex of the surface. Their ids within each chart never
-   * change (a part appends the vertices it inserts; a reset goes back to
-   * the cut).
-   */
-  #weld() {
-    /** @type {Map<string, number[]>} */
-    const byPosition = new Map();
-    for (const [k, c] of this.#charts.entries()) {
-      const p = c.positions;
-      for (let i = 0; i < p.length / 3; i++) {
-        const key = `${p[3 * i]} ${p[3 * i + 1]} ${p[3 * i + 2]}`;
-        const holders = byPosition.get(key);
-        if (holders) holders.push(k, i);
-        else byPosition.set(key, [k, i]);
-      }
-    }
-    /** @type {number[][]} */
-    const pairs = this.#charts.map(() => []);
-    for (const holders of byPosition.values()) {
-      if (holders.length < 4) continue;
-      const group = this.#groups++;
-      for (let j = 0; j < holders.length; j += 2) pairs[holders[j]].push(holders[j + 1], group);
-    }
-    return pairs.map((p) => Uint32Array.from(p));
+    // Cut vertices, found by position at the cut. Their ids within each
+    // chart never change (a part appends the vertices it inserts; a reset
+    // goes back to the cut).
+    this.#weld = weldByPosition(this.#charts);
+    this.#union = new ChartUnion({
+      sentVertices: options.sentVertices,
+      baseBounds: options.baseBounds,
+      wireframe: options.wireframe,
+      post: options.post,
+      source: () => ({ pieces: this.#charts, weld: this.#weld, level: this.#level(), received: this.#bytes }),
+      posted: () => this.#tellState(),
+    });
+    this.#union.publish();
   }
 
   /** @param {import('./part-selection.js').PartCamera} camera */
@@ -171,13 +131,12 @@ export class PartRefinement {
 
   /** @param {boolean} on */
   setWireframe(on) {
-    this.options.wireframe = on;
-    if (on) this.#publish();
+    this.#union.setWireframe(on);
   }
 
   stop() {
     this.#stopped = true;
-    if (this.#timer) clearTimeout(this.#timer);
+    this.#union.stop();
     this.view.free();
   }
 
@@ -190,34 +149,11 @@ export class PartRefinement {
   }
 
   /**
-   * The union as one compact level (measurements along the surface, the
-   * splat view), its triangles welded at the cut: every chart's triangles
-   * use the first copy of a cut vertex, so paths cross chart borders.
+   * The union as one compact level, welded at the cut (chart-union.js).
    * @returns {import('./codec.js').Level}
    */
   current() {
-    const vertices = this.#charts.reduce((n, c) => n + c.positions.length / 3, 0);
-    const positions = new Float32Array(3 * vertices);
-    const colours = this.#charts[0]?.colours ? new Uint8Array(3 * vertices) : null;
-    const indices = new Uint32Array(this.#charts.reduce((n, c) => n + c.indices.length, 0));
-    const canonical = new Int32Array(this.#groups).fill(-1);
-    let v = 0;
-    let t = 0;
-    for (const [k, c] of this.#charts.entries()) {
-      positions.set(c.positions, 3 * v);
-      if (colours && c.colours) colours.set(c.colours, 3 * v);
-      const ids = new Uint32Array(c.positions.length / 3).map((_, i) => v + i);
-      const pairs = this.#shared[k];
-      for (let j = 0; j < pairs.length; j += 2) {
-        const group = pairs[j + 1];
-        if (canonical[group] < 0) canonical[group] = ids[pairs[j]];
-        else ids[pairs[j]] = canonical[group];
-      }
-      for (let i = 0; i < c.indices.length; i++) indices[t + i] = ids[c.indices[i]];
-      v += c.positions.length / 3;
-      t += c.indices.length;
-    }
-    return { level: this.#level(), vertices, positions, colours, indices };
+    return this.#union.current();
   }
 
   /** The finest level a chart reached: what the page shows as the level on screen. */
@@ -327,6 +263,7 @@ export class PartRefinement {
         return;
       }
       this.#stopped = true;
+      this.#union.stop();
       const level = this.firstLevel + this.#charts[k].depth;
       this.options.tell({ type: 'error', kind: 'decode', level: level - 1, message: `the stream is damaged (${error instanceof Error ? error.message : String(error)})` });
       return;
@@ -339,14 +276,7 @@ export class PartRefinement {
     const chart = this.#charts[k];
     const { positions, colours, indices } = this.view.chart(k);
     Object.assign(chart, { depth: this.view.depth(k), positions, colours, indices, base: -1 });
-    this.#changed = true;
-    this.#timer ??= setTimeout(
-      () => {
-        this.#timer = null;
-        if (!this.#stopped) this.#publish();
-      },
-      Math.max(PUBLISH_MS, this.view.residentVertices() / PUBLISH_VERTICES_PER_MS),
-    );
+    this.#union.changed(this.view.residentVertices());
   }
 
   #tellState() {
@@ -358,109 +288,15 @@ export class PartRefinement {
         depths: this.#charts.map((c) => c.depth),
         finalDepth: this.parts.finalDepth,
         firstLevel: this.firstLevel,
+        level: this.#level(),
         resident,
         budget: this.options.budget,
         bytesFetched: this.#bytes,
         visible: this.#visible,
         inFlight: this.#inFlight,
-        settled: this.#camera !== null && this.#inFlight === 0 && this.#timer === null && !this.#changed,
+        settled: this.#camera !== null && this.#inFlight === 0 && !this.#union.pending,
         evictions: this.#evictions,
       },
     });
-  }
-
-  /**
-   * Posts the union: the charts that changed appended to the renderer's
-   * store, every chart's triangles, normals welded across the cut.
-   */
-  #publish() {
-    const charts = this.#charts;
-    const live = charts.reduce((n, c) => n + c.positions.length / 3, 0);
-    let fresh = charts.filter((c) => c.base < 0);
-    let first = this.#sent;
-    const adding = fresh.reduce((n, c) => n + c.positions.length / 3, 0);
-    if (first + adding > 2 * live + 65_536) {
-      // Stale copies outweigh the live ones: send everything again.
-      for (const c of charts) c.base = -1;
-      fresh = charts;
-      first = this.#kept;
-    }
-    let end = first;
-    for (const c of fresh) {
-      c.base = end;
-      end += c.positions.length / 3;
-    }
-    const positions = new Float32Array(3 * (end - first));
-    const colours = charts[0]?.colours ? new Uint8Array(3 * (end - first)) : null;
-    for (const c of fresh) {
-      positions.set(c.positions, 3 * (c.base - first));
-      if (colours && c.colours) colours.set(c.colours, 3 * (c.base - first));
-    }
-    const indices = new Uint32Array(charts.reduce((n, c) => n + c.indices.length, 0));
-    let t = 0;
-    for (const c of charts) {
-      for (let i = 0; i < c.indices.length; i++) indices[t + i] = c.indices[i] + c.base;
-      t += c.indices.length;
-    }
-    this.#sent = end;
-    const normals = this.#normals(end);
-    const edges = this.options.wireframe ? edgeIndices(indices, end) : null;
-    /** @type {Transferable[]} */
-    const transfer = [positions.buffer, indices.buffer, normals.buffer];
-    if (colours) transfer.push(colours.buffer);
-    if (edges) transfer.push(edges.buffer);
-    this.#changed = false;
-    this.options.post(
-      {
-        type: 'level',
-        level: this.#level(),
-        vertices: end,
-        faces: indices.length / 3,
-        firstVertex: first,
-        capacity: end,
-        positions,
-        normals,
-        colours,
-        indices,
-        edges,
-        baseBounds: this.options.baseBounds,
-        received: this.#bytes,
-        decodeMs: 0,
-        deriveMs: 0,
-        decoders: 1,
-        standIn: false,
-      },
-      transfer,
-    );
-    this.#tellState();
-  }
-
-  /**
-   * Smooth normals of every chart, summed over the charts for the cut
-   * vertices, packed at each chart's place in the store.
-   * @param {number} vertices the store's
-   */
-  #normals(vertices) {
-    const sums = this.#charts.map((c) => {
-      const sum = new Float32Array(c.positions.length);
-      accumulateNormals(c.positions, c.indices, sum, 0, c.indices.length);
-      return sum;
-    });
-    const group = new Float64Array(3 * this.#groups);
-    for (const [k, pairs] of this.#shared.entries()) {
-      for (let j = 0; j < pairs.length; j += 2) {
-        for (let a = 0; a < 3; a++) group[3 * pairs[j + 1] + a] += sums[k][3 * pairs[j] + a];
-      }
-    }
-    const packed = new Int16Array(3 * vertices);
-    for (const [k, c] of this.#charts.entries()) {
-      const sum = sums[k];
-      const pairs = this.#shared[k];
-      for (let j = 0; j < pairs.length; j += 2) {
-        for (let a = 0; a < 3; a++) sum[3 * pairs[j] + a] = group[3 * pairs[j + 1] + a];
-      }
-      packNormals(sum, packed.subarray(3 * c.base, 3 * c.base + sum.length), 0, sum.length);
-    }
-    return packed;
   }
 }

@@ -170,6 +170,49 @@ export function sphereDistance(eye, sphere) {
 }
 
 /**
+ * Where a chart stands for a camera: its distance, and whether it is in
+ * view (in the frustum, and not facing away).
+ * @param {number[][]} planes the camera's ({@link frustumPlanes})
+ * @param {Vec3} eye
+ * @param {{ sphere: Sphere, cone?: NormalCone }} chart
+ */
+export function sight(planes, eye, chart) {
+  const distance = sphereDistance(eye, chart.sphere);
+  const visible = inFrustum(planes, chart.sphere) && !(chart.cone && facesAway(chart.cone, chart.sphere, eye));
+  return { distance, visible };
+}
+
+/**
+ * An error in model units at `distance`, in pixels on screen.
+ * @param {number} error
+ * @param {number} distance
+ * @param {PartCamera} camera
+ */
+export function onScreen(error, distance, camera) {
+  return (error / distance) * camera.pixelsPerRadian;
+}
+
+/**
+ * Most wanted first: the largest error on screen, then the nearest.
+ * @param {{ pixels: number, distance: number }} a
+ * @param {{ pixels: number, distance: number }} b
+ */
+export function byNeed(a, b) {
+  return b.pixels - a.pixels || a.distance - b.distance;
+}
+
+/**
+ * What gives its vertices back first: out of view before in view, the
+ * farthest first out of view, in view the smallest error `cutPixels` it
+ * would show once given back.
+ * @param {{ visible: boolean, distance: number, cutPixels: number }} a
+ * @param {{ visible: boolean, distance: number, cutPixels: number }} b
+ */
+export function byLeastNeeded(a, b) {
+  return Number(a.visible) - Number(b.visible) || (a.visible ? a.cutPixels - b.cutPixels : b.distance - a.distance);
+}
+
+/**
  * The part index as the service sends it (`GET …/parts`).
  * @typedef {object} PartIndex
  * @property {number} charts
@@ -224,10 +267,9 @@ export function partTable(index) {
 export function assess(charts, parts, camera) {
   const planes = frustumPlanes(camera.clip);
   return charts.map((c, chart) => {
-    const distance = sphereDistance(camera.eye, c.sphere);
-    const visible = inFrustum(planes, c.sphere) && !(c.cone && facesAway(c.cone, c.sphere, camera.eye));
-    const pixels = (parts.remaining[chart][c.depth] / distance) * camera.pixelsPerRadian;
-    const cutPixels = (parts.remaining[chart][0] / distance) * camera.pixelsPerRadian;
+    const { distance, visible } = sight(planes, camera.eye, c);
+    const pixels = onScreen(parts.remaining[chart][c.depth], distance, camera);
+    const cutPixels = onScreen(parts.remaining[chart][0], distance, camera);
     return { chart, distance, visible, pixels, cutPixels };
   });
 }
@@ -248,7 +290,7 @@ export function wantedParts(charts, parts, camera, { firstLevel, capLevel, thres
       const c = charts[a.chart];
       return !c.busy && !c.yielded && a.visible && c.depth < parts.finalDepth && firstLevel + c.depth <= capLevel && a.pixels > threshold;
     })
-    .sort((a, b) => b.pixels - a.pixels || a.distance - b.distance);
+    .sort(byNeed);
 }
 
 /**
@@ -268,6 +310,6 @@ export function evictionOrder(charts, assessed, wanted) {
   const need = assessed[wanted].pixels;
   return assessed
     .filter((a) => a.chart !== wanted && charts[a.chart].depth > 0 && !charts[a.chart].busy && (!a.visible || a.cutPixels < need))
-    .sort((a, b) => Number(a.visible) - Number(b.visible) || (a.visible ? a.cutPixels - b.cutPixels : b.distance - a.distance))
+    .sort(byLeastNeeded)
     .map((a) => a.chart);
 }

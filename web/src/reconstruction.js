@@ -32,13 +32,14 @@ import { NetworkError, fetchPayload } from './payload.js';
  * @property {Record<string, string>} [headers] sent with every request
  * @property {number} [capacity] vertices of the last level (from the manifest): the
  *   renderer sizes its position and colour buffers once for it
- * @property {PartsRequest} [parts] refine a charted stream by parts where the camera
- *   looks, after its global batches (worker.js, part-refinement.js)
+ * @property {PartsRequest} [parts] refine a charted or nested stream by parts where the camera
+ *   looks, after its global batches (worker.js, part-refinement.js, nested-refinement.js)
  */
 
 /**
  * @typedef {object} PartsRequest
- * @property {string} indexUrl absolute URL of the part index (the manifest's `parts`)
+ * @property {string} indexUrl absolute URL of the part index (the manifest's `parts` or `nested_parts`)
+ * @property {boolean} [nested] a nested stream's (format 6: nested-refinement.js)
  * @property {string} apiBase the URL the index's paths are relative to (the manifest's)
  * @property {[string, string][]} query forwarded on every request (`device`, `token`)
  * @property {number} budget resident vertices, at most

@@ -48,9 +48,9 @@ import { PointModel } from './splats/point-model.js';
  * @property {import('./view-state.js').ViewState} [view] a shared view to open at (view-state.js)
  * @property {string | null} [contentState] a IIIF Content State to open at (`iiif-content`; content-state.js)
  * @property {{ tour: number, step: number } | null} [tour] a tour link: open this tour at this step (from 1; tour.js)
- * @property {'uniform' | 'view' | null} [refine] how a charted stream with a part index refines:
- *   `uniform` (null or absent) batch by batch to the cap, `view` chart by chart where the camera
- *   looks (part-refinement.js; README, "View-dependent refinement")
+ * @property {'uniform' | 'view' | null} [refine] how a charted or nested stream with a part index
+ *   refines: `uniform` (null or absent) batch by batch to the cap, `view` chart by chart where the
+ *   camera looks (part-refinement.js, nested-refinement.js; README, "View-dependent refinement")
  * @property {number | null} [vertexBudget] with `refine: 'view'`, the most vertices held
  *   (null or absent: by the visitor's device, part-selection.js VERTEX_BUDGETS)
  */
@@ -77,6 +77,7 @@ import { PointModel } from './splats/point-model.js';
  * @property {'mesh' | 'points'} [kind] a point cloud's levels are prefixes of a point stream (splats/point-model.js)
  * @property {number} [stream_format] 5: a charted stream, whose charts a pool of workers refines
  * @property {string} [parts] the part index of a charted stream (view-dependent refinement)
+ * @property {string} [nested_parts] the part index of a nested stream (format 6: view-dependent refinement down its tree of charts)
  * @property {import('./rights.js').Rights} [rights] credit line and licence (absent from older servers)
  * @property {{ url: string, level: number, bytes: number } | null} [download] a GLB of the level this visitor may take, where the policy offers one
  */
@@ -249,7 +250,7 @@ export class Viewer {
   /** @type {Map<number, (answer: { distance?: number, level?: number, error?: string }) => void>} */
   #geodesics = new Map();
   #nextGeodesic = 1;
-  /** View-dependent refinement's state, from the decode worker (null: not refining by parts). @type {import('./part-refinement.js').PartsState | null} */
+  /** View-dependent refinement's state, from the decode worker (null: not refining by parts). @type {import('./part-refinement.js').PartsState | import('./nested-refinement.js').NestedState | null} */
   #parts = null;
   /** @type {ReturnType<typeof setTimeout> | null} */
   #partCameraTimer = null;
@@ -335,7 +336,8 @@ export class Viewer {
 
   /**
    * View-dependent refinement's state (null when the model does not refine by parts):
-   * charts, their depths, the final depth, resident vertices and the budget, bytes fetched.
+   * charts, their depths, the final depth, resident vertices and the budget, bytes fetched;
+   * for a nested stream (`kind: 'nested'`) per phase (nested-refinement.js NestedState).
    */
   partsState() {
     return this.#parts && structuredClone(this.#parts);
@@ -344,15 +346,16 @@ export class Viewer {
   /**
    * One chart as the decode worker holds it (tests compare it with a whole decoder's chart).
    * @param {number} chart
+   * @param {number} [phase] a nested stream's phase (default 0)
    * @returns {Promise<{ depth: number, positions: Float32Array, colours: Uint8Array | null, indices: Uint32Array }>}
    */
-  partChart(chart) {
+  partChart(chart, phase = 0) {
     const worker = this.#worker;
     if (!worker) return Promise.reject(new Error('no model loaded'));
     const id = this.#nextGeodesic++;
     return new Promise((resolve, reject) => {
       this.#partCharts.set(id, (answer) => (answer.error ? reject(new Error(answer.error)) : resolve(answer)));
-      worker.postMessage({ type: 'part-chart', id, chart });
+      worker.postMessage({ type: 'part-chart', id, chart, phase });
     });
   }
 
@@ -698,10 +701,12 @@ export class Viewer {
         ? 'always'
         : 'last',
     };
-    const byParts = Boolean(manifest.parts) && this.options.refine === 'view' && this.options.level === null && this.#hold === null;
+    const index = manifest.parts ?? manifest.nested_parts;
+    const byParts = Boolean(index) && this.options.refine === 'view' && this.options.level === null && this.#hold === null;
     if (byParts) {
       request.parts = {
-        indexUrl: url(/** @type {string} */ (manifest.parts)),
+        indexUrl: url(/** @type {string} */ (index)),
+        nested: !manifest.parts,
         apiBase: this.options.manifestUrl,
         query: [...this.options.query],
         budget: this.options.vertexBudget ?? defaultBudget(manifest.visitor?.device),
@@ -863,7 +868,7 @@ export class Viewer {
   /**
    * @param {import('./reconstruction.js').PageMessage | import('./splats/mesh-splat-view.js').LevelData
    *   | { type: 'geodesic', id: number, distance?: number, level?: number, error?: string }
-   *   | { type: 'parts', state: import('./part-refinement.js').PartsState } | { type: 'part-chart', id: number }} message
+   *   | { type: 'parts', state: import('./part-refinement.js').PartsState | import('./nested-refinement.js').NestedState } | { type: 'part-chart', id: number }} message
    */
   #message(message) {
     if (message.type === 'level-data') return void this.meshSplats.receive(message);
@@ -877,7 +882,8 @@ export class Viewer {
       this.#parts = message.state;
       if (this.state.shownLevel >= 0) this.#set({ vertices: message.state.resident, received: message.state.bytesFetched });
       if (!before) this.#sendPartCamera();
-      if (!before || before.depths.some((d, k) => d !== message.state.depths[k])) this.#emit('vitrine-parts', { depths: message.state.depths });
+      // Depths per chart (per phase and chart for a nested stream): compared flat, the shape never changes.
+      if (!before || String(before.depths) !== String(message.state.depths)) this.#emit('vitrine-parts', { depths: message.state.depths });
       return;
     }
     if (message.type === 'geodesic') {

@@ -11,6 +11,8 @@
  */
 
 import { VitrineCodec } from './codec.js';
+import { NestedRefinement } from './nested-refinement.js';
+import { nestedTable } from './nested-selection.js';
 import { PartRefinement } from './part-refinement.js';
 import { fetchPayload } from './payload.js';
 import { Reconstruction } from './reconstruction.js';
@@ -24,9 +26,10 @@ import { Reconstruction } from './reconstruction.js';
  *   | { type: 'geodesic', id: number, from: number[], to: number[] }
  *   | { type: 'level-data', id: number }
  *   | { type: 'part-camera', camera: import('./part-selection.js').PartCamera }
- *   | { type: 'part-chart', id: number, chart: number }} WorkerCommand
- * `part-camera`: where the camera is, for view-dependent refinement (part-refinement.js);
- * `part-chart` is answered with `{ type: 'part-chart', id, depth, positions, colours, indices }` or `{ type: 'part-chart', id, error }`.
+ *   | { type: 'part-chart', id: number, chart: number, phase?: number }} WorkerCommand
+ * `part-camera`: where the camera is, for view-dependent refinement (part-refinement.js, nested-refinement.js);
+ * `part-chart` (`phase`: a nested stream's, default 0) is answered with
+ * `{ type: 'part-chart', id, depth, positions, colours, indices }` or `{ type: 'part-chart', id, error }`.
  * `geodesic` is answered with `{ type: 'geodesic', id, distance, level }` or `{ type: 'geodesic', id, error }`;
  * `level-data` with a copy of the last decoded level (splats/mesh-splat-view.js `LevelData`), or nothing before one.
  */
@@ -37,7 +40,7 @@ const scope = /** @type {DedicatedWorkerGlobalScope} */ (/** @type {unknown} */ 
 let codec = null;
 /** @type {Reconstruction | null} */
 let job = null;
-/** View-dependent refinement, once the global batches are in (a load with `parts`). @type {PartRefinement | null} */
+/** View-dependent refinement, once the global batches are in (a load with `parts`). @type {PartRefinement | NestedRefinement | null} */
 let parts = null;
 /** The camera sent before the refinement started. @type {import('./part-selection.js').PartCamera | null} */
 let partCamera = null;
@@ -107,7 +110,7 @@ scope.onmessage = async (/** @type {MessageEvent<WorkerCommand>} */ event) => {
   } else if (command.type === 'part-chart') {
     try {
       if (!parts) throw new Error('not refining by parts');
-      const { depth, positions, colours, indices } = parts.chart(command.chart);
+      const { depth, positions, colours, indices } = parts.chart(command.chart, command.phase ?? 0);
       scope.postMessage({ type: 'part-chart', id: command.id, depth, positions, colours, indices });
     } catch (error) {
       scope.postMessage({ type: 'part-chart', id: command.id, error: error instanceof Error ? error.message : String(error) });
@@ -143,7 +146,7 @@ let instanceNow = null;
 
 /**
  * @param {VitrineCodec} codec
- * @param {PartRefinement} refinement
+ * @param {{ current(): import('./codec.js').Level }} refinement
  * @param {number[]} from
  * @param {number[]} to
  */
@@ -161,8 +164,10 @@ function surfaceDistance(codec, refinement, from, to) {
  * A charted stream refined where the camera looks (issue 41): the part
  * index first, then the base and the global batches as any load (one
  * decoder, no pool), then the first parted batch's head turns the decoder
- * into a PartView and part-refinement.js takes over. A stream whose cap
- * stops before its parted batches loads as usual.
+ * into a PartView and part-refinement.js takes over; for a nested stream
+ * (format 6, the request's `nested`), into a NestedView declared from the
+ * index, and nested-refinement.js takes over. A stream whose cap stops
+ * before its parted batches loads as usual.
  * @param {VitrineCodec} codec
  * @param {import('./reconstruction.js').LoadRequest} request
  * @param {number} load
@@ -185,7 +190,7 @@ async function loadParted(codec, request, load) {
     if ('bytes' in fetched) bytes += fetched.bytes.length;
     return fetched;
   };
-  /** @type {import('./part-selection.js').PartIndex} */
+  /** @type {import('./part-selection.js').PartIndex & import('./nested-selection.js').NestedPartIndex} */
   let index;
   try {
     const fetched = await payload(options.indexUrl, 'part index');
@@ -224,9 +229,9 @@ async function loadParted(codec, request, load) {
       const head = await payload(url(index.head_url), 'parted batch head');
       if (!('bytes' in head)) throw new Error('the server refused the parted batch head');
       if (load !== loads) return decoder.free();
-      const view = decoder.intoView(head.bytes);
-      parts = new PartRefinement({
-        view,
+      /** @param {string} what @param {string} path */
+      const piece = (what, path) => fetchPayload(url(path), { what, headers });
+      const common = {
         index,
         budget: options.budget,
         capLevel: partedUpTo ?? request.upTo,
@@ -234,13 +239,23 @@ async function loadParted(codec, request, load) {
         baseBounds: level.baseBounds,
         bytesFetched: level.received + bytes,
         wireframe: request.wireframe,
-        fetchPart: (part) => {
-          const address = url(index.part_url.replace('{level}', String(part.level)).replace('{chart}', String(part.chart)));
-          return fetchPayload(address, { what: `part ${part.chart} of batch ${part.level}`, headers });
-        },
+        /** @param {{ level: number, chart: number }} part */
+        fetchPart: (part) =>
+          piece(`part ${part.chart} of batch ${part.level}`, index.part_url.replace('{level}', String(part.level)).replace('{chart}', String(part.chart))),
         post,
-        tell: (message) => scope.postMessage(message),
-      });
+        tell: (/** @type {any} */ message) => scope.postMessage(message),
+      };
+      if (options.nested) {
+        const view = decoder.intoNested(head.bytes, nestedTable(index).batchesInOrder);
+        parts = new NestedRefinement({
+          ...common,
+          view,
+          fetchSplit: (split) =>
+            piece(`split entry ${split.parent} of batch ${split.level}`, index.split_url.replace('{level}', String(split.level)).replace('{parent}', String(split.parent))),
+        });
+      } else {
+        parts = new PartRefinement({ ...common, view: decoder.intoView(head.bytes) });
+      }
       if (partCamera) parts.setCamera(partCamera);
     } catch (error) {
       const kind = error instanceof Error && /refused|fetch|answered/.test(error.message) ? 'network' : 'decode';

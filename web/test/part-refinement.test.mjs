@@ -7,25 +7,18 @@
 // reaches the final depth bit for bit the whole decoder's; the budget holds.
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
-import { existsSync, readFileSync } from 'node:fs';
-import { VitrineCodec, partedLayout, splitStream } from '../src/codec.js';
-import { OrbitCamera, multiply } from '../src/camera.js';
+import { partedLayout, splitStream } from '../src/codec.js';
 import { PartRefinement } from '../src/part-refinement.js';
-import { boundingSphere } from '../src/part-selection.js';
-import { fixture, wasmPath } from './support/fixtures.mjs';
+import { fixture } from './support/fixtures.mjs';
+import { cameraOn, loadCodec as codec, refinementSink } from './support/refinement.mjs';
 
 /** @typedef {import('../src/reconstruction.js').LevelMessage} LevelMessage */
 /** @typedef {import('../src/part-refinement.js').PartsState} PartsState */
 
-async function codec() {
-  assert.ok(existsSync(wasmPath), `build the wasm first: ${wasmPath}`);
-  return VitrineCodec.instantiate(readFileSync(wasmPath));
-}
-
 /**
  * The fixture's global batches decoded, its parted batches as a part index
  * (errors halving with each level) and the parts' bytes.
- * @param {VitrineCodec} c
+ * @param {import('../src/codec.js').VitrineCodec} c
  */
 function opened(c) {
   const { base, batches } = splitStream(fixture('charted-torus').stream);
@@ -56,21 +49,6 @@ function opened(c) {
 }
 
 /**
- * A camera close to a chart, looking at it from outside the model.
- * @param {Float32Array} positions the chart's
- * @returns {import('../src/part-selection.js').PartCamera}
- */
-function cameraOn(positions) {
-  const { centre } = boundingSphere(positions);
-  const c = new OrbitCamera({ min: [-2, -2, -2], max: [2, 2, 2] }, 1);
-  const out = Math.hypot(...centre) || 1;
-  const yaw = Math.atan2(centre[0], centre[2]);
-  const pitch = Math.asin(Math.max(-1, Math.min(1, centre[1] / out)));
-  c.state = { target: centre, distance: 0.05, yaw, pitch };
-  return { eye: c.basis().eye, clip: Array.from(multiply(c.projection(1), c.view())), pixelsPerRadian: 1000 / c.fovY };
-}
-
-/**
  * Runs a refinement until it settles; returns its messages and a vertex store
  * as the renderer's (vertex-store.js: positions from `firstVertex` on).
  * @param {{ budget: number }} options
@@ -78,16 +56,9 @@ function cameraOn(positions) {
 async function refine({ budget }) {
   const c = await codec();
   const { view, index, bytes, vertices, base, batches } = opened(c);
-  let store = new Float32Array(0);
-  /** @type {LevelMessage | null} */
-  let last = null;
-  /** @type {PartsState | null} */
-  let state = null;
-  /** @type {string[]} */
-  const errors = [];
+  /** @type {ReturnType<typeof refinementSink<PartsState>>} */
+  const sink = refinementSink();
   const fetched = { count: 0 };
-  /** @type {(() => void) | null} */
-  let wake = null;
   const refinement = new PartRefinement({
     view,
     index,
@@ -102,29 +73,13 @@ async function refine({ budget }) {
       await new Promise((resolve) => setTimeout(resolve, 1));
       return { bytes: /** @type {Uint8Array} */ (bytes.get(`${part.level} ${part.chart}`)) };
     },
-    post: (message) => {
-      if (message.type !== 'level') return;
-      const first = /** @type {number} */ (message.firstVertex);
-      const grown = new Float32Array(Math.max(store.length, 3 * message.vertices));
-      grown.set(store);
-      grown.set(message.positions, 3 * first);
-      store = grown;
-      last = message;
-    },
-    tell: (message) => {
-      if (message.type === 'parts') state = message.state;
-      else errors.push(JSON.stringify(message));
-      wake?.();
-    },
+    post: sink.post,
+    tell: sink.tell,
   });
   const target = 0;
-  refinement.setCamera(cameraOn(view.chart(target).positions));
-  for (let i = 0; i < 500 && !(/** @type {PartsState | null} */ (state)?.settled); i++) {
-    await new Promise((resolve) => {
-      wake = () => resolve(undefined);
-      setTimeout(resolve, 20);
-    });
-  }
+  const state = await sink.settle(() => refinement.setCamera(cameraOn(view.chart(target).positions)));
+  const { store, last } = sink.posted();
+  const errors = sink.errors;
   return { c, refinement, view, store, last: /** @type {LevelMessage | null} */ (last), state: /** @type {PartsState | null} */ (state), errors, base, batches, target, fetched };
 }
 

@@ -36,7 +36,7 @@ function digest(level) {
 
 test('the committed fixtures: small, each the stream its sidecar was blessed from', () => {
   const names = fixtureNames();
-  assert.deepEqual(names, ['charted-torus', 'painted-torus', 'plate', 'sphere', 'torus']);
+  assert.deepEqual(names, ['charted-torus', 'nested-torus', 'painted-torus', 'plate', 'sphere', 'torus']);
   for (const name of names) {
     const f = fixture(name);
     assert.ok(f.stream.length < 16 << 10, `${name}.vtr is ${f.stream.length} bytes`);
@@ -45,8 +45,8 @@ test('the committed fixtures: small, each the stream its sidecar was blessed fro
     assert.ok(f.levels.length >= 3, `${name}: a base and several batches`);
     f.levels.forEach((level, k) => assert.equal(level.level, k));
     // Byte 4 is the stream's version: 5 for the charted stream (its later
-    // batches in one part per chart), 4 for the plain ones.
-    assert.equal(f.stream[4], name === 'charted-torus' ? 5 : 4, `${name}.vtr version`);
+    // batches in one part per chart), 6 for the nested one, 4 for the plain ones.
+    assert.equal(f.stream[4], { 'charted-torus': 5, 'nested-torus': 6 }[name] ?? 4, `${name}.vtr version`);
   }
 });
 
@@ -62,7 +62,7 @@ for (const name of fixtureNames()) {
       // The zero-copy views the decode worker reads are the same bytes.
       assert.deepEqual(digest(decoder.view()), f.levels[k], `${name} level ${k} through view()`);
     }
-    if (name === 'painted-torus' || name === 'charted-torus') assert.ok(f.levels.every((l) => l.colours !== null), 'colour at every level');
+    if (name === 'painted-torus' || name === 'charted-torus' || name === 'nested-torus') assert.ok(f.levels.every((l) => l.colours !== null), 'colour at every level');
     else assert.ok(f.levels.every((l) => l.colours === null), 'no colour');
     decoder.free();
   });
@@ -238,9 +238,12 @@ function edited(edit) {
   return writeBatch(batch);
 }
 
+/** The fixtures this file's batch parser reads: formats 4 and 5 (a nested stream's batches carry a phase). */
+const flatFixtures = () => fixtureNames().filter((name) => name !== 'nested-torus');
+
 test('the test can take a batch apart and put it together again byte for byte', () => {
   let parted = 0;
-  for (const name of fixtureNames()) {
+  for (const name of flatFixtures()) {
     const { batches } = splitStream(fixture(name).stream);
     batches.forEach((bytes, i) => {
       const batch = parseBatch(bytes, labelled(batches, i));
@@ -345,7 +348,7 @@ test('wasm refuses every batch of every fixture with flipped bytes', async () =>
     for (let at = 40; at < out.length; at += 7) out[at] ^= 0x5a;
     return out;
   };
-  for (const name of fixtureNames()) {
+  for (const name of flatFixtures()) {
     const { base, batches } = splitStream(fixture(name).stream);
     for (const [flip, reason] of /** @type {Array<[(b: Uint8Array, first: boolean) => Uint8Array, RegExp]>} */ ([
       [connectivity, /pass insert|patch faces do not match their pattern|truncated entropy-coded payload/],

@@ -11,6 +11,11 @@
 //!    phase's first batch after phase 0: one per chart of the phase before)
 //!    and `start, end` per chart (byte ranges within the batch). The
 //!    layouts are kept for step 2.
+//!    A viewer that fetches heads and parts, never whole batches, calls
+//!    `nested_layout_declare(level, phase, charts, splits)` instead, from
+//!    the part index's facts, with the `splits` children counts as u32s
+//!    (little-endian) in the input buffer: the same layouts without their
+//!    byte ranges, all that step 2 reads.
 //! 2. `nested_new(decoder, len)` with the first parted batch's head in the
 //!    input buffer turns a decoder (its global batches applied) into a view
 //!    of the kept layouts; the decoder handle is spent, the layouts cleared.
@@ -85,6 +90,41 @@ pub extern "C" fn nested_layout(len: u32) -> i32 {
             let charts = layout.parts.len() as i32;
             LAYOUTS.with(|l| l.borrow_mut().push(layout));
             charts
+        }
+        Err(e) => fail(e.to_string()),
+    }
+}
+
+/// Declares the next parted batch's layout from a part index's facts (see
+/// the module's notes): the chart count, or −1 (not kept) when it does not
+/// follow the layouts kept so far or its children do not add up.
+#[no_mangle]
+pub extern "C" fn nested_layout_declare(level: u32, phase: u32, charts: u32, splits: u32) -> i32 {
+    let children: Vec<usize> = input(splits.saturating_mul(4), |bytes| {
+        bytes
+            .chunks_exact(4)
+            .map(|w| u32::from_le_bytes([w[0], w[1], w[2], w[3]]) as usize)
+            .collect()
+    });
+    if children.len() != splits as usize {
+        return fail(format!(
+            "{splits} children counts expected in the input buffer"
+        ));
+    }
+    let declared = LAYOUTS.with(|l| {
+        let previous = l.borrow().last().map(|p| (p.phase, p.parts.len()));
+        NestedLayout::declare(
+            level as usize,
+            phase as usize,
+            charts as usize,
+            &children,
+            previous,
+        )
+    });
+    match declared {
+        Ok(layout) => {
+            LAYOUTS.with(|l| l.borrow_mut().push(layout));
+            charts as i32
         }
         Err(e) => fail(e.to_string()),
     }

@@ -50,8 +50,10 @@ pub struct EncodeArgs {
     pub guard: GuardArgs,
     /// Cut the stream into charts that decode on several cores (format 5):
     /// `off` (the default: format 4), `auto` (2 charts from 100,000 vertices, 4 from 200,000;
-    /// plain below 100,000), a number of charts, 2–64, or `nested` (format 6:
-    /// nested charts for view-dependent streaming).
+    /// plain below 100,000), a number of charts, 2–64, `nested` (format 6:
+    /// nested charts for view-dependent streaming, shaped by the mesh's size)
+    /// or `nested:TOP,FANOUT,PHASES` (format 6 in this shape: TOP charts, each
+    /// split into FANOUT children at each of PHASES − 1 splits).
     #[arg(long, default_value = "off")]
     pub charts: ChartsArg,
 }

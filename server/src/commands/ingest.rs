@@ -63,8 +63,11 @@ pub struct IngestArgs {
     /// cores at once (format 5): `auto` (the default: 2 charts from 100,000
     /// vertices, 4 from 200,000, a plain stream below; about 1–1.5 % more
     /// bytes, 1.3–1.5× faster to the last level with two decode workers:
-    /// BENCHMARKS.md, "Charts"), `off` (format 4), 2–64, or `nested`
-    /// (format 6: nested charts, each part served on its own).
+    /// BENCHMARKS.md, "Charts"), `off` (format 4), 2–64, `nested`
+    /// (format 6: nested charts, each part served on its own, shaped by the
+    /// mesh's size) or `nested:TOP,FANOUT,PHASES` (format 6 in this shape:
+    /// TOP charts, each split into FANOUT children at each of PHASES − 1
+    /// splits).
     #[arg(long, default_value = "auto")]
     pub charts: ChartsArg,
     /// How colour travels: `ccc` (a cubic cell complex: a cell texture and

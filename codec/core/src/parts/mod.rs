@@ -149,14 +149,7 @@ impl NestedLayout {
         if !(1..=crate::MAX_PHASE_CHARTS).contains(&charts) {
             return Err(Error::stream(format!("{charts} charts is out of range")));
         }
-        let begins = match previous {
-            None => phase == 0,
-            Some((p, _)) if p == phase => false,
-            Some((p, _)) => p + 1 == phase,
-        };
-        if !begins && previous.is_none_or(|(p, k)| p != phase || k != charts) {
-            return Err(Error::stream("a parted batch out of its phase"));
-        }
+        let begins = begins_phase(phase, charts, previous)?;
         let mut splits = Vec::new();
         if begins {
             let section = r.section()?;
@@ -201,6 +194,62 @@ impl NestedLayout {
             parts,
         }))
     }
+}
+
+impl NestedLayout {
+    /// A parted batch's layout declared from what a part index says of it
+    /// (its level, phase and chart count, and in a phase's first batch
+    /// after phase 0 each previous chart's number of children), without
+    /// its bytes: every range is empty. Enough for
+    /// [`crate::Decoder::into_nested_view`], which reads only the tree's
+    /// shape, so a viewer that fetches heads and parts, never whole
+    /// batches, starts a view. `previous`: the phase and chart count of the
+    /// batch declared before (`None` for the first), as in
+    /// [`NestedLayout::parse_after`].
+    pub fn declare(
+        level: usize,
+        phase: usize,
+        charts: usize,
+        children: &[usize],
+        previous: Option<(usize, usize)>,
+    ) -> Result<NestedLayout> {
+        if !(1..=crate::MAX_PHASE_CHARTS).contains(&charts) {
+            return Err(Error::stream(format!("{charts} charts is out of range")));
+        }
+        let begins = begins_phase(phase, charts, previous)?;
+        let parents = match previous {
+            Some((_, k)) if begins && phase > 0 => k,
+            _ => 0,
+        };
+        if children.len() != parents || (parents > 0 && children.iter().sum::<usize>() != charts) {
+            return Err(Error::stream(
+                "a split declares a different number of charts",
+            ));
+        }
+        Ok(NestedLayout {
+            level,
+            phase,
+            head: 0..0,
+            begins,
+            splits: children.iter().map(|&c| (c, 0..0)).collect(),
+            parts: vec![0..0; charts],
+        })
+    }
+}
+
+/// Whether a parted batch of `phase` with `charts` charts begins its phase,
+/// after a batch of `previous` (phase, charts); an error when it is out of
+/// its phase.
+fn begins_phase(phase: usize, charts: usize, previous: Option<(usize, usize)>) -> Result<bool> {
+    let begins = match previous {
+        None => phase == 0,
+        Some((p, _)) if p == phase => false,
+        Some((p, _)) => p + 1 == phase,
+    };
+    if !begins && previous.is_none_or(|(p, k)| p != phase || k != charts) {
+        return Err(Error::stream("a parted batch out of its phase"));
+    }
+    Ok(begins)
 }
 
 /// What a viewer that refines one leaf of a nested stream (format 6)
