@@ -7,8 +7,8 @@
 // whole decoder's chart; the charts behind stay coarser; fewer bytes than
 // the whole stream; resident vertices within the budget, also a budget
 // small enough to make the viewer fold subtrees back; a phone capped below
-// the last level fetches nothing past its cap; without `?refine=view` the
-// stream decodes uniformly.
+// the last level fetches nothing past its cap; refinement by view is the
+// default for a nested stream, `?refine=uniform` decodes it batch by batch.
 import { after, before, test } from 'node:test';
 import assert from 'node:assert/strict';
 import { launch } from '../test/support/browser.mjs';
@@ -177,8 +177,14 @@ test('a phone capped below the last level: no part or split entry past the cap, 
   await page.close();
 });
 
-test('without ?refine=view a nested stream decodes batch by batch to the last level, as any stream', async () => {
-  const { page, problems, requests } = await open('', '');
+test('a nested stream refines by view without ?refine, and batch by batch with ?refine=uniform', async () => {
+  const byDefault = await open('', CAMERA);
+  const shown = await settled(byDefault.page);
+  assert.equal(shown.kind, 'nested', 'refined by view without being asked');
+  assert.deepEqual(byDefault.problems, []);
+  await byDefault.page.close();
+
+  const { page, problems, requests } = await open('refine=uniform', '');
   await page.waitForFunction(() => /** @type {any} */ (document.querySelector('vitrine-viewer'))?.viewer?.state.status === 'complete', undefined, {
     timeout: 30_000,
   });

@@ -23,7 +23,9 @@
  * `step` open a guided tour at a step (from 1; tour.js). `refine="view"` refines a
  * charted or nested stream chart by chart where the camera looks, within `vertex-budget`
  * vertices (default by device; README, "View-dependent refinement");
- * `refine="uniform"`, the default, batch by batch.
+ * `refine="uniform"` batch by batch. Without the attribute a nested stream
+ * (format 6, made for scans larger than a device) refines by view and any
+ * other stream batch by batch.
  */
 
 import { t } from './i18n/index.js';
@@ -95,7 +97,7 @@ export class VitrineViewerElement extends HTMLElement {
       view: parseView(this.getAttribute('view')),
       contentState: this.getAttribute('iiif-content'),
       tour: tourLink(this.getAttribute('tour'), this.getAttribute('step')),
-      refine: this.getAttribute('refine') === 'view' ? 'view' : 'uniform',
+      refine: refineMode(this.getAttribute('refine')),
       vertexBudget: positiveInteger(this.getAttribute('vertex-budget')),
     });
     void this.viewer.start();
@@ -114,6 +116,15 @@ export class VitrineViewerElement extends HTMLElement {
 startLanguage();
 
 if (!customElements.get('vitrine-viewer')) customElements.define('vitrine-viewer', VitrineViewerElement);
+
+/**
+ * `refine`: `view` or `uniform`; null (the stream's own default) otherwise.
+ * @param {string | null} value
+ * @returns {'view' | 'uniform' | null}
+ */
+function refineMode(value) {
+  return value === 'view' || value === 'uniform' ? value : null;
+}
 
 /** @param {string | null} value @returns {boolean | null} `on`: true, `off`: false, else null */
 function onOff(value) {

@@ -49,8 +49,10 @@ import { PointModel } from './splats/point-model.js';
  * @property {string | null} [contentState] a IIIF Content State to open at (`iiif-content`; content-state.js)
  * @property {{ tour: number, step: number } | null} [tour] a tour link: open this tour at this step (from 1; tour.js)
  * @property {'uniform' | 'view' | null} [refine] how a charted or nested stream with a part index
- *   refines: `uniform` (null or absent) batch by batch to the cap, `view` chart by chart where the
- *   camera looks (part-refinement.js, nested-refinement.js; README, "View-dependent refinement")
+ *   refines: `uniform` batch by batch to the cap, `view` chart by chart where the camera looks
+ *   (part-refinement.js, nested-refinement.js; README, "View-dependent refinement"); null or
+ *   absent: `view` for a nested stream (format 6 is made for scans larger than a device's
+ *   memory, which a uniform refinement would fill), `uniform` for any other
  * @property {number | null} [vertexBudget] with `refine: 'view'`, the most vertices held
  *   (null or absent: by the visitor's device, part-selection.js VERTEX_BUDGETS)
  */
@@ -702,7 +704,8 @@ export class Viewer {
         : 'last',
     };
     const index = manifest.parts ?? manifest.nested_parts;
-    const byParts = Boolean(index) && this.options.refine === 'view' && this.options.level === null && this.#hold === null;
+    const refine = this.options.refine ?? (manifest.nested_parts && !manifest.parts ? 'view' : 'uniform');
+    const byParts = Boolean(index) && refine === 'view' && this.options.level === null && this.#hold === null;
     if (byParts) {
       request.parts = {
         indexUrl: url(/** @type {string} */ (index)),
