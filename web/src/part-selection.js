@@ -126,6 +126,7 @@ export function facesAway(cone, sphere, eye) {
  * @property {Vec3} eye
  * @property {number[]} clip column-major 4×4, model coordinates → clip space
  * @property {number} pixelsPerRadian the view's height in pixels over its vertical field of view
+ * @property {number} [aspect] the view's width over its height (occlusion.js's map follows it; absent: square)
  */
 
 /**
