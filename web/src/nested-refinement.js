@@ -35,15 +35,14 @@
  * of the union, for the camera) want nothing and fold first, as those out
  * of view: a close-up does not refine the far side of the object. The map
  * is made again for each camera, and when the charts shown changed since
- * it was made, at most once per {@link OCCLUSION_GAP} times its cost (an
- * older map of the same camera stays right: the surface still to come lies
- * within the tolerance of the one it was made from, only less is hidden).
+ * it was made, at most once per {@link OCCLUSION_GAP} times its cost
+ * (occlusion.js OcclusionMap).
  */
 
 import { ChartUnion, weldByPosition } from './chart-union.js';
 import { DecodeError } from './codec.js';
 import { foldOrder, nestedTable, occluderTolerance, occlusionSphere, wantedSteps } from './nested-selection.js';
-import { depthMap, occluded } from './occlusion.js';
+import { OcclusionMap } from './occlusion.js';
 import { PARTS_IN_FLIGHT, boundingSphere, normalCone } from './part-selection.js';
 
 /**
@@ -164,12 +163,8 @@ export class NestedRefinement {
   #union;
   /** The charts shown changed this many times (the depth map's is older when less). */
   #generation = 0;
-  /**
-   * The depth map of the surface shown, and for what.
-   * @type {{ map: import('./occlusion.js').DepthMap, camera: import('./part-selection.js').PartCamera, generation: number, at: number, ms: number } | null}
-   */
-  #occlusion = null;
-  #occlusionMaps = 0;
+  /** The depth map of the charts shown, for the camera. */
+  #occlusion = new OcclusionMap({ gap: OCCLUSION_GAP, maxTriangles: OCCLUSION_TRIANGLES });
 
   /** @param {NestedRefinementOptions} options */
   constructor(options) {
@@ -358,28 +353,20 @@ export class NestedRefinement {
 
   /**
    * Makes the depth map again for a new camera, or when the charts shown
-   * changed and its last cost allows ({@link OCCLUSION_GAP}).
+   * changed and its last cost allows.
    * @param {import('./part-selection.js').PartCamera} camera
    */
   #refreshOcclusion(camera) {
-    const last = this.#occlusion;
-    const now = performance.now();
-    if (last && last.camera === camera && (last.generation === this.#generation || now - last.at < OCCLUSION_GAP * last.ms)) return;
-    const occluders = this.#showing().pieces.map((n) => ({ positions: n.positions, indices: n.indices, tolerance: occluderTolerance(this.table, n) }));
-    const map = depthMap(occluders, camera.clip, camera.aspect ?? 1, { maxTriangles: OCCLUSION_TRIANGLES });
-    const done = performance.now();
-    this.#occlusion = { map, camera, generation: this.#generation, at: done, ms: done - now };
-    this.#occlusionMaps++;
+    this.#occlusion.refresh(camera, this.#generation, () =>
+      this.#showing().pieces.map((n) => ({ positions: n.positions, indices: n.indices, tolerance: occluderTolerance(this.table, n) })),
+    );
   }
 
   /**
-   * Whether a chart is hidden behind the surface shown, for the depth map's camera.
+   * Whether a chart is hidden behind the charts shown, for the camera.
    * @param {import('./nested-selection.js').NodeState} node
    */
-  #hidden = (node) => {
-    const map = this.#occlusion?.map;
-    return map !== undefined && occluded(map, occlusionSphere(this.table, node));
-  };
+  #hidden = (node) => this.#occlusion.hides(this.#camera, occlusionSphere(this.table, node));
 
   /** Every chart held. */
   #all() {
@@ -561,9 +548,9 @@ export class NestedRefinement {
         inFlight: this.#inFlight,
         settled: this.#camera !== null && this.#inFlight === 0 && !this.#union.pending,
         evictions: this.#evictions,
-        hiddenCharts: this.#camera && this.#occlusion?.camera === this.#camera ? pieces.filter(this.#hidden).length : 0,
-        occlusionMs: this.#occlusion?.ms ?? 0,
-        occlusionMaps: this.#occlusionMaps,
+        hiddenCharts: pieces.filter(this.#hidden).length,
+        occlusionMs: this.#occlusion.ms,
+        occlusionMaps: this.#occlusion.made,
       },
     });
   }

@@ -222,3 +222,53 @@ export function occluded(map, sphere) {
   }
   return true;
 }
+
+/**
+ * The depth map of a refinement's camera, kept while it stays right: made
+ * again for each camera (a map answers only for the camera it was made
+ * for), and when the surface shown changed since it was made, no sooner
+ * than `gap` times its last cost after it (an older map of the same camera
+ * stays right, as the surface still to come lies within the tolerance of
+ * the one it was made from: it only hides less). So at most 1 / (1 + gap)
+ * of the worker's time goes to maps while parts arrive.
+ */
+export class OcclusionMap {
+  /** @type {{ map: DepthMap, camera: object, generation: number, at: number, ms: number } | null} */
+  #last = null;
+  /** Maps made so far. */
+  made = 0;
+
+  /** @param {{ gap: number, maxTriangles: number }} options */
+  constructor(options) {
+    this.options = options;
+  }
+
+  /**
+   * @param {import('./part-selection.js').PartCamera} camera
+   * @param {number} generation counts the changes of the surface shown
+   * @param {() => Occluder[]} occluders the surface shown now
+   */
+  refresh(camera, generation, occluders) {
+    const last = this.#last;
+    const now = performance.now();
+    if (last && last.camera === camera && (last.generation === generation || now - last.at < this.options.gap * last.ms)) return;
+    const map = depthMap(occluders(), camera.clip, camera.aspect ?? 1, { maxTriangles: this.options.maxTriangles });
+    const done = performance.now();
+    this.#last = { map, camera, generation, at: done, ms: done - now };
+    this.made++;
+  }
+
+  /**
+   * Whether a sphere is hidden for `camera` (never when the map is another camera's).
+   * @param {import('./part-selection.js').PartCamera | null} camera
+   * @param {import('./part-selection.js').Sphere} sphere
+   */
+  hides(camera, sphere) {
+    return this.#last !== null && this.#last.camera === camera && occluded(this.#last.map, sphere);
+  }
+
+  /** The last map's cost in milliseconds (0: none yet). */
+  get ms() {
+    return this.#last?.ms ?? 0;
+  }
+}
