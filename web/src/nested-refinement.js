@@ -358,7 +358,7 @@ export class NestedRefinement {
    */
   #refreshOcclusion(camera) {
     this.#occlusion.refresh(camera, this.#generation, () =>
-      this.#showing().pieces.map((n) => ({ positions: n.positions, indices: n.indices, tolerance: occluderTolerance(this.table, n) })),
+      this.#showing().pieces.map((n) => ({ key: n, positions: n.positions, indices: n.indices, tolerance: occluderTolerance(this.table, n) })),
     );
   }
 
@@ -366,7 +366,7 @@ export class NestedRefinement {
    * Whether a chart is hidden behind the charts shown, for the camera.
    * @param {import('./nested-selection.js').NodeState} node
    */
-  #hidden = (node) => this.#occlusion.hides(this.#camera, occlusionSphere(this.table, node));
+  #hidden = (node) => this.#occlusion.hides(this.#camera, node, () => occlusionSphere(this.table, node));
 
   /** Every chart held. */
   #all() {

@@ -15,11 +15,13 @@
  * and the occlusion libraries there are (masked occlusion culling, Umbra)
  * are native code for game engines, not a few hundred lines in a worker.
  *
- * Cost: one projection per vertex (a 4×4 row product) and, per triangle, a
- * bounding box that almost always holds no pixel centre when the mesh is
- * fine (2 M triangles on 64×48 pixels: ~0.0015 pixel each), so linear in
- * the union's size, with nothing allocated past a scratch buffer: measured
- * in test/occlusion.test.mjs's cost note and nested-refinement.js.
+ * Cost: one projection per vertex (three rows of the clip matrix) and, per
+ * triangle, a bounding box that almost always holds no pixel centre when
+ * the mesh is fine (2 M triangles on 64×48 pixels: ~0.0015 pixel each), so
+ * linear in the union's size, nothing allocated but the map and one scratch
+ * buffer. COST_NOTE
+ * The test of a sphere reads at most the map's pixels (4096), usually a
+ * few dozen.
  *
  * Why it is conservative (never hides what shows):
  * - a map pixel holds, over the triangles covering its centre, the least
@@ -54,6 +56,14 @@ export const MAP_LONG_SIDE = 64;
  * @property {ArrayLike<number>} clip the camera's, column-major 4×4
  * @property {number} wScale |∂w/∂x| in model units: a length in the model is at most this much w
  * @property {number} triangles drawn (rasterised, not subsampled out)
+ * @property {(Extent | null)[]} extents per occluder, its own: where it
+ *   and the surface still to come in it lie (null: a vertex behind the eye)
+ */
+
+/**
+ * Where a piece of surface lies for the camera: a rectangle on the map (in
+ * pixels, not clipped) and its nearest view depth (clip w).
+ * @typedef {{ x0: number, x1: number, y0: number, y1: number, nearest: number }} Extent
  */
 
 /**
@@ -93,10 +103,18 @@ export function depthMap(occluders, clip, aspect, { longSide = MAP_LONG_SIDE, ma
   const total = occluders.reduce((n, o) => n + o.indices.length / 3, 0);
   const stride = total > maxTriangles ? Math.ceil(total / maxTriangles) : 1;
   let drawn = 0;
+  /** @type {(Extent | null)[]} */
+  const extents = [];
+  // How far on the map a shift of one model unit at view depth 1 may move a
+  // point on screen (d(x/w) = (dx − ndc·dw) / w, |ndc| ≤ 1 on the map).
+  const spread = Math.max((Math.hypot(a0, a1, a2) + wScale) * halfWidth, (Math.hypot(b0, b1, b2) + wScale) * halfHeight);
   for (const { positions, indices, tolerance } of occluders) {
     const vertices = positions.length / 3;
     if (scratch.length < 3 * vertices) scratch = new Float32Array(3 * vertices);
     const s = scratch;
+    let behind = false;
+    let nearest = Infinity;
+    let [ex0, ex1, ey0, ey1] = [Infinity, -Infinity, Infinity, -Infinity];
     for (let v = 0; v < 3 * vertices; v += 3) {
       const x = positions[v];
       const y = positions[v + 1];
@@ -104,14 +122,30 @@ export function depthMap(occluders, clip, aspect, { longSide = MAP_LONG_SIDE, ma
       const w = w0 * x + w1 * y + w2 * z + w3;
       if (!(w > NEAR_W)) {
         s[v + 2] = -1; // behind the eye: its triangles are not drawn
+        behind = true;
         continue;
       }
       const q = 1 / w;
-      s[v] = ((a0 * x + a1 * y + a2 * z + a3) * q + 1) * halfWidth;
-      s[v + 1] = ((b0 * x + b1 * y + b2 * z + b3) * q + 1) * halfHeight;
+      const sx = ((a0 * x + a1 * y + a2 * z + a3) * q + 1) * halfWidth;
+      const sy = ((b0 * x + b1 * y + b2 * z + b3) * q + 1) * halfHeight;
+      s[v] = sx;
+      s[v + 1] = sy;
       s[v + 2] = q;
+      if (w < nearest) nearest = w;
+      if (sx < ex0) ex0 = sx;
+      if (sx > ex1) ex1 = sx;
+      if (sy < ey0) ey0 = sy;
+      if (sy > ey1) ey1 = sy;
     }
     const slack = tolerance * wScale;
+    // The surface to come in this piece lies within its tolerance of it:
+    // nearer by at most that, and on screen that much (at its depth) wider.
+    const near = nearest - slack;
+    if (behind || vertices === 0 || !(near > NEAR_W)) extents.push(null);
+    else {
+      const grow = (tolerance * spread) / near + 1;
+      extents.push({ x0: ex0 - grow, x1: ex1 + grow, y0: ey0 - grow, y1: ey1 + grow, nearest: near });
+    }
     for (let t = 0; t < indices.length; t += 3 * stride) {
       const i0 = 3 * indices[t];
       const i1 = 3 * indices[t + 1];
@@ -170,7 +204,7 @@ export function depthMap(occluders, clip, aspect, { longSide = MAP_LONG_SIDE, ma
       }
     }
   }
-  return { width, height, depth, clip: Array.from(m), wScale, triangles: drawn };
+  return { width, height, depth, clip: Array.from(m), wScale, triangles: drawn, extents };
 }
 
 /**
@@ -211,12 +245,21 @@ export function occluded(map, sphere) {
     y0 = Math.min(y0, sy);
     y1 = Math.max(y1, sy);
   }
-  // Every pixel the rectangle touches, clipped to the map.
+  return covered(map, { x0, x1, y0, y1, nearest });
+}
+
+/**
+ * Whether the map holds something nearer than the extent's nearest depth
+ * at every pixel its rectangle touches (clipped to the map; none: no).
+ * @param {DepthMap} map
+ * @param {Extent} extent
+ */
+export function covered(map, { x0, x1, y0, y1, nearest }) {
   const px0 = Math.max(0, Math.floor(x0));
   const px1 = Math.min(map.width - 1, Math.floor(x1));
   const py0 = Math.max(0, Math.floor(y0));
   const py1 = Math.min(map.height - 1, Math.floor(y1));
-  if (px0 > px1 || py0 > py1) return false;
+  if (!(px0 <= px1 && py0 <= py1)) return false;
   for (let py = py0; py <= py1; py++) {
     for (let px = px0; px <= px1; px++) if (!(map.depth[py * map.width + px] < nearest)) return false;
   }
@@ -233,7 +276,7 @@ export function occluded(map, sphere) {
  * of the worker's time goes to maps while parts arrive.
  */
 export class OcclusionMap {
-  /** @type {{ map: DepthMap, camera: object, generation: number, at: number, ms: number } | null} */
+  /** @type {{ map: DepthMap, camera: object, generation: number, at: number, ms: number, extents: WeakMap<object, Extent | null> } | null} */
   #last = null;
   /** Maps made so far. */
   made = 0;
@@ -246,25 +289,38 @@ export class OcclusionMap {
   /**
    * @param {import('./part-selection.js').PartCamera} camera
    * @param {number} generation counts the changes of the surface shown
-   * @param {() => Occluder[]} occluders the surface shown now
+   * @param {() => (Occluder & { key: object })[]} occluders the surface shown now, each
+   *   with a key (its chart) that {@link hides} knows it by
    */
   refresh(camera, generation, occluders) {
     const last = this.#last;
     const now = performance.now();
     if (last && last.camera === camera && (last.generation === generation || now - last.at < this.options.gap * last.ms)) return;
-    const map = depthMap(occluders(), camera.clip, camera.aspect ?? 1, { maxTriangles: this.options.maxTriangles });
+    const pieces = occluders();
+    const map = depthMap(pieces, camera.clip, camera.aspect ?? 1, { maxTriangles: this.options.maxTriangles });
+    /** @type {WeakMap<object, Extent | null>} */
+    const extents = new WeakMap();
+    for (const [k, piece] of pieces.entries()) extents.set(piece.key, map.extents[k]);
     const done = performance.now();
-    this.#last = { map, camera, generation, at: done, ms: done - now };
+    this.#last = { map, camera, generation, at: done, ms: done - now, extents };
     this.made++;
   }
 
   /**
-   * Whether a sphere is hidden for `camera` (never when the map is another camera's).
+   * Whether a chart is hidden for `camera` (never when the map is another
+   * camera's): a chart drawn in the map by its own extent there (its
+   * vertices then, grown by its tolerance: much tighter than a sphere),
+   * another (one made or changed since, an expanded parent) by its sphere.
    * @param {import('./part-selection.js').PartCamera | null} camera
-   * @param {import('./part-selection.js').Sphere} sphere
+   * @param {object} key
+   * @param {() => import('./part-selection.js').Sphere} sphere
    */
-  hides(camera, sphere) {
-    return this.#last !== null && this.#last.camera === camera && occluded(this.#last.map, sphere);
+  hides(camera, key, sphere) {
+    const last = this.#last;
+    if (last === null || last.camera !== camera) return false;
+    const extent = last.extents.get(key);
+    if (extent === null) return false;
+    return extent ? covered(last.map, extent) : occluded(last.map, sphere());
   }
 
   /** The last map's cost in milliseconds (0: none yet). */

@@ -95,7 +95,7 @@ export class PartRefinement {
   #generation = 0;
   #occlusion = new OcclusionMap(OCCLUSION);
   /** @param {number} k */
-  #hidden = (k) => this.#occlusion.hides(this.#camera, occlusionSphere(this.parts, k, this.#charts[k].sphere));
+  #hidden = (k) => this.#occlusion.hides(this.#camera, this.#charts[k], () => occlusionSphere(this.parts, k, this.#charts[k].sphere));
 
   /** @param {PartRefinementOptions} options */
   constructor(options) {
@@ -180,7 +180,7 @@ export class PartRefinement {
     if (!camera || this.#stopped) return;
     for (let round = 0; round < this.#charts.length * (this.parts.finalDepth + 1) && this.#inFlight < PARTS_IN_FLIGHT; round++) {
       this.#occlusion.refresh(camera, this.#generation, () =>
-        this.#charts.map((c, k) => ({ positions: c.positions, indices: c.indices, tolerance: occluderTolerance(this.parts, k, c.depth) })),
+        this.#charts.map((c, k) => ({ key: c, positions: c.positions, indices: c.indices, tolerance: occluderTolerance(this.parts, k, c.depth) })),
       );
       const limits = { firstLevel: this.firstLevel, capLevel: this.capLevel, hidden: this.#hidden };
       const wanted = wantedParts(this.#charts, this.parts, camera, limits);
