@@ -5,7 +5,7 @@
 // an empty or degenerate surface hiding nothing.
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
-import { depthMap, occluded } from '../src/occlusion.js';
+import { OcclusionMap, depthMap, occluded } from '../src/occlusion.js';
 import { boundingSphere } from '../src/part-selection.js';
 
 /**
@@ -110,4 +110,35 @@ test('the map follows the aspect; a subsample draws fewer triangles and hides no
   const half = depthMap([{ ...square(0, 1), tolerance: 0 }], clipFrom(3), 1, { maxTriangles: 1 });
   assert.equal(half.triangles, 1);
   assert.ok(!occluded(half, sphere(0, 0, -1, 0.2)));
+});
+
+test('a chart drawn in the map is tested by its own extent: tighter than its sphere, never hidden by itself', () => {
+  const camera = { eye: /** @type {[number, number, number]} */ ([0, 0, 3]), clip: clipFrom(3), pixelsPerRadian: 300 };
+  const wall = { key: {}, ...square(0, 1), tolerance: 0 };
+  // A square 0.5 behind the wall, its sphere reaching in front of the wall.
+  const flat = { key: {}, ...square(-0.5, 0.6), tolerance: 0.1 };
+  const occlusion = new OcclusionMap({ gap: 4, maxTriangles: Infinity });
+  occlusion.refresh(camera, 0, () => [wall, flat]);
+  assert.equal(occlusion.made, 1);
+  const sphere = boundingSphere(flat.positions);
+  assert.ok(sphere.radius > 0.5, 'its sphere crosses the wall');
+  assert.ok(!occlusion.hides(camera, {}, () => sphere), 'by its sphere: not hidden');
+  assert.ok(occlusion.hides(camera, flat.key, () => sphere), 'by its extent: hidden');
+  assert.ok(!occlusion.hides(camera, wall.key, () => boundingSphere(wall.positions)), 'the wall does not hide itself');
+  assert.ok(!occlusion.hides({ ...camera }, flat.key, () => sphere), 'another camera: the map does not answer');
+  // Its tolerance past the gap: the surface to come may reach in front of the wall.
+  const loose = { key: {}, ...square(-0.5, 0.6), tolerance: 0.6 };
+  const c2 = { ...camera };
+  occlusion.refresh(c2, 0, () => [wall, loose]);
+  assert.equal(occlusion.made, 2, 'a new camera: a new map');
+  assert.ok(!occlusion.hides(c2, loose.key, () => sphere));
+  // A piece with a vertex behind the eye has no extent: never hidden.
+  const straddling = { key: {}, positions: new Float32Array([-0.1, -0.1, -1, 0.1, -0.1, -1, 0, 0.1, 5]), indices: new Uint32Array([0, 1, 2]), tolerance: 0 };
+  const c3 = { ...camera };
+  occlusion.refresh(c3, 0, () => [wall, straddling]);
+  assert.ok(!occlusion.hides(c3, straddling.key, () => ({ centre: [0, 0, -1], radius: 0.01 })));
+  assert.ok(occlusion.hides(c3, {}, () => ({ centre: [0, 0, -1], radius: 0.01 })), 'a chart not drawn: by its sphere');
+  // The same camera, the surface unchanged: the map is kept.
+  occlusion.refresh(c3, 0, () => [wall]);
+  assert.equal(occlusion.made, 3);
 });
