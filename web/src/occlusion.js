@@ -249,6 +249,18 @@ export function occluded(map, sphere) {
 }
 
 /**
+ * Whether an extent lies wholly off the map: the chart, and the surface to
+ * come in it, are out of view (its vertices' rectangle is the tight frustum
+ * test a bounding sphere's is not: a triangle in front of the eye projects
+ * inside its vertices' hull).
+ * @param {DepthMap} map
+ * @param {Extent} extent
+ */
+export function offMap(map, { x0, x1, y0, y1 }) {
+  return x1 < 0 || y1 < 0 || x0 > map.width || y0 > map.height;
+}
+
+/**
  * Whether the map holds something nearer than the extent's nearest depth
  * at every pixel its rectangle touches (clipped to the map; none: no).
  * @param {DepthMap} map
@@ -309,8 +321,9 @@ export class OcclusionMap {
   /**
    * Whether a chart is hidden for `camera` (never when the map is another
    * camera's): a chart drawn in the map by its own extent there (its
-   * vertices then, grown by its tolerance: much tighter than a sphere),
-   * another (one made or changed since, an expanded parent) by its sphere.
+   * vertices then, grown by its tolerance: much tighter than a sphere; off
+   * the map, it is out of view), another (one made since, an expanded
+   * parent) by its sphere.
    * @param {import('./part-selection.js').PartCamera | null} camera
    * @param {object} key
    * @param {() => import('./part-selection.js').Sphere} sphere
@@ -320,7 +333,7 @@ export class OcclusionMap {
     if (last === null || last.camera !== camera) return false;
     const extent = last.extents.get(key);
     if (extent === null) return false;
-    return extent ? covered(last.map, extent) : occluded(last.map, sphere());
+    return extent ? offMap(last.map, extent) || covered(last.map, extent) : occluded(last.map, sphere());
   }
 
   /** The last map's cost in milliseconds (0: none yet). */

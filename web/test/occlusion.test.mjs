@@ -138,7 +138,13 @@ test('a chart drawn in the map is tested by its own extent: tighter than its sph
   occlusion.refresh(c3, 0, () => [wall, straddling]);
   assert.ok(!occlusion.hides(c3, straddling.key, () => ({ centre: [0, 0, -1], radius: 0.01 })));
   assert.ok(occlusion.hides(c3, {}, () => ({ centre: [0, 0, -1], radius: 0.01 })), 'a chart not drawn: by its sphere');
+  // Off the map by its vertices (its sphere would reach into the view): out of view.
+  const aside = { key: {}, ...square(-0.5, 0.2, 6), tolerance: 0 };
+  const c4 = { ...camera };
+  occlusion.refresh(c4, 0, () => [aside]);
+  assert.ok(occlusion.hides(c4, aside.key, () => ({ centre: [6, 0, -0.5], radius: 5 })));
+  assert.ok(!occlusion.hides(c4, {}, () => ({ centre: [6, 0, -0.5], radius: 5 })));
   // The same camera, the surface unchanged: the map is kept.
-  occlusion.refresh(c3, 0, () => [wall]);
-  assert.equal(occlusion.made, 3);
+  occlusion.refresh(c4, 0, () => [wall]);
+  assert.equal(occlusion.made, 4);
 });
