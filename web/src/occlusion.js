@@ -20,8 +20,8 @@
  * the mesh is fine (2 M triangles on 64×48 pixels: ~0.0015 pixel each), so
  * linear in the union's size, nothing allocated but the map and one scratch
  * buffer. Measured on a 2-core machine shared with a headless Chromium:
- * 2 M triangles (1 M vertices) in 120–170 ms in Node 20 (/tmp script, a
- * UV sphere); in the decode worker of bench/nested-closeup.mjs on igea 2 M,
+ * 2 M triangles (1 M vertices) in 120–170 ms in Node 20 (a UV sphere:
+ * bench/occlusion-cost.mjs); in the decode worker of bench/nested-closeup.mjs on igea 2 M,
  * 40–330 ms per map for 0.4–1.2 M vertices shown. It is bounded by
  * {@link OcclusionMap} (one map per camera, and no sooner than a few times
  * its cost after the last while the surface changes) and `maxTriangles`.
