@@ -2,7 +2,9 @@
 /**
  * Occlusion culling for view-dependent refinement (issue 41): a tiny depth
  * map of the surface shown, rasterised on the CPU in the decode worker, and
- * whether a chart's bounding sphere lies wholly behind it. A chart hidden so
+ * whether a chart lies wholly behind it: a chart drawn in the map by its
+ * own vertices' extent (screen rectangle, nearest depth), any other by its
+ * bounding sphere. A chart hidden so
  * (the far side of a head seen close up) wants no part: without this, every
  * chart in the frustum not facing wholly away refined to under a pixel.
  * Pure: no DOM, no worker, no codec (test/occlusion.test.mjs in Node).
@@ -19,14 +21,16 @@
  * triangle, a bounding box that almost always holds no pixel centre when
  * the mesh is fine (2 M triangles on 64×48 pixels: ~0.0015 pixel each), so
  * linear in the union's size, nothing allocated but the map and one scratch
- * buffer. Measured on a 2-core machine shared with a headless Chromium:
- * 2 M triangles (1 M vertices) in 120–170 ms in Node 20 (a UV sphere:
- * bench/occlusion-cost.mjs); in the decode worker of bench/nested-closeup.mjs on igea 2 M,
- * 40–330 ms per map for 0.4–1.2 M vertices shown. It is bounded by
- * {@link OcclusionMap} (one map per camera, and no sooner than a few times
- * its cost after the last while the surface changes) and `maxTriangles`.
- * The test of a sphere reads at most the map's pixels (4096), usually a
- * few dozen.
+ * buffer. Measured on a 2-core machine shared with others: 2 M triangles
+ * (1 M vertices) in 28 ms with a core free, 70–170 ms with the cores busy
+ * (Node 20, a UV sphere: bench/occlusion-cost.mjs); in the decode worker
+ * of bench/nested-closeup.mjs on igea 2 M (headless Chromium drawing with
+ * SwiftShader on the same cores), 40–330 ms per map for 0.4–1.2 M
+ * vertices. It is bounded by {@link OcclusionMap} (one map per camera, and
+ * no sooner than a few times its cost after the last while the surface
+ * changes) and `maxTriangles` (past it, every k-th triangle: for a fine
+ * mesh that leaves most pixels empty, so in effect no culling, never a
+ * wrong one). The test of a chart reads at most the map's pixels (4096).
  *
  * Why it is conservative (never hides what shows):
  * - a map pixel holds, over the triangles covering its centre, the least
@@ -34,8 +38,11 @@
  *   sphere" means some shown triangle, even pushed back by its tolerance
  *   (the surface still to come lies within it), covers the centre in front
  *   of the sphere; an empty pixel holds +∞ and hides nothing;
- * - the sphere's rectangle is that of the cube around it (its eight corners
- *   projected), and every pixel it touches must be covered, so a chart seen
+ * - a sphere's rectangle is that of the cube around it (its eight corners
+ *   projected); a drawn chart's, its vertices' grown by its tolerance on
+ *   screen (a triangle in front of the eye projects inside its vertices'
+ *   hull, so off the map it is out of view), its depth their nearest less
+ *   its tolerance; every pixel it touches must be covered, so a chart seen
  *   through any pixel centre of the map refines; one seen only between
  *   centres (a sliver under a map pixel wide) may not: the price of a map
  *   this small;
@@ -43,9 +50,9 @@
  *   a triangle with a vertex behind the eye is not drawn (less is hidden);
  * - triangles left out (none, or a subsample when the union is huge) only
  *   leave pixels empty or farther: less is hidden, never more.
- * - a chart's own surface lies in its sphere (inflated by its drift: see
- *   nested-selection.js), so it is never nearer than the sphere's nearest
- *   point: a chart does not hide itself.
+ * - a chart's own surface lies in its extent, or its sphere (inflated by
+ *   its drift: see nested-selection.js), so it is never nearer than their
+ *   nearest point: a chart does not hide itself.
  */
 
 /** The map's long side in pixels; the short side follows the view's aspect. */
