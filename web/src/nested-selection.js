@@ -172,15 +172,16 @@ export function occluderTolerance(table, node) {
 /**
  * A chart's bounding sphere for occlusion: the one made at its cut, grown
  * by every part error of its phase (their sum: how far its parts may have
- * moved its surface out of that sphere), so its own surface, shown at any
- * depth and pushed back by its tolerance, is never nearer than the sphere's
- * nearest point: a chart never hides itself.
+ * moved its surface out of that sphere) and twice the largest below it (its
+ * descendants', shown in its place when it is expanded), so its own
+ * surface, or its descendants', is never nearer than the sphere's nearest
+ * point: a chart never hides itself.
  * @param {NestedTable} table
  * @param {NodeState} node
  * @returns {import('./part-selection.js').Sphere}
  */
 export function occlusionSphere(table, node) {
-  const drift = table.parts[node.phase][node.chart].reduce((e, part) => e + part.error, 0);
+  const drift = table.parts[node.phase][node.chart].reduce((e, part) => e + part.error, 0) + 2 * table.below[node.phase][node.chart];
   return { centre: node.sphere.centre, radius: node.sphere.radius + drift };
 }
 
