@@ -5,7 +5,8 @@
 // with `?refine=view`, settles, then zooms onto one point of the surface.
 // Reported: bytes fetched for the overview and for the close-up against
 // the whole stream's, the most vertices resident, and the time from the
-// zoom to the chart under the camera at the last phase's final depth, with
+// zoom to the chart under the camera at the last phase's final depth, the
+// occlusion depth map's cost, with
 // DevTools network emulation at `--mbits` (default 10 Mbit/s; 0: loopback).
 // Keep meshes to 2 M vertices or fewer on a small machine.
 //   node bench/nested-closeup.mjs MESH [--charts nested:2,2,5] [--target x,y,z] [--distance 0.05] [--budget N] [--mbits 10]
@@ -60,6 +61,8 @@ try {
     : [(bounds.min[0] + bounds.max[0]) / 2, (bounds.min[1] + bounds.max[1]) / 2, bounds.max[2]];
   const distance = size * (values.distance ? Number(values.distance) : 0.05);
   let maxResident = overview.resident;
+  // The depth map's cost (occlusion.js), as sampled: the slowest seen.
+  let maxOcclusionMs = overview.occlusionMs;
   const zoomed = performance.now();
   await page.evaluate(
     ({ target, distance }) => {
@@ -77,6 +80,7 @@ try {
     await new Promise((r) => setTimeout(r, 200));
     const s = await page.evaluate(() => /** @type {any} */ (document.querySelector('vitrine-viewer')).viewer.partsState());
     maxResident = Math.max(maxResident, s.resident);
+    maxOcclusionMs = Math.max(maxOcclusionMs, s.occlusionMs);
     if (finalMs === null && s.deepestPhase === s.phases - 1 && s.depths[s.phases - 1].some((/** @type {number} */ d) => d === s.finalDepth)) {
       finalMs = performance.now() - zoomed;
     }
@@ -93,6 +97,7 @@ try {
   console.log(`  zoom to the final depth   ${finalMs === null ? 'not reached' : `${(finalMs / 1000).toFixed(1)} s`}`);
   console.log(`  resident at most          ${maxResident} vertices (budget ${closeup.budget}); ${closeup.evictions} subtrees folded back`);
   console.log(`  charts shown per phase    ${closeup.shownCharts.join(' ')} of ${closeup.charts.join(' ')}`);
+  console.log(`  occlusion                 ${closeup.hiddenCharts} charts shown hidden; ${closeup.occlusionMaps} depth maps, the last ${closeup.occlusionMs.toFixed(1)} ms (slowest ${maxOcclusionMs.toFixed(1)} ms)`);
   const leaves = closeup.depths[closeup.phases - 1];
   const atFinal = leaves.filter((/** @type {number} */ d) => d === closeup.finalDepth).length;
   console.log(`  leaves at the final depth ${atFinal} of ${leaves.length} (depths ${leaves.join(' ')} of ${closeup.finalDepth})`);

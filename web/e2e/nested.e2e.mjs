@@ -4,7 +4,8 @@
 // split in 2, 3 phases), served by the real `vitrine serve`; the page opens
 // zoomed onto the front of the sphere with `?refine=view`. The chart under
 // the camera reaches the last phase at its final depth, bit for bit the
-// whole decoder's chart; the charts behind stay coarser; fewer bytes than
+// whole decoder's chart; the charts behind stay coarser (hidden behind the
+// front: at the depth they were made at); fewer bytes than
 // the whole stream; resident vertices within the budget, also a budget
 // small enough to make the viewer fold subtrees back; a phone capped below
 // the last level fetches nothing past its cap; refinement by view is the
@@ -110,6 +111,10 @@ test('the chart under the camera goes down to the last phase, the ones behind st
   const behind = charts.filter((c) => !some(c.positions, (_x, _y, z) => z > 0.1));
   assert.ok(behind.length > 0, 'some charts held lie behind the sphere');
   for (const c of behind) assert.ok(c.phase < last || c.depth < state.finalDepth, `a chart behind stays coarser (phase ${c.phase}, depth ${c.depth})`);
+  // Hidden behind the front (occlusion.js), they do not refine at all: each
+  // stays at the depth it was made at (the cut, or its parent's split).
+  for (const c of behind) assert.equal(c.depth, 0, `a chart behind the sphere applies no part (phase ${c.phase}, chart ${c.chart}, depth ${c.depth})`);
+  console.log(`nested: ${behind.length} charts held wholly behind the sphere, all at depth 0; ${state.hiddenCharts} charts shown hidden; depth map ${state.occlusionMs.toFixed(2)} ms, ${state.occlusionMaps} made`);
   assert.ok(state.resident <= state.budget);
   // The index (a few kilobytes here, its rows for every part) counts among the bytes fetched.
   const indexBytes = (await (await fetch(new URL(manifest.nested_parts, service.url))).arrayBuffer()).byteLength;

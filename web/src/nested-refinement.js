@@ -30,11 +30,19 @@
  * fold back, out of view first, then those whose folded error on screen
  * is smallest (nested-selection.js `foldOrder`); a split whose children
  * turn out larger than foreseen is undone at once.
+ *
+ * Charts hidden behind the surface shown (occlusion.js: a small depth map
+ * of the union, for the camera) want nothing and fold first, as those out
+ * of view: a close-up does not refine the far side of the object. The map
+ * is made again for each camera, and when the charts shown changed since
+ * it was made, at most once per {@link OCCLUSION_GAP} times its cost
+ * (occlusion.js OcclusionMap).
  */
 
 import { ChartUnion, weldByPosition } from './chart-union.js';
 import { DecodeError } from './codec.js';
-import { foldOrder, nestedTable, wantedSteps } from './nested-selection.js';
+import { foldOrder, nestedTable, occluderTolerance, occlusionSphere, wantedSteps } from './nested-selection.js';
+import { OcclusionMap } from './occlusion.js';
 import { PARTS_IN_FLIGHT, boundingSphere, normalCone } from './part-selection.js';
 
 /**
@@ -43,6 +51,20 @@ import { PARTS_IN_FLIGHT, boundingSphere, normalCone } from './part-selection.js
  * that adds more than foreseen and passes the budget is undone.
  */
 const SPLIT_MARGIN = 0.1;
+
+/**
+ * The depth map of the same camera is made again once the charts shown
+ * changed, but no sooner than this many times its last cost after it: at
+ * most a fifth of the worker's time goes to occlusion while parts arrive.
+ */
+const OCCLUSION_GAP = 4;
+
+/**
+ * Triangles drawn into the depth map, at most: past it every k-th is drawn
+ * (occlusion.js; pixels left empty hide nothing, so less is culled, never
+ * what shows). 4 M: about the desktop budget's union.
+ */
+const OCCLUSION_TRIANGLES = 4_000_000;
 
 /**
  * @typedef {object} NestedState what the page reads (viewer.partsState())
@@ -63,6 +85,9 @@ const SPLIT_MARGIN = 0.1;
  * @property {number} inFlight parts and split entries on their way
  * @property {boolean} settled nothing on its way and nothing more wanted for the last camera
  * @property {number} evictions subtrees folded back to make room so far
+ * @property {number} hiddenCharts charts shown that the last depth map hides
+ * @property {number} occlusionMs the last depth map's cost
+ * @property {number} occlusionMaps depth maps made so far
  */
 
 /**
@@ -136,6 +161,10 @@ export class NestedRefinement {
   #entries = new Map();
   /** @type {ChartUnion} */
   #union;
+  /** The charts shown changed this many times (the depth map's is older when less). */
+  #generation = 0;
+  /** The depth map of the charts shown, for the camera. */
+  #occlusion = new OcclusionMap({ gap: OCCLUSION_GAP, maxTriangles: OCCLUSION_TRIANGLES });
 
   /** @param {NestedRefinementOptions} options */
   constructor(options) {
@@ -264,7 +293,8 @@ export class NestedRefinement {
     if (!camera || this.#stopped) return;
     const steps = this.table.charts.reduce((n, k, p) => n + k * (this.table.batches[p] + 1), 0);
     for (let round = 0; round < steps && this.#inFlight < PARTS_IN_FLIGHT; round++) {
-      const wanted = wantedSteps(this.table, this.#showing().pieces, camera, { capLevel: this.capLevel });
+      this.#refreshOcclusion(camera);
+      const wanted = wantedSteps(this.table, this.#showing().pieces, camera, { capLevel: this.capLevel, hidden: this.#hidden });
       let started = false;
       let again = false;
       for (const w of wanted) {
@@ -305,7 +335,7 @@ export class NestedRefinement {
     if (fits()) return true;
     const path = this.#path(/** @type {Node} */ (wanted.node));
     const expanded = this.#all().filter((n) => n.expanded && !this.#busyBelow(n));
-    const order = /** @type {Node[]} */ (foldOrder(this.table, expanded, wanted, path, camera));
+    const order = /** @type {Node[]} */ (foldOrder(this.table, expanded, wanted, path, camera, this.#hidden));
     // Nothing is folded unless folding them all would make the room
     // (a subtree inside another folded counts once).
     const outer = order.filter((n) => !this.#path(n).some((a) => a !== n && order.includes(a)));
@@ -320,6 +350,23 @@ export class NestedRefinement {
     }
     return false;
   }
+
+  /**
+   * Makes the depth map again for a new camera, or when the charts shown
+   * changed and its last cost allows.
+   * @param {import('./part-selection.js').PartCamera} camera
+   */
+  #refreshOcclusion(camera) {
+    this.#occlusion.refresh(camera, this.#generation, () =>
+      this.#showing().pieces.map((n) => ({ key: n, positions: n.positions, indices: n.indices, tolerance: occluderTolerance(this.table, n) })),
+    );
+  }
+
+  /**
+   * Whether a chart is hidden behind the charts shown, for the camera.
+   * @param {import('./nested-selection.js').NodeState} node
+   */
+  #hidden = (node) => this.#occlusion.hides(this.#camera, node, () => occlusionSphere(this.table, node));
 
   /** Every chart held. */
   #all() {
@@ -432,6 +479,7 @@ export class NestedRefinement {
     }
     const { positions, colours, indices } = this.view.chart(node.phase, node.chart);
     Object.assign(node, { depth: this.view.depth(node.phase, node.chart), vertices: positions.length / 3, positions, colours, indices, base: -1 });
+    this.#generation++;
     // The border is frozen: the weld holds, only the union is posted again.
     this.#union.changed(this.view.residentVertices());
   }
@@ -461,6 +509,7 @@ export class NestedRefinement {
   /** The charts shown changed: weld again, post soon. */
   #changed() {
     this.#shown = null;
+    this.#generation++;
     this.#union.changed(this.view.residentVertices());
   }
 
@@ -499,6 +548,9 @@ export class NestedRefinement {
         inFlight: this.#inFlight,
         settled: this.#camera !== null && this.#inFlight === 0 && !this.#union.pending,
         evictions: this.#evictions,
+        hiddenCharts: pieces.filter(this.#hidden).length,
+        occlusionMs: this.#occlusion.ms,
+        occlusionMaps: this.#occlusion.made,
       },
     });
   }

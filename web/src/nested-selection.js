@@ -158,15 +158,50 @@ export function errorLeft(table, node) {
 }
 
 /**
- * The shown charts' next steps, most wanted first: in view, not busy, not
- * past the cap, with the error they leave above the threshold on screen.
+ * How far the surface still to come may lie from a shown chart's, in model
+ * units, for occlusion (occlusion.js): twice the error it leaves, since
+ * that is the largest of its parts still to come, not their sum (which the
+ * halving of errors from level to level keeps under twice it).
+ * @param {NestedTable} table
+ * @param {NodeState} node
+ */
+export function occluderTolerance(table, node) {
+  return 2 * errorLeft(table, node);
+}
+
+/**
+ * A chart's bounding sphere for occlusion: the one made at its cut, grown
+ * by every part error of its phase (their sum: how far its parts may have
+ * moved its surface out of that sphere) and twice the largest below it (its
+ * descendants', shown in its place when it is expanded), so its own
+ * surface, or its descendants', is never nearer than the sphere's nearest
+ * point: a chart never hides itself.
+ * @param {NestedTable} table
+ * @param {NodeState} node
+ * @returns {import('./part-selection.js').Sphere}
+ */
+export function occlusionSphere(table, node) {
+  const drift = table.parts[node.phase][node.chart].reduce((e, part) => e + part.error, 0) + 2 * table.below[node.phase][node.chart];
+  return { centre: node.sphere.centre, radius: node.sphere.radius + drift };
+}
+
+/**
+ * Whether a chart is hidden behind the surface shown (occlusion.js), for
+ * the camera the selection is asked about; absent: nothing is.
+ * @typedef {(node: NodeState) => boolean} Hidden
+ */
+
+/**
+ * The shown charts' next steps, most wanted first: in view (and not hidden
+ * behind the surface shown), not busy, not past the cap, with the error
+ * they leave above the threshold on screen.
  * @param {NestedTable} table
  * @param {NodeState[]} shown the charts on screen (no expanded one)
  * @param {import('./part-selection.js').PartCamera} camera
- * @param {{ capLevel: number, threshold?: number }} limits
+ * @param {{ capLevel: number, threshold?: number, hidden?: Hidden }} limits
  * @returns {Action[]}
  */
-export function wantedSteps(table, shown, camera, { capLevel, threshold = SCREEN_ERROR_PX }) {
+export function wantedSteps(table, shown, camera, { capLevel, threshold = SCREEN_ERROR_PX, hidden }) {
   const planes = frustumPlanes(camera.clip);
   /** @type {Action[]} */
   const wanted = [];
@@ -176,7 +211,8 @@ export function wantedSteps(table, shown, camera, { capLevel, threshold = SCREEN
     if (!step || step.level > capLevel) continue;
     const { distance, visible } = sight(planes, camera.eye, node);
     const pixels = onScreen(errorLeft(table, node), distance, camera);
-    if (visible && pixels > threshold) wanted.push({ node, ...step, pixels, distance });
+    // The cheap tests first: the map is read only for a chart that would refine.
+    if (visible && pixels > threshold && !hidden?.(node)) wanted.push({ node, ...step, pixels, distance });
   }
   return wanted.sort(byNeed);
 }
@@ -184,7 +220,8 @@ export function wantedSteps(table, shown, camera, { capLevel, threshold = SCREEN
 /**
  * Which expanded charts to fold back (their subtrees dropped, the chart
  * shown again) to make room for `wanted`: those off its path to the root
- * with nothing on its way below them; out of view first (farthest first),
+ * with nothing on its way below them; out of view (or hidden behind the
+ * surface shown) first (farthest first),
  * then those in view whose error on screen once folded (every part below
  * them) is smaller than `wanted`'s now (smallest first). A chart folded so
  * never wants its room back more than the one that took it, so two do not
@@ -194,14 +231,17 @@ export function wantedSteps(table, shown, camera, { capLevel, threshold = SCREEN
  * @param {Action} wanted
  * @param {NodeState[]} path `wanted`'s chart and its ancestors
  * @param {import('./part-selection.js').PartCamera} camera
+ * @param {Hidden} [hidden]
  * @returns {NodeState[]}
  */
-export function foldOrder(table, expanded, wanted, path, camera) {
+export function foldOrder(table, expanded, wanted, path, camera, hidden) {
   const planes = frustumPlanes(camera.clip);
   return expanded
     .filter((n) => !path.includes(n))
     .map((node) => {
-      const { distance, visible } = sight(planes, camera.eye, node);
+      const seen = sight(planes, camera.eye, node);
+      const distance = seen.distance;
+      const visible = seen.visible && !hidden?.(node);
       return { node, distance, visible, cutPixels: onScreen(table.below[node.phase][node.chart], distance, camera) };
     })
     .filter((a) => !a.visible || a.cutPixels < wanted.pixels)

@@ -9,11 +9,19 @@
  * view-dependent refinement: charts that changed appended to the store,
  * cut vertices welded by position so the shading is continuous across
  * chart borders. A charted stream's cut is fixed, so it is welded once.
+ *
+ * Charts hidden behind the charts shown (occlusion.js) want no part and
+ * give their vertices back first, as those out of view, as for a nested
+ * stream (nested-refinement.js).
  */
 
 import { ChartUnion, weldByPosition } from './chart-union.js';
 import { DecodeError } from './codec.js';
-import { PARTS_IN_FLIGHT, assess, boundingSphere, evictionOrder, normalCone, partTable, wantedParts } from './part-selection.js';
+import { OcclusionMap } from './occlusion.js';
+import { PARTS_IN_FLIGHT, assess, boundingSphere, evictionOrder, normalCone, occluderTolerance, occlusionSphere, partTable, wantedParts } from './part-selection.js';
+
+/** The depth map's throttle and size bound, as nested-refinement.js's. */
+const OCCLUSION = { gap: 4, maxTriangles: 4_000_000 };
 
 /**
  * @typedef {object} PartsState what the page reads (viewer.partsState())
@@ -25,7 +33,7 @@ import { PARTS_IN_FLIGHT, assess, boundingSphere, evictionOrder, normalCone, par
  * @property {number} resident vertices held, all charts together
  * @property {number} budget
  * @property {number} bytesFetched payload bytes of this load: base, global batches, part index, head and parts
- * @property {boolean[]} visible per chart, in the view's frustum
+ * @property {boolean[]} visible per chart, in view: in the frustum, not facing away, not hidden behind the charts shown
  * @property {number} inFlight parts on their way
  * @property {boolean} settled nothing on its way and nothing more wanted for the last camera
  * @property {number} evictions charts reset to make room so far
@@ -83,6 +91,11 @@ export class PartRefinement {
   #visible;
   /** @type {ChartUnion} */
   #union;
+  /** Counts the changes of the charts shown (the depth map's is older when less). */
+  #generation = 0;
+  #occlusion = new OcclusionMap(OCCLUSION);
+  /** @param {number} k */
+  #hidden = (k) => this.#occlusion.hides(this.#camera, this.#charts[k], () => occlusionSphere(this.parts, k, this.#charts[k].sphere));
 
   /** @param {PartRefinementOptions} options */
   constructor(options) {
@@ -166,9 +179,12 @@ export class PartRefinement {
     const camera = this.#camera;
     if (!camera || this.#stopped) return;
     for (let round = 0; round < this.#charts.length * (this.parts.finalDepth + 1) && this.#inFlight < PARTS_IN_FLIGHT; round++) {
-      const limits = { firstLevel: this.firstLevel, capLevel: this.capLevel };
+      this.#occlusion.refresh(camera, this.#generation, () =>
+        this.#charts.map((c, k) => ({ key: c, positions: c.positions, indices: c.indices, tolerance: occluderTolerance(this.parts, k, c.depth) })),
+      );
+      const limits = { firstLevel: this.firstLevel, capLevel: this.capLevel, hidden: this.#hidden };
       const wanted = wantedParts(this.#charts, this.parts, camera, limits);
-      const assessed = assess(this.#charts, this.parts, camera);
+      const assessed = assess(this.#charts, this.parts, camera, this.#hidden);
       this.#visible = assessed.map((a) => a.visible);
       let started = false;
       for (const w of wanted) {
@@ -276,6 +292,7 @@ export class PartRefinement {
     const chart = this.#charts[k];
     const { positions, colours, indices } = this.view.chart(k);
     Object.assign(chart, { depth: this.view.depth(k), positions, colours, indices, base: -1 });
+    this.#generation++;
     this.#union.changed(this.view.residentVertices());
   }
 

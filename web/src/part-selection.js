@@ -126,6 +126,7 @@ export function facesAway(cone, sphere, eye) {
  * @property {Vec3} eye
  * @property {number[]} clip column-major 4×4, model coordinates → clip space
  * @property {number} pixelsPerRadian the view's height in pixels over its vertical field of view
+ * @property {number} [aspect] the view's width over its height (occlusion.js's map follows it; absent: square)
  */
 
 /**
@@ -256,18 +257,47 @@ export function partTable(index) {
  */
 
 /**
- * How each chart stands for this camera: in view (in the frustum, and not
- * facing away) or not, distance, the
+ * How far the surface still to come may lie from a chart's shown, in model
+ * units, for occlusion (occlusion.js): twice the largest error of its parts
+ * not applied (their sum, as errors halve from level to level, is under it).
+ * @param {ReturnType<typeof partTable>} parts
+ * @param {number} chart
+ * @param {number} depth
+ */
+export function occluderTolerance(parts, chart, depth) {
+  return 2 * parts.remaining[chart][depth];
+}
+
+/**
+ * A chart's sphere for occlusion: the one at its cut grown by the sum of its
+ * parts' errors (how far they may move its surface out of it), so its own
+ * surface never hides it.
+ * @param {ReturnType<typeof partTable>} parts
+ * @param {number} chart
+ * @param {Sphere} sphere at the cut
+ * @returns {Sphere}
+ */
+export function occlusionSphere(parts, chart, sphere) {
+  return { centre: sphere.centre, radius: sphere.radius + parts.table[chart].reduce((e, p) => e + p.error, 0) };
+}
+
+/**
+ * How each chart stands for this camera: in view (in the frustum, not
+ * facing away, and not hidden behind the surface shown: `hidden`) or not,
+ * distance, the
  * error on screen of what it has not applied yet (`pixels`) and of
  * everything past the cut (`cutPixels`: its error if it were reset).
  * @param {ChartState[]} charts
  * @param {ReturnType<typeof partTable>} parts
  * @param {PartCamera} camera
+ * @param {(chart: number) => boolean} [hidden] absent: nothing is
  */
-export function assess(charts, parts, camera) {
+export function assess(charts, parts, camera, hidden) {
   const planes = frustumPlanes(camera.clip);
   return charts.map((c, chart) => {
-    const { distance, visible } = sight(planes, camera.eye, c);
+    const seen = sight(planes, camera.eye, c);
+    const distance = seen.distance;
+    const visible = seen.visible && !hidden?.(chart);
     const pixels = onScreen(parts.remaining[chart][c.depth], distance, camera);
     const cutPixels = onScreen(parts.remaining[chart][0], distance, camera);
     return { chart, distance, visible, pixels, cutPixels };
@@ -282,10 +312,10 @@ export function assess(charts, parts, camera) {
  * @param {ChartState[]} charts
  * @param {ReturnType<typeof partTable>} parts
  * @param {PartCamera} camera
- * @param {{ firstLevel: number, capLevel: number, threshold?: number }} limits
+ * @param {{ firstLevel: number, capLevel: number, threshold?: number, hidden?: (chart: number) => boolean }} limits
  */
-export function wantedParts(charts, parts, camera, { firstLevel, capLevel, threshold = SCREEN_ERROR_PX }) {
-  return assess(charts, parts, camera)
+export function wantedParts(charts, parts, camera, { firstLevel, capLevel, threshold = SCREEN_ERROR_PX, hidden }) {
+  return assess(charts, parts, camera, hidden)
     .filter((a) => {
       const c = charts[a.chart];
       return !c.busy && !c.yielded && a.visible && c.depth < parts.finalDepth && firstLevel + c.depth <= capLevel && a.pixels > threshold;

@@ -376,7 +376,7 @@ export class Viewer {
       const clip = multiply(multiply(camera.projection(this.aspect()), camera.view()), model);
       const eye = unrotate(m, camera.basis().eye);
       const pixelsPerRadian = this.ui.canvas.height / camera.fovY;
-      this.#worker.postMessage({ type: 'part-camera', camera: { eye, clip: Array.from(clip), pixelsPerRadian } });
+      this.#worker.postMessage({ type: 'part-camera', camera: { eye, clip: Array.from(clip), pixelsPerRadian, aspect: this.aspect() } });
     }, Math.max(0, wait));
   }
 

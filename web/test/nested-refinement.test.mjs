@@ -8,7 +8,8 @@
 // renderer does, are every chart shown at its depth, closed (the torus has
 // no border: every edge of the welded union has two triangles, so charts at
 // different phases meet without a crack) with one normal per position; the
-// budget holds, folding subtrees back.
+// budget holds, folding subtrees back; a chart hidden behind the torus
+// (occlusion.js) refines once the camera turns to it.
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
 import { NestedView, splitStream } from '../src/codec.js';
@@ -211,6 +212,29 @@ test('a small budget: subtrees fold back, never more resident than the budget, n
   assert.ok(moved.evictions > 0, 'subtrees folded back');
   assert.ok(moved.resident <= budget, `${moved.resident} resident, budget ${budget}`);
   assert.ok(moved.shownCharts.filter((n) => n > 0).length >= 2, `charts of several phases shown (${moved.shownCharts.join(' ')})`);
+  assertOneNormal(posted());
+  assertClosed(refinement, posted().last);
+  refinement.stop();
+});
+
+test('a chart hidden behind the torus refines once the camera turns to it; the union stays closed', async () => {
+  const { refinement, view, whole, state, errors, settle, posted } = await refine({ budget: 1e9 });
+  assert.ok(state && state.settled);
+  const final = state.phases - 1;
+  const before = state.depths[final].slice();
+  // The far side of the torus: the point opposite the first camera's, behind the near tube.
+  const p = view.chart(0, 0).positions;
+  const opposite = new Float32Array([-p[0], -p[1], -p[2]]);
+  const moved = await settle(cameraOn(opposite));
+  assert.deepEqual(errors, []);
+  assert.ok(moved && moved.settled);
+  const newly = moved.depths[final].flatMap((d, k) => (d === moved.finalDepth && before[k] !== moved.finalDepth ? [k] : []));
+  console.log(`nested, turned round: leaves ${before.join(' ')}, then ${moved.depths[final].join(' ')}; ${moved.hiddenCharts} shown hidden`);
+  assert.ok(newly.length > 0, 'a leaf the first camera did not refine reaches the final depth');
+  assert.ok(moved.hiddenCharts > 0, 'charts shown are hidden behind the tube (occlusion.js)');
+  for (const k of newly) {
+    assert.deepEqual(Buffer.from(view.chart(final, k).positions.buffer), Buffer.from(whole.chart(final, k).positions.buffer), `leaf ${k}'s positions`);
+  }
   assertOneNormal(posted());
   assertClosed(refinement, posted().last);
   refinement.stop();

@@ -3,11 +3,13 @@
 // (nested-selection.js): the part index as a tree (phases, batches,
 // children, the errors left below each chart, the batches a view is
 // declared from), the next step of a chart (part, then split), which shown
-// charts step for a camera, and which expanded charts fold back first.
+// charts step for a camera, and which expanded charts fold back first;
+// a chart hidden behind another (occlusion.js) wants nothing and folds first.
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
 import { OrbitCamera, multiply } from '../src/camera.js';
-import { errorLeft, foldOrder, nestedTable, nextStep, wantedSteps } from '../src/nested-selection.js';
+import { errorLeft, foldOrder, nestedTable, nextStep, occluderTolerance, occlusionSphere, wantedSteps } from '../src/nested-selection.js';
+import { depthMap, occluded } from '../src/occlusion.js';
 
 /**
  * @param {[number, number, number]} target
@@ -85,4 +87,32 @@ test('what folds back first: out of view, then the smallest error folded; never 
   assert.deepEqual(foldOrder(t, [ahead, behind], wanted, [child, ahead], cam), [behind]);
   const order = foldOrder(t, [ahead, behind], { ...wanted, pixels: 1e9 }, [child], cam);
   assert.deepEqual(order, [behind, ahead], 'out of view first');
+});
+
+test('a chart hidden behind another wants nothing and folds first; seen again, it steps', () => {
+  const t = nestedTable(index());
+  // Chart 0 is a wall at z = 0 across the view (its own vertices), chart 1 a sphere of radius 1 at z = −10 behind it.
+  // prettier-ignore
+  const positions = new Float32Array([-50, -50, 0, 50, -50, 0, 50, 50, 0, -50, 50, 0]);
+  const wall = { phase: 0, chart: 0, depth: 2, sphere: { centre: /** @type {[number, number, number]} */ ([0, 0, 0]), radius: 71 }, expanded: false, vertices: 4, positions, indices: new Uint32Array([0, 1, 2, 0, 2, 3]) };
+  const behind = { phase: 0, chart: 1, depth: 0, sphere: { centre: /** @type {[number, number, number]} */ ([0, 0, -10]), radius: 1 }, expanded: false, vertices: 100 };
+  const cam = camera([0, 0, 0], 3);
+  /** @param {typeof cam} c */
+  const hiddenFor = (c) => {
+    const map = depthMap([{ positions: wall.positions, indices: wall.indices, tolerance: occluderTolerance(t, wall) }], c.clip, 1);
+    return (/** @type {import('../src/nested-selection.js').NodeState} */ node) => occluded(map, occlusionSphere(t, node));
+  };
+  assert.deepEqual(wantedSteps(t, [wall, behind], cam, { capLevel: 99 }).map((w) => w.node.chart), [0, 1], 'without the map: both');
+  const hidden = hiddenFor(cam);
+  assert.ok(!hidden(wall), 'the wall does not hide itself');
+  assert.deepEqual(wantedSteps(t, [wall, behind], cam, { capLevel: 99, hidden }).map((w) => w.node.chart), [0], 'the chart behind the wall wants nothing');
+  // Expanded, the chart behind folds first, as one out of view would.
+  const child = { phase: 1, chart: 0, depth: 0, sphere: wall.sphere, expanded: false, vertices: 60 };
+  const wanted = { ...wantedSteps(t, [child], cam, { capLevel: 99 })[0], pixels: 0 };
+  const expandedBehind = { ...behind, depth: 2, expanded: true };
+  assert.deepEqual(foldOrder(t, [expandedBehind], wanted, [child], cam), [], 'in view, its error folded too large to give way');
+  assert.deepEqual(foldOrder(t, [expandedBehind], wanted, [child], cam, hidden), [expandedBehind], 'hidden: folds');
+  // The camera goes behind the wall: the chart is seen again and steps.
+  const back = camera([0, 0, -10], 3);
+  assert.deepEqual(wantedSteps(t, [behind], back, { capLevel: 99, hidden: hiddenFor(back) }).map((w) => w.node.chart), [1]);
 });

@@ -2,7 +2,8 @@
 // Node tests of view-dependent refinement's choices (part-selection.js):
 // which chart's next part is fetched for a camera (error on screen, frustum,
 // cap, final depth, charts that sit a batch out), and which charts give
-// their vertices back for the budget, in what order.
+// their vertices back for the budget, in what order; a chart hidden behind
+// another (occlusion.js) wants no part and gives its vertices back first.
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
 import { OrbitCamera, multiply } from '../src/camera.js';
@@ -17,9 +18,12 @@ import {
   frustumPlanes,
   inFrustum,
   normalCone,
+  occluderTolerance,
+  occlusionSphere,
   partTable,
   wantedParts,
 } from '../src/part-selection.js';
+import { depthMap, occluded } from '../src/occlusion.js';
 
 /**
  * A camera at `eye` looking at `target` (model coordinates = world: no up rotation).
@@ -147,4 +151,21 @@ test('budgets by device class', () => {
     () => partTable({ charts: 2, first_level: 3, head_url: '', part_url: '', parts: [{ level: 3, chart: 0, bytes: 1, inserted: 1, error: 0 }] }),
     /no part for chart 1/,
   );
+});
+
+test('a chart hidden behind another wants no part and is reset first', () => {
+  // Chart 0 at z = 0 is a wall across the view; chart 1 at z = −3 lies behind it.
+  const { table, charts } = setup([[0.1, 0.05], [0.1, 0.05]]);
+  const cam = camera([0, 0, 0], 5);
+  // prettier-ignore
+  const wall = { positions: new Float32Array([-50, -50, 0, 50, -50, 0, 50, 50, 0, -50, 50, 0]), indices: new Uint32Array([0, 1, 2, 0, 2, 3]) };
+  const map = depthMap([{ ...wall, tolerance: occluderTolerance(table, 0, 0) }], cam.clip, 1);
+  const hidden = (/** @type {number} */ k) => occluded(map, occlusionSphere(table, k, charts[k].sphere));
+  const limits = { firstLevel: 5, capLevel: 99 };
+  assert.deepEqual(wantedParts(charts, table, cam, limits).map((w) => w.chart), [0, 1]);
+  assert.deepEqual(wantedParts(charts, table, cam, { ...limits, hidden }).map((w) => w.chart), [0], 'the chart behind wants nothing');
+  charts[1].depth = 2;
+  const assessed = assess(charts, table, cam, hidden);
+  assert.deepEqual(assessed.map((a) => a.visible), [true, false]);
+  assert.deepEqual(evictionOrder(charts, assessed, 0), [1], 'reset first, as one out of view');
 });
