@@ -177,9 +177,10 @@ pub async fn index(
         Some(json) => json.clone(),
         None => {
             let index = part_index(id, nested, &stored)?;
-            let json = Bytes::from(serde_json::to_vec(&index).map_err(|e| {
-                AppError::Internal(format!("part index of compression {id}: {e}"))
-            })?);
+            let json =
+                Bytes::from(serde_json::to_vec(&index).map_err(|e| {
+                    AppError::Internal(format!("part index of compression {id}: {e}"))
+                })?);
             stored.index_json.get_or_init(|| json).clone()
         }
     };
