@@ -61,11 +61,36 @@ impl Payload {
 pub struct PartRows {
     pub parts: Vec<PartRecord>,
     pub splits: Vec<SplitRecord>,
+    /// Each parted batch's phase and chart count, by batch: what slicing
+    /// the batch after it needs, looked up per part request.
+    batches: std::collections::BTreeMap<u32, (usize, usize)>,
     /// The index as served (`parts::index`), serialized on first use.
     pub index_json: std::sync::OnceLock<Bytes>,
 }
 
 impl PartRows {
+    pub fn new(parts: Vec<PartRecord>, splits: Vec<SplitRecord>) -> PartRows {
+        let mut batches = std::collections::BTreeMap::new();
+        for p in &parts {
+            batches
+                .entry(p.iteration)
+                .or_insert((p.phase as usize, 0))
+                .1 += 1;
+        }
+        PartRows {
+            parts,
+            splits,
+            batches,
+            index_json: Default::default(),
+        }
+    }
+
+    /// Batch `iteration`'s phase and chart count; `None` for a batch
+    /// without parts.
+    pub fn batch(&self, iteration: u32) -> Option<(usize, usize)> {
+        self.batches.get(&iteration).copied()
+    }
+
     fn weight(&self) -> u32 {
         u32::try_from(self.parts.len() + self.splits.len() + 1).unwrap_or(u32::MAX)
     }

@@ -453,11 +453,10 @@ async fn serve_piece(
 async fn part_rows(state: &AppState, id: i64) -> Result<Arc<PartRows>, AppError> {
     let storage = state.storage();
     let load = async {
-        Ok(Arc::new(PartRows {
-            parts: storage.parts(id).await?,
-            splits: storage.splits(id).await?,
-            index_json: Default::default(),
-        }))
+        Ok(Arc::new(PartRows::new(
+            storage.parts(id).await?,
+            storage.splits(id).await?,
+        )))
     };
     Ok(through(
         &state.caches().part_rows,
@@ -477,10 +476,7 @@ async fn previous_parted(
     iteration: u32,
 ) -> Result<Option<(usize, usize)>, AppError> {
     let rows = part_rows(state, id).await?;
-    let before: Vec<_> = rows
-        .parts
-        .iter()
-        .filter(|p| p.iteration + 1 == iteration)
-        .collect();
-    Ok(before.first().map(|p| (p.phase as usize, before.len())))
+    Ok(iteration
+        .checked_sub(1)
+        .and_then(|before| rows.batch(before)))
 }
