@@ -11,7 +11,7 @@
 //! and the top charts' parts, the server's payload cache holds those.
 
 use serde::Deserialize;
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, HashMap};
 
 /// The part index (`server/src/service/parts.rs`), the fields read here.
 #[derive(Deserialize)]
@@ -76,18 +76,30 @@ impl PartIndex {
             .nth(((pick.clamp(0.0, 1.0) * n as f64) as usize).min(n - 1))
             .ok_or("no leaf")?;
         // The chart on the path in each phase, leaf first, up to phase 0.
+        let parents: HashMap<(usize, usize), Option<usize>> = self
+            .parts
+            .iter()
+            .map(|p| ((p.phase, p.chart), p.parent))
+            .collect();
         let mut chain = vec![leaf];
         for phase in (1..=last).rev() {
             let chart = chain[chain.len() - 1];
-            let parent = self
-                .parts
-                .iter()
-                .find(|p| p.phase == phase && p.chart == chart)
-                .and_then(|p| p.parent)
+            let parent = parents
+                .get(&(phase, chart))
+                .copied()
+                .flatten()
                 .ok_or_else(|| format!("chart {chart} of phase {phase} has no parent"))?;
             chain.push(parent);
         }
         chain.reverse();
+        // The path's part in each batch, found in one pass (an index of a
+        // 25 M-vertex stream has some 8,000 parts; every visitor reads it).
+        let on_path: HashMap<usize, &PartEntry> = self
+            .parts
+            .iter()
+            .filter(|p| chain.get(p.phase) == Some(&p.chart))
+            .map(|p| (p.level, p))
+            .collect();
 
         let levels: BTreeMap<usize, usize> =
             self.parts.iter().map(|p| (p.level, p.phase)).collect();
@@ -114,11 +126,9 @@ impl PartIndex {
                 bytes += entry.bytes;
             }
             let chart = chain[phase];
-            if let Some(part) = self
-                .parts
-                .iter()
-                .find(|p| p.level == level && p.chart == chart && p.phase == phase)
-                .filter(|p| p.bytes > 0)
+            if let Some(part) = on_path
+                .get(&level)
+                .filter(|p| p.phase == phase && p.bytes > 0)
             {
                 urls.push(fill(&self.part_url, level, "{chart}", chart));
                 bytes += part.bytes;
