@@ -78,6 +78,10 @@ function listen(until) {
       surfaceIds: new Uint32Array(count), clip: new Uint32Array(count), planes: new Float32Array(0) });
     look({ min: [-1, -1, -1], max: [1, 1, 1] });
   },
+  /** Turns the camera to `state` (from its home view). @param {Partial<import('../src/camera.js').OrbitState>} state */
+  orbit(state) {
+    if (camera) camera.state = { ...structuredClone(camera.home), ...state };
+  },
   /** @param {Partial<import('../src/splats/splat-renderer.js').SplatOptions>} options */
   capture(options) {
     view.setOptions(options);
