@@ -53,11 +53,14 @@ function listen(until) {
       batchUrls: batches.map((b) => new URL(b, location.href).href), upTo: batches.length });
     return done;
   },
-  /** @param {number[]} positions @param {number[]} indices @param {import('../src/geometry.js').Bounds} box @param {Partial<import('../src/camera.js').OrbitState>} state */
-  async mesh(positions, indices, box, state) {
+  /**
+   * @param {number[]} positions @param {number[]} indices @param {import('../src/geometry.js').Bounds} box
+   * @param {Partial<import('../src/camera.js').OrbitState>} state @param {number} [sharpThreshold] w_s (default 0.9)
+   */
+  async mesh(positions, indices, box, state, sharpThreshold) {
     look(box, state);
     const done = listen((m) => m.type === 'splats');
-    worker.postMessage({ type: 'mesh', id: 1, positions: new Float32Array(positions), indices: new Uint32Array(indices), colours: null });
+    worker.postMessage({ type: 'mesh', id: 1, positions: new Float32Array(positions), indices: new Uint32Array(indices), colours: null, sharpThreshold });
     return done;
   },
   /** Points on a unit sphere, drawn without preprocessing (frame time). @param {number} count */

@@ -4,6 +4,7 @@
  * L-shaped block), ray-cast on the CPU through a capture's camera, and how
  * far a rendered image's foreground is from it: for the splat tests, which
  * compare clipped and unclipped splats against the surface they sample.
+ * Also a box as a triangle mesh, its sharp edges the box's.
  */
 import { multiply } from '../../src/camera.js';
 import { invert } from '../../src/splats/splat-renderer.js';
@@ -91,4 +92,51 @@ export function silhouetteError(shown, truth, width) {
     }
   }
   return { error, holes, inside };
+}
+
+/**
+ * A box as a closed triangle mesh, each face a grid of `cells` × `cells`
+ * quads (vertices shared along the edges, outward winding).
+ * @param {Box} box @param {number} cells
+ */
+export function boxMesh(box, cells) {
+  /** @type {number[]} */
+  const positions = [];
+  /** @type {number[]} */
+  const indices = [];
+  /** @type {Map<string, number>} */
+  const ids = new Map();
+  /** @param {number[]} p */
+  const vertex = (p) => {
+    const key = p.map((c) => c.toFixed(6)).join(' ');
+    let id = ids.get(key);
+    if (id === undefined) {
+      id = positions.length / 3;
+      ids.set(key, id);
+      positions.push(...p);
+    }
+    return id;
+  };
+  for (let axis = 0; axis < 3; axis++) {
+    const [u, v] = [(axis + 1) % 3, (axis + 2) % 3];
+    for (const side of [0, 1]) {
+      /** @param {number} i @param {number} j */
+      const at = (i, j) => {
+        const p = [0, 0, 0];
+        p[axis] = side ? box.max[axis] : box.min[axis];
+        p[u] = box.min[u] + ((box.max[u] - box.min[u]) * i) / cells;
+        p[v] = box.min[v] + ((box.max[v] - box.min[v]) * j) / cells;
+        return vertex(p);
+      };
+      for (let i = 0; i < cells; i++) {
+        for (let j = 0; j < cells; j++) {
+          const [a, b, c, d] = [at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)];
+          // u × v points along +axis: counter-clockwise seen from the max side.
+          if (side) indices.push(a, b, c, a, c, d);
+          else indices.push(a, c, b, a, d, c);
+        }
+      }
+    }
+  }
+  return { positions, indices };
 }
