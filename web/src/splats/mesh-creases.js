@@ -32,16 +32,31 @@ export function faceNormals(positions, indices) {
 }
 
 /**
+ * The faces around each vertex, as compressed rows: vertex v's are
+ * `faces[offsets[v]..offsets[v + 1]]`.
+ * @param {Uint32Array} indices @param {number} vertexCount
+ */
+export function vertexFaces(indices, vertexCount) {
+  const offsets = new Uint32Array(vertexCount + 1);
+  for (let c = 0; c < indices.length; c++) offsets[indices[c] + 1]++;
+  for (let v = 0; v < vertexCount; v++) offsets[v + 1] += offsets[v];
+  const fill = offsets.slice(0, vertexCount);
+  const faces = new Uint32Array(indices.length);
+  for (let c = 0; c < indices.length; c++) faces[fill[indices[c]]++] = (c / 3) | 0;
+  return { offsets, faces };
+}
+
+/**
  * The patch of every face: faces are joined across each edge whose faces
- * are not sharp (a third face on an edge is compared with the first), so
- * without a sharp edge a patch is a connected component.
+ * are not sharp (on an edge of more than two faces, each pair is
+ * compared), so without a sharp edge a patch is a connected component.
  * @param {Uint32Array} indices
  * @param {Float32Array} normals from {@link faceNormals}
- * @param {number} vertexCount
+ * @param {{ offsets: Uint32Array, faces: Uint32Array }} around from {@link vertexFaces}
  * @param {number} threshold w_s
  * @returns {Uint32Array} per face, the smallest face index of its patch
  */
-export function facePatches(indices, normals, vertexCount, threshold) {
+export function facePatches(indices, normals, around, threshold) {
   const faces = indices.length / 3;
   const parent = new Uint32Array(faces);
   for (let f = 0; f < faces; f++) parent[f] = f;
@@ -54,22 +69,23 @@ export function facePatches(indices, normals, vertexCount, threshold) {
   const smooth = (f, g) => {
     const a = 3 * f, b = 3 * g;
     const d = normals[a] * normals[b] + normals[a + 1] * normals[b + 1] + normals[a + 2] * normals[b + 2];
-    const l = Math.hypot(normals[a], normals[a + 1], normals[a + 2]) * Math.hypot(normals[b], normals[b + 1], normals[b + 2]);
+    const la = normals[a] * normals[a] + normals[a + 1] * normals[a + 1] + normals[a + 2] * normals[a + 2];
+    const lb = normals[b] * normals[b] + normals[b + 1] * normals[b + 1] + normals[b + 2] * normals[b + 2];
+    const l = Math.sqrt(la * lb);
     return l > 0 && d >= threshold * l;
   };
-  /** First face seen on each edge, by its key. @type {Map<number, number>} */
-  const first = new Map();
-  for (let t = 0; t < indices.length; t += 3) {
-    const f = t / 3;
+  for (let f = 0; f < faces; f++) {
     for (let k = 0; k < 3; k++) {
-      const a = indices[t + k];
-      const b = indices[t + ((k + 1) % 3)];
-      const key = a < b ? a * vertexCount + b : b * vertexCount + a;
-      const g = first.get(key);
-      if (g === undefined) first.set(key, f);
-      else if (smooth(f, g)) {
-        const rf = root(f), rg = root(g);
-        if (rf !== rg) parent[Math.max(rf, rg)] = Math.min(rf, rg);
+      const a = indices[3 * f + k];
+      const b = indices[3 * f + ((k + 1) % 3)];
+      // The faces across edge ab: those around a that also hold b.
+      for (let i = around.offsets[a]; i < around.offsets[a + 1]; i++) {
+        const g = around.faces[i];
+        if (g <= f || (indices[3 * g] !== b && indices[3 * g + 1] !== b && indices[3 * g + 2] !== b)) continue;
+        if (smooth(f, g)) {
+          const rf = root(f), rg = root(g);
+          if (rf !== rg) parent[Math.max(rf, rg)] = Math.min(rf, rg);
+        }
       }
     }
   }

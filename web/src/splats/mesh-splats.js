@@ -15,7 +15,7 @@
  * component, nothing clipped.
  */
 
-import { SHARP_THRESHOLD, faceNormals, facePatches } from './mesh-creases.js';
+import { SHARP_THRESHOLD, faceNormals, facePatches, vertexFaces } from './mesh-creases.js';
 
 /** Most clip planes per splat (as the point preprocessing keeps). */
 const MAX_PLANES = 8;
@@ -30,8 +30,8 @@ const MAX_PLANES = 8;
 export function meshSplats(positions, indices, colours, sharpThreshold = SHARP_THRESHOLD) {
   const n = positions.length / 3;
   const faceNormal = faceNormals(positions, indices);
-  const patch = facePatches(indices, faceNormal, n, sharpThreshold);
   const around = vertexFaces(indices, n);
+  const patch = facePatches(indices, faceNormal, around, sharpThreshold);
   // One splat per (vertex, patch), a vertex's splats contiguous.
   const firstSplat = new Uint32Array(n + 1);
   /** @type {number[]} */
@@ -42,7 +42,7 @@ export function meshSplats(positions, indices, colours, sharpThreshold = SHARP_T
       const p = patch[around.faces[k]];
       if (!splatPatch.includes(p, firstSplat[v])) splatPatch.push(p);
     }
-    if (splatPatch.length === firstSplat[v]) splatPatch.push(0xffffffff); // a lone vertex
+    if (splatPatch.length === firstSplat[v]) splatPatch.push(indices.length + v); // a lone vertex: an id of its own
   }
   firstSplat[n] = splatPatch.length;
   const count = splatPatch.length;
@@ -56,10 +56,12 @@ export function meshSplats(positions, indices, colours, sharpThreshold = SHARP_T
   // Normals and the centroid of the splat's faces, per splat.
   const normals = new Float32Array(3 * count);
   const faceCentre = new Float32Array(3 * count);
+  const faceCount = new Uint32Array(count);
   for (let v = 0; v < n; v++) {
     for (let k = around.offsets[v]; k < around.offsets[v + 1]; k++) {
       const f = around.faces[k];
       const s = splatAt(v, patch[f]);
+      faceCount[s]++;
       for (let a = 0; a < 3; a++) {
         normals[3 * s + a] += faceNormal[3 * f + a];
         faceCentre[3 * s + a] += (positions[3 * indices[3 * f] + a] + positions[3 * indices[3 * f + 1] + a] + positions[3 * indices[3 * f + 2] + a]) / 3;
@@ -69,9 +71,7 @@ export function meshSplats(positions, indices, colours, sharpThreshold = SHARP_T
       const l = Math.hypot(normals[3 * s], normals[3 * s + 1], normals[3 * s + 2]);
       if (l > 0) for (let a = 0; a < 3; a++) normals[3 * s + a] /= l;
       else normals[3 * s + 2] = 1;
-      const faces = around.offsets[v + 1] - around.offsets[v];
-      const mine = faces === 0 ? 1 : [...around.faces.subarray(around.offsets[v], around.offsets[v + 1])].filter((f) => patch[f] === splatPatch[s]).length;
-      for (let a = 0; a < 3; a++) faceCentre[3 * s + a] /= mine;
+      for (let a = 0; a < 3; a++) faceCentre[3 * s + a] /= Math.max(1, faceCount[s]);
     }
   }
   const radii = edgeRadii(positions, indices, n);
@@ -81,27 +81,13 @@ export function meshSplats(positions, indices, colours, sharpThreshold = SHARP_T
   const surfaceIds = new Uint32Array(count);
   for (let s = 0; s < count; s++) {
     const v = vertexOf[s];
-    splatPositions.set(positions.subarray(3 * v, 3 * v + 3), 3 * s);
-    splatColours?.set(/** @type {Uint8Array} */ (colours).subarray(3 * v, 3 * v + 3), 3 * s);
+    for (let a = 0; a < 3; a++) splatPositions[3 * s + a] = positions[3 * v + a];
+    if (splatColours && colours) for (let a = 0; a < 3; a++) splatColours[3 * s + a] = colours[3 * v + a];
     splatRadii[s] = radii[v];
     surfaceIds[s] = splatPatch[s];
   }
   const { clip, planes } = creasePlanes({ positions, indices, around, firstSplat, splatPatch, vertexOf, normals, faceCentre, splatAt });
   return { count, positions: splatPositions, normals, colours: splatColours, radii: splatRadii, surfaceIds, clip, planes };
-}
-
-/**
- * The faces around each vertex, as compressed rows.
- * @param {Uint32Array} indices @param {number} n
- */
-function vertexFaces(indices, n) {
-  const offsets = new Uint32Array(n + 1);
-  for (let c = 0; c < indices.length; c++) offsets[indices[c] + 1]++;
-  for (let v = 0; v < n; v++) offsets[v + 1] += offsets[v];
-  const fill = offsets.slice(0, n);
-  const faces = new Uint32Array(indices.length);
-  for (let c = 0; c < indices.length; c++) faces[fill[indices[c]]++] = (c / 3) | 0;
-  return { offsets, faces };
 }
 
 /**
