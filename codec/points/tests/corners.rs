@@ -2,7 +2,9 @@
 //! on a convex edge and a concave crease at once (the inner corners of an
 //! L-shaped block), grouping them by surface id drops the splat from
 //! clipping instead of cutting away its visible half; where every group
-//! agrees (a cube's corners) the splat keeps its planes.
+//! agrees (a cube's corners) the splat keeps its planes. Also the
+//! concave mode (the L-block's crease) and the intersection mode (its top
+//! face's reflex corner), which no other test reaches.
 
 use vitrine_points::splat::{preprocess, ClipMode, SplatOptions, Splats, PLANE_FLOATS};
 use vitrine_points::testing::{cube, faces_sample, l_block_faces, Rect, L_BLOCK_HALF_HEIGHT};
@@ -159,5 +161,65 @@ fn splat_cube_corners_keep_their_planes() {
         outside * 2 >= at_corner.len(),
         "{outside} of {}",
         at_corner.len()
+    );
+}
+
+#[test]
+fn splat_l_block_crease_is_concave_and_the_reflex_corner_an_intersection() {
+    let (pos, nrm) = faces_sample(&l_block_faces(), 40_000, 7);
+    let splats = preprocess(&pos, &nrm, &SplatOptions::default());
+    let c = &splats.clipping;
+    // Splats on the crease's two faces (x = 0 for y > 0, y = 0 for x > 0),
+    // away from the inner corners, with partners: their planes cut what
+    // pokes into the solid behind the other face, and keep their own face.
+    let (mut crease, mut concave_ok) = (0, 0);
+    for i in 0..pos.len() {
+        let (p, n, r) = (pos[i], nrm[i], splats.radii[i]);
+        // Within reach of the crease, not of the far edges of these faces.
+        let on_x0 = n[0] == 1.0 && p[0] == 0.0 && p[1] < 0.5;
+        let on_y0 = n[1] == 1.0 && p[1] == 0.0 && p[0] < 0.5;
+        if !(on_x0 || on_y0) || p[2].abs() > 0.3 || c.partners_of(i).is_empty() {
+            continue;
+        }
+        crease += 1;
+        // Along the face towards the crease, past it (inside the solid), and
+        // away from it (the face itself).
+        let (inside, face) = if on_x0 {
+            ([0.0, -0.5 * r, p[2]], [0.0, p[1] + 0.5 * r, p[2]])
+        } else {
+            ([-0.5 * r, 0.0, p[2]], [p[0] + 0.5 * r, 0.0, p[2]])
+        };
+        concave_ok += usize::from(clipped(&splats, i, inside) && !clipped(&splats, i, face));
+    }
+    // The top face's splats at the reflex corner of its L (the top inner
+    // corner), with partners on both crease faces (both convex to it):
+    // clipped only where both planes cut (the notch), so the L's own top
+    // stays. The corner split leaves them to the joint classification.
+    let ids = &splats.surface_ids;
+    let reflex: Vec<usize> = (0..pos.len())
+        .filter(|&i| {
+            let p = c.partners_of(i);
+            let near_corner = dist(pos[i], [0.0, 0.0, L_BLOCK_HALF_HEIGHT]) < 3.0 * splats.radii[i];
+            near_corner
+                && nrm[i][2] == 1.0
+                && p.iter().any(|&j| ids[j as usize] != ids[p[0] as usize])
+        })
+        .collect();
+    let intersections = reflex
+        .iter()
+        .filter(|&&i| c.mode(i) == ClipMode::Intersection)
+        .count();
+    println!(
+        "L-block crease: {concave_ok} of {crease} splats cut inside the solid and keep their face; \
+         {intersections} of {} top splats with partners on both crease faces clip by intersection",
+        reflex.len()
+    );
+    assert!(crease > 20, "{crease}");
+    assert_eq!(concave_ok, crease, "crease splats clipped as convex");
+    assert!(!reflex.is_empty());
+    assert_eq!(
+        intersections,
+        reflex.len(),
+        "the top's reflex corner clipped by union"
     );
 }
