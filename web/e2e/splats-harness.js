@@ -53,11 +53,14 @@ function listen(until) {
       batchUrls: batches.map((b) => new URL(b, location.href).href), upTo: batches.length });
     return done;
   },
-  /** @param {number[]} positions @param {number[]} indices @param {import('../src/geometry.js').Bounds} box @param {Partial<import('../src/camera.js').OrbitState>} state */
-  async mesh(positions, indices, box, state) {
+  /**
+   * @param {number[]} positions @param {number[]} indices @param {import('../src/geometry.js').Bounds} box
+   * @param {Partial<import('../src/camera.js').OrbitState>} state @param {number} [sharpThreshold] w_s (default 0.9)
+   */
+  async mesh(positions, indices, box, state, sharpThreshold) {
     look(box, state);
     const done = listen((m) => m.type === 'splats');
-    worker.postMessage({ type: 'mesh', id: 1, positions: new Float32Array(positions), indices: new Uint32Array(indices), colours: null });
+    worker.postMessage({ type: 'mesh', id: 1, positions: new Float32Array(positions), indices: new Uint32Array(indices), colours: null, sharpThreshold });
     return done;
   },
   /** Points on a unit sphere, drawn without preprocessing (frame time). @param {number} count */
@@ -77,6 +80,10 @@ function listen(until) {
     view.setSplats({ count, positions, normals, colours: null, radii: new Float32Array(count).fill(radius),
       surfaceIds: new Uint32Array(count), clip: new Uint32Array(count), planes: new Float32Array(0) });
     look({ min: [-1, -1, -1], max: [1, 1, 1] });
+  },
+  /** Turns the camera to `state` (from its home view). @param {Partial<import('../src/camera.js').OrbitState>} state */
+  orbit(state) {
+    if (camera) camera.state = { ...structuredClone(camera.home), ...state };
   },
   /** @param {Partial<import('../src/splats/splat-renderer.js').SplatOptions>} options */
   capture(options) {

@@ -10,6 +10,7 @@ import { VitrineCodec } from '../src/codec.js';
 import { PointStream, splitHeader, splitLevels } from '../src/splats/point-stream.js';
 import { meshSplats } from '../src/splats/mesh-splats.js';
 import { fixturesDir, wasmPath } from './support/fixtures.mjs';
+import { boxMesh } from './support/solids.mjs';
 
 const spheres = new Uint8Array(readFileSync(join(fixturesDir, 'two-spheres.vpts')));
 
@@ -65,4 +66,49 @@ test('a mesh level: normals, edge-length radii, one surface per component', () =
   assert.equal(s.surfaceIds[0], s.surfaceIds[2]);
   assert.notEqual(s.surfaceIds[0], s.surfaceIds[3]);
   assert.equal(s.clip.every((w) => w === 0), true);
+});
+
+test("a mesh level's sharp edges: vertices split per side, flat normals, the other side's plane clips", () => {
+  const { positions, indices } = boxMesh({ min: [-1, -1, -1], max: [1, 1, 1] }, 4);
+  const s = meshSplats(new Float32Array(positions), new Uint32Array(indices), null);
+  const n = positions.length / 3;
+  // 8 corners on 3 faces, 12 edges × 3 inner vertices on 2: 8·2 + 36 more splats.
+  assert.equal(s.count, n + 8 * 2 + 36);
+  assert.equal(new Set(s.surfaceIds).size, 6, 'one surface per face');
+  let clipped = 0;
+  let beyond = 0;
+  for (let i = 0; i < s.count; i++) {
+    const nrm = [...s.normals.subarray(3 * i, 3 * i + 3)];
+    // Every splat's normal is its face's: one axis, exactly.
+    assert.equal(nrm.filter((c) => Math.abs(c) > 1e-6).length, 1, `splat ${i}: ${nrm}`);
+    const count = s.clip[i] & 15;
+    if (count === 0) continue;
+    clipped++;
+    assert.equal((s.clip[i] >> 4) & 3, 1, 'union');
+    const first = s.clip[i] >>> 6;
+    const p = [...s.positions.subarray(3 * i, 3 * i + 3)];
+    const r = s.radii[i];
+    // Inside the box, just under the splat: kept; pushed out in its own
+    // plane past an edge it is near: cut.
+    const inside = p.map((c) => c * (1 - 1e-3));
+    const cuts = (/** @type {number[]} */ q) => {
+      for (let k = first; k < first + count; k++) {
+        const [a, b, c, d] = s.planes.subarray(4 * k, 4 * k + 4);
+        if (a * q[0] + b * q[1] + c * q[2] + d > 0) return true;
+      }
+      return false;
+    };
+    assert.equal(cuts(inside), false, `splat ${i} cuts the inside`);
+    const out = p.map((c, a) => (Math.abs(nrm[a]) > 0.5 || Math.abs(c) < 1 - 1.01 * r ? c : c + Math.sign(c) * r));
+    if (out.some((c, a) => Math.abs(c) > 1 && Math.abs(nrm[a]) < 0.5)) {
+      beyond++;
+      assert.equal(cuts(out), true, `splat ${i} keeps ${out}`);
+    }
+  }
+  assert.ok(clipped > 100 && beyond > 50, `${clipped} splats clipped, ${beyond} checked past an edge`);
+  // No sharp edge below −1: the splats of before (one per vertex, nothing clipped).
+  const plain = meshSplats(new Float32Array(positions), new Uint32Array(indices), null, -2);
+  assert.equal(plain.count, n);
+  assert.equal(new Set(plain.surfaceIds).size, 1);
+  assert.ok(plain.clip.every((w) => w === 0));
 });

@@ -62,12 +62,18 @@ fn main() {
             let g = vitrine_points::splat::neighbour_graph(&pos, &r);
             println!("graph {:.3} s CPU", cpu_s() - t);
             let t = cpu_s();
-            let o = SplatOptions::default();
-            let c = vitrine_points::splat::clip::clip_partners(&pos, &nrm, &r, &g, &o);
-            println!("clip {:.3} s CPU", cpu_s() - t);
-            let t = cpu_s();
             let ids = vitrine_points::splat::surface_ids(&nrm, &g, 0.9);
             println!("ids {:.3} s CPU", cpu_s() - t);
+            let t = cpu_s();
+            let o = SplatOptions::default();
+            let input = vitrine_points::splat::ClipInput {
+                positions: &pos,
+                normals: &nrm,
+                radii: &r,
+                surface_ids: &ids,
+            };
+            let c = vitrine_points::splat::clip::clip_partners(input, &g, &o);
+            println!("clip {:.3} s CPU", cpu_s() - t);
             std::hint::black_box((c, ids));
         }
         let (t, c) = (Instant::now(), cpu_s());

@@ -1,5 +1,6 @@
 //! Generated clouds with known normals for the tests, benches and examples:
-//! a deterministic random source and samplers of a sphere and a cube.
+//! a deterministic random source and samplers of a sphere, a cube and a
+//! solid made of rectangles (an L-shaped block).
 
 /// SplitMix64 step.
 pub fn next(state: &mut u64) -> u64 {
@@ -69,4 +70,112 @@ pub fn cube(n: usize, h: f32, seed: u64) -> (Vec<[f32; 3]>, Vec<[f32; 3]>) {
 pub fn angle_deg(a: [f32; 3], b: [f32; 3]) -> f32 {
     let d = a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
     d.clamp(-1.0, 1.0).acos().to_degrees()
+}
+
+/// A flat face of a solid: a rectangle from `corner` spanned by `u` and
+/// `v`, with its outward normal.
+#[derive(Clone, Copy, Debug)]
+pub struct Rect {
+    pub corner: [f32; 3],
+    pub u: [f32; 3],
+    pub v: [f32; 3],
+    pub normal: [f32; 3],
+}
+
+impl Rect {
+    fn area(&self) -> f32 {
+        let c = [
+            self.u[1] * self.v[2] - self.u[2] * self.v[1],
+            self.u[2] * self.v[0] - self.u[0] * self.v[2],
+            self.u[0] * self.v[1] - self.u[1] * self.v[0],
+        ];
+        (c[0] * c[0] + c[1] * c[1] + c[2] * c[2]).sqrt()
+    }
+
+    /// Whether `p` lies on the rectangle (within `eps` of its plane).
+    pub fn contains(&self, p: [f32; 3], eps: f32) -> bool {
+        let d = [0, 1, 2].map(|k| p[k] - self.corner[k]);
+        let along = |a: [f32; 3]| {
+            (d[0] * a[0] + d[1] * a[1] + d[2] * a[2]) / (a[0] * a[0] + a[1] * a[1] + a[2] * a[2])
+        };
+        let off = d[0] * self.normal[0] + d[1] * self.normal[1] + d[2] * self.normal[2];
+        let (s, t) = (along(self.u), along(self.v));
+        off.abs() < eps && (0.0..=1.0).contains(&s) && (0.0..=1.0).contains(&t)
+    }
+}
+
+/// Half the height of [`l_block_faces`]' block.
+pub const L_BLOCK_HALF_HEIGHT: f32 = 0.5;
+
+/// The faces of an L-shaped block: the L [−1, 1]×[−1, 0] ∪ [−1, 0]×[0, 1]
+/// in x, y, extruded over z ∈ [−0.5, 0.5]. Its one concave crease runs
+/// along x = y = 0 and meets the top and bottom at two inner corners,
+/// (0, 0, ±0.5), where it meets convex edges (seed 002, §7.2's mixed
+/// partner sets).
+pub fn l_block_faces() -> Vec<Rect> {
+    let h = L_BLOCK_HALF_HEIGHT;
+    let rect = |corner, u, v, normal| Rect {
+        corner,
+        u,
+        v,
+        normal,
+    };
+    let up = [0.0, 0.0, 2.0 * h];
+    vec![
+        rect(
+            [-1.0, -1.0, h],
+            [2.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [0.0, 0.0, 1.0],
+        ),
+        rect(
+            [-1.0, 0.0, h],
+            [1.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [0.0, 0.0, 1.0],
+        ),
+        rect(
+            [-1.0, -1.0, -h],
+            [2.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [0.0, 0.0, -1.0],
+        ),
+        rect(
+            [-1.0, 0.0, -h],
+            [1.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [0.0, 0.0, -1.0],
+        ),
+        rect([-1.0, -1.0, -h], [0.0, 2.0, 0.0], up, [-1.0, 0.0, 0.0]),
+        rect([-1.0, -1.0, -h], [2.0, 0.0, 0.0], up, [0.0, -1.0, 0.0]),
+        rect([1.0, -1.0, -h], [0.0, 1.0, 0.0], up, [1.0, 0.0, 0.0]),
+        rect([0.0, 0.0, -h], [1.0, 0.0, 0.0], up, [0.0, 1.0, 0.0]),
+        rect([0.0, 0.0, -h], [0.0, 1.0, 0.0], up, [1.0, 0.0, 0.0]),
+        rect([-1.0, 1.0, -h], [1.0, 0.0, 0.0], up, [0.0, 1.0, 0.0]),
+    ]
+}
+
+/// `n` points uniformly at random over `faces` (by area), with the faces'
+/// normals.
+pub fn faces_sample(faces: &[Rect], n: usize, seed: u64) -> (Vec<[f32; 3]>, Vec<[f32; 3]>) {
+    let mut s = seed;
+    let areas: Vec<f32> = faces.iter().map(Rect::area).collect();
+    let total: f32 = areas.iter().sum();
+    let mut pos = Vec::with_capacity(n);
+    let mut nrm = Vec::with_capacity(n);
+    for _ in 0..n {
+        let mut pick = unit(&mut s) * total;
+        let face = faces
+            .iter()
+            .zip(&areas)
+            .find(|(_, &a)| {
+                pick -= a;
+                pick < 0.0
+            })
+            .map_or(&faces[faces.len() - 1], |(f, _)| f);
+        let (a, b) = (unit(&mut s), unit(&mut s));
+        pos.push([0, 1, 2].map(|k| face.corner[k] + a * face.u[k] + b * face.v[k]));
+        nrm.push(face.normal);
+    }
+    (pos, nrm)
 }

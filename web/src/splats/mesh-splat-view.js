@@ -1,10 +1,11 @@
 // @ts-check
 /**
  * The "Splats" view of a mesh model: the level on screen (its vertices,
- * vertex normals and colours) drawn as splats over the viewer's canvas.
- * The decode worker copies the level out ('level-data'), the splat worker
- * derives the splats (mesh-splats.js); the main thread only hands buffers
- * on. Off, the canvas is removed and the mesh path is as it was.
+ * normals and colours, split and clipped at its sharp edges) drawn as
+ * splats over the viewer's canvas. The decode worker copies the level out
+ * ('level-data'), the splat worker derives the splats (mesh-splats.js); the
+ * main thread only hands buffers on. Off, the canvas is removed and the
+ * mesh path is as it was.
  */
 
 import { SplatView } from './splat-view.js';

@@ -112,7 +112,7 @@ scope.onmessage = (/** @type {MessageEvent<SplatCommand>} */ event) => {
   }
   else if (command.type === 'mesh') {
     const started = performance.now();
-    const set = meshSplats(command.positions, command.indices, command.colours);
+    const set = meshSplats(command.positions, command.indices, command.colours, command.sharpThreshold);
     post({ type: 'splats', id: command.id, level: -1, set, received: 0, ms: performance.now() - started });
   }
 };

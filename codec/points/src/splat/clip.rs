@@ -15,8 +15,33 @@
 //! | 0–3 | number of planes (0–8; 0 = never clipped) |
 //! | 4–5 | [`ClipMode`]: 1 union (clipped if any plane clips), 2 intersection (clipped if all do) |
 //! | 6–31 | index of the splat's first plane in `planes` (in planes, not floats) |
+//!
+//! # Corners
+//!
+//! Near a corner a splat's partners can lie on several surfaces, some
+//! meeting it at a convex edge and some at a concave one (the inner corner
+//! of an L-shaped block). One classification of the whole set is then
+//! wrong for part of it: concave partners taken as convex cut away the
+//! splat's visible half. The seed leaves this open (§7.2) and proposes
+//! the split done here: the partners are grouped by surface id, each group
+//! is classified (eq. 4.13–4.14), and where the groups disagree (one
+//! concave, another convex) the splat is dropped from clipping. It keeps
+//! its partners but gets no planes: it may overshoot by up to its radius,
+//! which a hole would not forgive. Where the groups agree, the whole set is
+//! classified as before (a reflex corner of one face, where two convex
+//! groups meet, needs the intersection that only the joint set gives).
 
 use super::{cross, dot, sub, Graph, SplatOptions};
+
+/// What clipping needs to know about the cloud besides the graph.
+#[derive(Clone, Copy, Debug)]
+pub struct ClipInput<'a> {
+    pub positions: &'a [[f32; 3]],
+    pub normals: &'a [[f32; 3]],
+    pub radii: &'a [f32],
+    /// From [`super::surface_ids`]: partners are grouped by them.
+    pub surface_ids: &'a [u32],
+}
 
 /// Floats per packed plane.
 pub const PLANE_FLOATS: usize = 4;
@@ -38,6 +63,9 @@ pub struct Clipping {
     /// Splats on a crease (an angular gap in their continuous neighbours)
     /// with at least one sharp edge.
     pub candidates: usize,
+    /// Splats with partners whose surface-id groups disagree (see the
+    /// module comment): partners kept, no planes.
+    pub mixed_corners: usize,
     /// Partners per splat as rows: `partners[offsets[i]..offsets[i + 1]]`.
     pub offsets: Vec<u32>,
     pub partners: Vec<u32>,
@@ -149,14 +177,15 @@ fn crosses_both(
 
 /// Finds the clip partners of every splat, classifies them and packs the
 /// planes (see the module comment for the layout).
-pub fn clip_partners(
-    positions: &[[f32; 3]],
-    normals: &[[f32; 3]],
-    radii: &[f32],
-    graph: &Graph,
-    opts: &SplatOptions,
-) -> Clipping {
+pub fn clip_partners(input: ClipInput, graph: &Graph, opts: &SplatOptions) -> Clipping {
+    let ClipInput {
+        positions,
+        normals,
+        radii,
+        surface_ids,
+    } = input;
     let n = positions.len();
+    assert_eq!(surface_ids.len(), n, "one surface id per splat");
     let w = opts.sharp_threshold;
     let mut angles = Vec::new();
     let crease: Vec<bool> = (0..n)
@@ -193,14 +222,12 @@ pub fn clip_partners(
         found.truncate(opts.max_partners.min(15));
         out.partners.extend(found.iter().map(|f| f.1));
         out.offsets.push(out.partners.len() as u32);
-        if !found.is_empty() {
+        let partners = &out.partners[out.partners.len() - found.len()..];
+        if groups_disagree(i, partners, surface_ids, positions, normals) {
+            out.mixed_corners += 1;
+        } else if !found.is_empty() {
             let first = (out.planes.len() / PLANE_FLOATS) as u32;
-            let (mode, concave) = classify(
-                i,
-                &out.partners[out.partners.len() - found.len()..],
-                positions,
-                normals,
-            );
+            let (mode, concave) = classify(i, partners, positions, normals);
             for &(_, j) in &found {
                 let (nj, cj) = (normals[j as usize], positions[j as usize]);
                 let s = if concave { -1.0 } else { 1.0 };
@@ -213,17 +240,15 @@ pub fn clip_partners(
     out
 }
 
-/// Eq. 4.13–4.15: the partners' class (about their mean centre) and the
-/// splat's (about its own plane); the same class (or an undecided one)
-/// gives the union of the clip half-spaces, mixed classes the
-/// intersection. Returns the mode and whether the partners' half-spaces are
-/// taken as concave (clip where (P − C_j)·n_j < 0).
-fn classify(
+/// Eq. 4.13–4.14: the partners' class about their mean centre and the
+/// splat's about its own plane, each concave (`Some(true)`), convex
+/// (`Some(false)`) or undecided.
+fn classes(
     i: usize,
     partners: &[u32],
     positions: &[[f32; 3]],
     normals: &[[f32; 3]],
-) -> (ClipMode, bool) {
+) -> (Option<bool>, Option<bool>) {
     let k = partners.len() as f32;
     let mut m = [0f32; 3];
     for &j in partners {
@@ -231,32 +256,83 @@ fn classify(
             m[a] += positions[j as usize][a] / k;
         }
     }
-    let class = |signs: &mut dyn Iterator<Item = f32>| {
-        let (mut pos, mut neg) = (true, true);
-        for s in signs {
-            pos &= s > 0.0;
-            neg &= s < 0.0;
-        }
-        match (pos, neg) {
-            (true, _) => Some(true),  // concave
-            (_, true) => Some(false), // convex
-            _ => None,
-        }
-    };
-    let partner_class = class(
-        &mut partners
+    let partner_class = class_of(
+        partners
             .iter()
             .map(|&j| dot(sub(m, positions[j as usize]), normals[j as usize])),
     );
-    let own_class = class(
-        &mut partners
+    let own_class = class_of(
+        partners
             .iter()
             .map(|&j| dot(sub(positions[j as usize], positions[i]), normals[i])),
     );
+    (partner_class, own_class)
+}
+
+/// Concave (`Some(true)`) when every signed distance is positive, convex
+/// when every one is negative, else undecided.
+fn class_of(signs: impl Iterator<Item = f32>) -> Option<bool> {
+    let (mut pos, mut neg) = (true, true);
+    for s in signs {
+        pos &= s > 0.0;
+        neg &= s < 0.0;
+    }
+    match (pos, neg) {
+        (true, _) => Some(true),
+        (_, true) => Some(false),
+        _ => None,
+    }
+}
+
+/// Eq. 4.15: the same class (or an undecided one) gives the union of the
+/// clip half-spaces, mixed classes the intersection. Returns the mode and
+/// whether the partners' half-spaces are taken as concave (clip where
+/// (P − C_j)·n_j < 0).
+fn classify(
+    i: usize,
+    partners: &[u32],
+    positions: &[[f32; 3]],
+    normals: &[[f32; 3]],
+) -> (ClipMode, bool) {
+    let (partner_class, own_class) = classes(i, partners, positions, normals);
     let concave = own_class.or(partner_class).unwrap_or(false);
     let mode = match (partner_class, own_class) {
         (Some(a), Some(b)) if a != b => ClipMode::Intersection,
         _ => ClipMode::Union,
     };
     (mode, concave)
+}
+
+/// The corner split (module comment): whether the partners, grouped by
+/// surface id and each group classified on its own, include a concave
+/// group and a convex one.
+fn groups_disagree(
+    i: usize,
+    partners: &[u32],
+    surface_ids: &[u32],
+    positions: &[[f32; 3]],
+    normals: &[[f32; 3]],
+) -> bool {
+    let mut by_id: Vec<u32> = partners.to_vec();
+    by_id.sort_unstable_by_key(|&j| (surface_ids[j as usize], j));
+    let (mut concave, mut convex) = (false, false);
+    for group in by_id.chunk_by(|&a, &b| surface_ids[a as usize] == surface_ids[b as usize]) {
+        let (partner_class, own_class) = classes(i, group, positions, normals);
+        // A group on one surface has no class of its own about its mean
+        // centre (eq. 4.13 is 0); where the group straddles the splat's
+        // plane (eq. 4.14 undecided, as the top face does around an inner
+        // corner), the splat is seen from the group's planes instead.
+        let seen_from_group = class_of(group.iter().map(|&j| {
+            dot(
+                sub(positions[i], positions[j as usize]),
+                normals[j as usize],
+            )
+        }));
+        match own_class.or(seen_from_group).or(partner_class) {
+            Some(true) => concave = true,
+            Some(false) => convex = true,
+            None => {}
+        }
+    }
+    concave && convex
 }

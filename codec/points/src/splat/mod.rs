@@ -8,15 +8,17 @@
 //! 3. Sharp edges: n_i·n_j < w_s; the rest are continuous.
 //! 4. [`clip`]: crease versus crossing by the angle-gap test over continuous
 //!    neighbours; clip partners where the planes' intersection line crosses
-//!    both splats; concave/convex classification; planes packed for the GPU.
-//! 5. [`segment`]: surface ids by breadth-first search over continuous edges.
+//!    both splats; concave/convex classification (split by surface id near
+//!    corners); planes packed for the GPU.
+//! 5. [`segment`]: surface ids by breadth-first search over continuous edges
+//!    (before clipping, which groups partners by them).
 
 pub mod clip;
 pub mod graph;
 pub mod radii;
 pub mod segment;
 
-pub use clip::{ClipMode, Clipping, PLANE_FLOATS};
+pub use clip::{ClipInput, ClipMode, Clipping, PLANE_FLOATS};
 pub use graph::{brute_force_graph, neighbour_graph, Graph};
 pub use radii::{prefix_radius_scale, splat_radii, RADIUS_NEIGHBOURS};
 pub use segment::surface_ids;
@@ -82,8 +84,14 @@ pub fn preprocess_with_radii(
                 .count()
         })
         .sum();
-    let clipping = clip::clip_partners(positions, normals, &radii, &graph, opts);
     let surface_ids = surface_ids(normals, &graph, w);
+    let input = ClipInput {
+        positions,
+        normals,
+        radii: &radii,
+        surface_ids: &surface_ids,
+    };
+    let clipping = clip::clip_partners(input, &graph, opts);
     Splats {
         radii,
         graph,
