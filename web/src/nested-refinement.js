@@ -73,6 +73,8 @@ const OCCLUSION_TRIANGLES = 4_000_000;
  * @property {number[]} charts per phase, in the stream
  * @property {number[]} residentCharts per phase, held
  * @property {number[]} shownCharts per phase, on screen
+ * @property {[number, number][]} shown the charts on screen, each as its phase and chart
+ * @property {number} shownTriangles the triangles on screen, all charts shown together
  * @property {number[][]} depths per phase and chart: parts applied, -1 while not held
  * @property {number[]} phaseBatches per phase: the parts each chart of it has in all
  * @property {number} finalDepth the last phase's
@@ -536,6 +538,8 @@ export class NestedRefinement {
         charts: t.charts,
         residentCharts: perPhase(() => true),
         shownCharts: t.charts.map((_, p) => pieces.filter((n) => n.phase === p).length),
+        shown: pieces.map((n) => [n.phase, n.chart]),
+        shownTriangles: pieces.reduce((sum, n) => sum + n.indices.length / 3, 0),
         depths: this.#nodes.map((phase) => phase.map((n) => (n ? n.depth : -1))),
         phaseBatches: t.batches,
         finalDepth: t.batches[t.phases - 1],

@@ -31,14 +31,18 @@ export const webDist = join(root, 'web', 'dist');
  */
 
 /**
- * @param {{ models: ModelSpec[], serveArgs?: string[] }} options
+ * `existingDb` serves a database ingested before (a benchmark's scan of
+ * millions of vertices, ingested once): no model is ingested, and the
+ * database is left as it was.
+ * @param {{ models: ModelSpec[], serveArgs?: string[], existingDb?: string }} options
  * @returns {Promise<{ url: string, dir: string, db: string, stop: () => Promise<void> }>}
  */
-export async function startService({ models, serveArgs = [] }) {
+export async function startService({ models, serveArgs = [], existingDb }) {
   if (!existsSync(vitrine)) throw new Error(`build the CLI first: cargo build --release -p vitrine (${vitrine})`);
   if (!existsSync(join(webDist, 'index.html'))) throw new Error('build the viewer first: npm run build');
+  if (existingDb && models.length > 0) throw new Error('models are ingested into a new database, not an existing one');
   const dir = mkdtempSync(join(tmpdir(), 'vitrine-service-'));
-  const db = `sqlite:${join(dir, 'vitrine.db')}`;
+  const db = existingDb ?? `sqlite:${join(dir, 'vitrine.db')}`;
   const env = { ...process.env, NO_COLOR: '1', RUST_LOG: process.env.RUST_LOG ?? 'warn,vitrine=info' };
   for (const m of models) {
     const mesh = m.kind === 'file' ? String(m.file) : join(dir, `${m.slug}.ply`);

