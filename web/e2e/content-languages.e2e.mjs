@@ -82,12 +82,19 @@ async function newPage(expected = () => false) {
   return { page, problems };
 }
 
-/** @param {Page} page */
-async function untilDrawn(page) {
-  await page.waitForFunction(() => /** @type {any} */ (document.querySelector('vitrine-viewer'))?.viewer?.state?.shownLevel >= 0, null, {
-    timeout: 60_000,
-    polling: 50,
-  });
+/**
+ * @param {Page} page
+ * @param {{ complete?: boolean }} [options] wait for every level, not the first drawn
+ */
+async function untilDrawn(page, { complete = false } = {}) {
+  await page.waitForFunction(
+    (complete) => {
+      const state = /** @type {any} */ (document.querySelector('vitrine-viewer'))?.viewer?.state;
+      return complete ? state?.status === 'complete' : state?.shownLevel >= 0;
+    },
+    complete,
+    { timeout: 60_000, polling: 50 },
+  );
 }
 
 /**
@@ -152,7 +159,9 @@ test('?lang=pt: the Portuguese title, description and credit, marked lang="pt", 
 test('?lang=de, no German given: the English texts, marked lang="en" and dir="auto"; the switch turns them Portuguese in place', async () => {
   const { page, problems } = await newPage();
   await page.goto(`${service.url}/m/lamp?lang=de`);
-  await untilDrawn(page);
+  // Every level in first: a batch still on its way after the switch is
+  // the refinement's, not a fetch the switch made.
+  await untilDrawn(page, { complete: true });
   await page.waitForFunction((title) => document.title.startsWith(title), EN.title);
   const seen = await shownTexts(page);
   assert.deepEqual(seen.title, marked(EN.title, 'en', 'auto'));
