@@ -4,7 +4,8 @@
 // `--charts nested` (or the shape given), the page opens on the home view
 // with `?refine=view`, settles, then zooms onto one point of the surface.
 // Reported: bytes fetched for the overview and for the close-up against
-// the whole stream's, the most vertices resident, and the time from the
+// the whole stream's, as the viewer counts them (the bodies the network
+// carried: the part index compressed, as the service sends JSON), the most vertices resident, and the time from the
 // zoom to the chart under the camera at the last phase's final depth, the
 // occlusion depth map's cost, with
 // DevTools network emulation at `--mbits` (default 10 Mbit/s; 0: loopback).
@@ -116,8 +117,9 @@ try {
   console.log(`nested close-up of ${mesh} (${values.charts}; ${manifest.levels.at(-1).vertices} vertices, ${mbits > 0 ? `${mbits} Mbit/s` : 'loopback'}; ${distance.toPrecision(3)} from ${target.map((v) => v.toPrecision(3)).join(', ')}):`);
   console.log(`  whole stream              ${mb(whole)}`);
   console.log(`  first frame               ${(firstFrameMs / 1000).toFixed(2)} s after navigation`);
-  console.log(`  overview settled          ${(overviewMs / 1000).toFixed(1)} s, ${mb(overview.bytesFetched)} (${((100 * overview.bytesFetched) / whole).toFixed(1)} %), ${overview.shownTriangles} triangles shown, ${overview.resident} vertices resident`);
-  console.log(`  after the close-up        ${mb(closeup.bytesFetched)} (${((100 * closeup.bytesFetched) / whole).toFixed(1)} %), ${mb(closeup.bytesFetched - overview.bytesFetched)} for the zoom`);
+  const pct = (/** @type {number} */ n) => `${((100 * n) / whole).toFixed(1)} %`;
+  console.log(`  overview settled          ${(overviewMs / 1000).toFixed(1)} s, ${mb(overview.bytesFetched)} (${pct(overview.bytesFetched)}), ${overview.shownTriangles} triangles shown, ${overview.resident} vertices resident`);
+  console.log(`  after the close-up        ${mb(closeup.bytesFetched)} (${pct(closeup.bytesFetched)}), ${mb(closeup.bytesFetched - overview.bytesFetched)} for the zoom`);
   console.log(`  zoom to the final depth   ${finalMs === null ? 'not reached' : `${(finalMs / 1000).toFixed(1)} s`}`);
   console.log(`  resident at most          ${maxResident} vertices (budget ${closeup.budget}); ${closeup.evictions} subtrees folded back`);
   console.log(`  shown at most             ${maxShown} triangles`);

@@ -83,7 +83,7 @@ const OCCLUSION_TRIANGLES = 4_000_000;
  * @property {number} level the finest level shown (a chart at depth d of phase p: the level of that part)
  * @property {number} resident vertices held, all charts together, parents included
  * @property {number} budget
- * @property {number} bytesFetched payload bytes of this load: base, global batches, part index, head, parts and split entries
+ * @property {number} bytesFetched bytes of this load as the network carried them: base, global batches, part index (compressed), head, parts and split entries
  * @property {number} inFlight parts and split entries on their way
  * @property {boolean} settled nothing on its way and nothing more wanted for the last camera
  * @property {number} evictions subtrees folded back to make room so far

@@ -8,13 +8,15 @@
  * test/nested-selection.test.mjs in Node. Charts are placed, measured and
  * ranked as part-selection.js does for a charted stream's.
  *
- * A chart's error still to come is the largest error of its phase's parts
- * it has not applied and of every part of its descendants: a chart near
- * the camera goes deepest (its parts, then its split, then its children's
- * parts), one far away stops where the rest is below a pixel on screen.
+ * A chart's error still to come is the largest refinement error
+ * (part-selection.js, `refinementError`) of its phase's parts it has not
+ * applied and of every part of its descendants: a chart near the camera
+ * goes deepest (its parts, then its split, then its children's parts), one
+ * far away stops where the rest is below a pixel on screen. Occlusion
+ * keeps the largest errors, a bound.
  */
 
-import { SCREEN_ERROR_PX, byLeastNeeded, byNeed, frustumPlanes, onScreen, sight } from './part-selection.js';
+import { SCREEN_ERROR_PX, byLeastNeeded, byNeed, frustumPlanes, onScreen, refinementError, sight } from './part-selection.js';
 
 /**
  * The part index of a nested stream as the service sends it (`GET …/parts`).
@@ -30,16 +32,17 @@ import { SCREEN_ERROR_PX, byLeastNeeded, byNeed, frustumPlanes, onScreen, sight 
  */
 
 /**
- * @typedef {{ level: number, chart: number, phase: number, parent?: number, bytes: number, inserted: number, error: number }} NestedPartEntry
+ * @typedef {{ level: number, chart: number, phase: number, parent?: number, bytes: number, inserted: number, error: number, bulk_error?: number }} NestedPartEntry
  * @typedef {{ level: number, parent: number, first_child: number, children: number, bytes: number }} SplitEntry
  */
 
 /**
  * The index as a tree. `parts[p][k][d]`: the part that takes chart k of
  * phase p from depth d to d + 1; `splits[p][k]`: its split into
- * `children[p][k]` of phase p + 1; `own[p][k][d]`: the largest error of
- * its parts from depth d on; `below[p][k]`: of every part of its
- * descendants; `batches`: each phase's parted batches (the parts a chart
+ * `children[p][k]` of phase p + 1; `own[p][k][d]`: the largest refinement
+ * error of its parts from depth d on; `below[p][k]`: of every part of its
+ * descendants; `ownBound` and `belowBound`: the same of their largest
+ * errors (for occlusion); `batches`: each phase's parted batches (the parts a chart
  * of it has in all); `phaseStart`: each phase's first level.
  * @typedef {object} NestedTable
  * @property {number} phases
@@ -52,6 +55,8 @@ import { SCREEN_ERROR_PX, byLeastNeeded, byNeed, frustumPlanes, onScreen, sight 
  * @property {[number, number][][]} children
  * @property {number[][][]} own
  * @property {number[][]} below
+ * @property {number[][][]} ownBound
+ * @property {number[][]} belowBound
  * @property {import('./codec.js').NestedBatch[]} batchesInOrder every parted batch, as the view is declared from
  */
 
@@ -98,20 +103,29 @@ export function nestedTable(index) {
     splits[phase][s.parent] = s;
     children[phase][s.parent] = [s.first_child, s.first_child + s.children];
   }
-  const own = parts.map((phase) =>
-    phase.map((chart) => {
-      const r = new Array(chart.length + 1).fill(0);
-      for (let d = chart.length - 1; d >= 0; d--) r[d] = Math.max(chart[d].error, r[d + 1]);
-      return r;
-    }),
-  );
-  const below = charts.map((n) => new Array(n).fill(0));
-  for (let p = phases - 2; p >= 0; p--) {
-    for (let k = 0; k < charts[p]; k++) {
-      for (let c = children[p][k][0]; c < children[p][k][1]; c++) below[p][k] = Math.max(below[p][k], own[p + 1][c][0], below[p + 1][c]);
+  /** @param {(part: NestedPartEntry) => number} of */
+  const suffixMax = (of) =>
+    parts.map((phase) =>
+      phase.map((chart) => {
+        const r = new Array(chart.length + 1).fill(0);
+        for (let d = chart.length - 1; d >= 0; d--) r[d] = Math.max(of(chart[d]), r[d + 1]);
+        return r;
+      }),
+    );
+  /** @param {number[][][]} own */
+  const descendants = (own) => {
+    const below = charts.map((n) => new Array(n).fill(0));
+    for (let p = phases - 2; p >= 0; p--) {
+      for (let k = 0; k < charts[p]; k++) {
+        for (let c = children[p][k][0]; c < children[p][k][1]; c++) below[p][k] = Math.max(below[p][k], own[p + 1][c][0], below[p + 1][c]);
+      }
     }
-  }
-  return { phases, firstLevel: index.first_level, phaseStart, batches, charts, parts, splits, children, own, below, batchesInOrder };
+    return below;
+  };
+  const own = suffixMax(refinementError);
+  const ownBound = suffixMax((part) => part.error);
+  const [below, belowBound] = [descendants(own), descendants(ownBound)];
+  return { phases, firstLevel: index.first_level, phaseStart, batches, charts, parts, splits, children, own, below, ownBound, belowBound, batchesInOrder };
 }
 
 /**
@@ -159,14 +173,14 @@ export function errorLeft(table, node) {
 
 /**
  * How far the surface still to come may lie from a shown chart's, in model
- * units, for occlusion (occlusion.js): twice the error it leaves, since
- * that is the largest of its parts still to come, not their sum (which the
+ * units, for occlusion (occlusion.js): twice the largest error of its
+ * parts still to come and its descendants', not their sum (which the
  * halving of errors from level to level keeps under twice it).
  * @param {NestedTable} table
  * @param {NodeState} node
  */
 export function occluderTolerance(table, node) {
-  return 2 * errorLeft(table, node);
+  return 2 * Math.max(table.ownBound[node.phase][node.chart][node.depth], table.belowBound[node.phase][node.chart]);
 }
 
 /**
@@ -181,7 +195,7 @@ export function occluderTolerance(table, node) {
  * @returns {import('./part-selection.js').Sphere}
  */
 export function occlusionSphere(table, node) {
-  const drift = table.parts[node.phase][node.chart].reduce((e, part) => e + part.error, 0) + 2 * table.below[node.phase][node.chart];
+  const drift = table.parts[node.phase][node.chart].reduce((e, part) => e + part.error, 0) + 2 * table.belowBound[node.phase][node.chart];
   return { centre: node.sphere.centre, radius: node.sphere.radius + drift };
 }
 

@@ -32,7 +32,7 @@ const OCCLUSION = { gap: 4, maxTriangles: 4_000_000 };
  * @property {number} level the finest level a chart reached (the union's, as posted)
  * @property {number} resident vertices held, all charts together
  * @property {number} budget
- * @property {number} bytesFetched payload bytes of this load: base, global batches, part index, head and parts
+ * @property {number} bytesFetched bytes of this load as the network carried them: base, global batches, part index (compressed), head and parts
  * @property {boolean[]} visible per chart, in view: in the frustum, not facing away, not hidden behind the charts shown
  * @property {number} inFlight parts on their way
  * @property {boolean} settled nothing on its way and nothing more wanted for the last camera

@@ -7,15 +7,36 @@
  * worker, test/part-selection.test.mjs in Node.
  *
  * A part's `error` is the largest distance, in model units, from a vertex
- * it inserts to the chart's coarser surface. On screen that is
- * error / distance × pixels per radian; a chart is refined while the
- * largest error of the parts it has not applied yet is above
- * {@link SCREEN_ERROR_PX} (the largest, not the next one's: a chart may sit
- * a batch out with an empty part, error 0, and refine again after it).
+ * it inserts to the chart's coarser surface, and its `bulk_error` the
+ * distance 90 % of them lie within. On screen an error is
+ * error / distance × pixels per radian. A chart is refined by its parts'
+ * refinement errors ({@link refinementError}: the bulk, or the largest
+ * over {@link LARGEST_SPREAD}), while the largest of those of the parts it
+ * has not applied yet is above {@link SCREEN_ERROR_PX} (the largest, not
+ * the next one's: a chart may sit a batch out with an empty part, error 0,
+ * and refine again after it). Occlusion keeps the largest errors: a bound.
  */
 
 /** A chart refines while its remaining error on screen is above this many pixels. */
 export const SCREEN_ERROR_PX = 1;
+
+/**
+ * How many times {@link SCREEN_ERROR_PX} a part's largest error may be on
+ * screen once its bulk is under it: a scan's noisiest vertices stay out of
+ * the refinement, a feature a few vertices carry (a spike, a thin ridge)
+ * does not.
+ */
+export const LARGEST_SPREAD = 4;
+
+/**
+ * The error a part is refined by, in model units: its bulk error, or its
+ * largest over {@link LARGEST_SPREAD} where that is more (an index measured
+ * before bulk errors sends the largest as both: refined by it, as then).
+ * @param {{ error: number, bulk_error?: number }} part
+ */
+export function refinementError(part) {
+  return Math.max(part.bulk_error ?? part.error, part.error / LARGEST_SPREAD);
+}
 
 /** Parts requested at once, at most. */
 export const PARTS_IN_FLIGHT = 3;
@@ -220,13 +241,14 @@ export function byLeastNeeded(a, b) {
  * @property {number} first_level the first parted batch's level
  * @property {string} head_url
  * @property {string} part_url with `{level}` and `{chart}`
- * @property {{ level: number, chart: number, bytes: number, inserted: number, error: number }[]} parts
+ * @property {{ level: number, chart: number, bytes: number, inserted: number, error: number, bulk_error?: number }[]} parts
  */
 
 /**
  * The index by chart and depth: `table[chart][depth]` is the part that
- * takes the chart from depth to depth + 1, and `remaining[chart][depth]`
- * the largest error of that part and every later one of the chart.
+ * takes the chart from depth to depth + 1, `remaining[chart][depth]` the
+ * largest refinement error of that part and every later one of the chart,
+ * `bound[chart][depth]` the largest error (for occlusion).
  * @param {PartIndex} index
  */
 export function partTable(index) {
@@ -237,12 +259,14 @@ export function partTable(index) {
   for (const [chart, parts] of table.entries()) {
     for (let d = 0; d < depths; d++) if (!parts[d]) throw new Error(`the part index has no part for chart ${chart} at level ${index.first_level + d}`);
   }
-  const remaining = table.map((parts) => {
-    const r = new Array(depths + 1).fill(0);
-    for (let d = depths - 1; d >= 0; d--) r[d] = Math.max(parts[d].error, r[d + 1]);
-    return r;
-  });
-  return { table, remaining, finalDepth: depths };
+  /** @param {(part: PartIndex['parts'][number]) => number} of */
+  const suffixMax = (of) =>
+    table.map((parts) => {
+      const r = new Array(depths + 1).fill(0);
+      for (let d = depths - 1; d >= 0; d--) r[d] = Math.max(of(parts[d]), r[d + 1]);
+      return r;
+    });
+  return { table, remaining: suffixMax(refinementError), bound: suffixMax((p) => p.error), finalDepth: depths };
 }
 
 /**
@@ -265,7 +289,7 @@ export function partTable(index) {
  * @param {number} depth
  */
 export function occluderTolerance(parts, chart, depth) {
-  return 2 * parts.remaining[chart][depth];
+  return 2 * parts.bound[chart][depth];
 }
 
 /**

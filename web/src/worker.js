@@ -44,6 +44,20 @@ let job = null;
 let parts = null;
 /** The camera sent before the refinement started. @type {import('./part-selection.js').PartCamera | null} */
 let partCamera = null;
+/**
+ * The body bytes the network carried for the last fetch of `address`, by
+ * its resource timing (compressed, where the service compressed it); null
+ * where the browser keeps no such entry.
+ * @param {string} address
+ * @returns {number | null}
+ */
+function carriedBytes(address) {
+  if (typeof location === 'undefined' || typeof performance?.getEntriesByName !== 'function') return null;
+  const entries = /** @type {PerformanceResourceTiming[]} */ (performance.getEntriesByName(new URL(address, location.href).href, 'resource'));
+  const last = entries.at(-1);
+  return last && last.encodedBodySize > 0 ? last.encodedBodySize : null;
+}
+
 /** Bumped by every load, so a load still starting (or fetching its part index) gives up. */
 let loads = 0;
 /** The cap of a parted load (null: none), which 'extend' raises or lowers. @type {number | null} */
@@ -196,6 +210,9 @@ async function loadParted(codec, request, load) {
     const fetched = await payload(options.indexUrl, 'part index');
     if (!('bytes' in fetched)) throw new Error('the server refused the part index');
     index = JSON.parse(new TextDecoder().decode(fetched.bytes));
+    // JSON the service compresses: counted as the network carried it.
+    const carried = carriedBytes(options.indexUrl);
+    if (carried !== null) bytes += carried - fetched.bytes.length;
   } catch (error) {
     post({ type: 'error', kind: 'network', level: -1, message: error instanceof Error ? error.message : String(error) }, []);
     return;

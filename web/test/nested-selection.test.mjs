@@ -55,6 +55,26 @@ test('the index as a tree', () => {
   assert.equal(nextStep(t, { ...node, phase: 1, chart: 3 }), null, 'a leaf at its final depth');
 });
 
+test('charts refine by their parts\' bulk error; their largest bounds occlusion and still refines a feature', () => {
+  // Noise: each part's largest error twice its bulk. A feature: phase 1's
+  // chart 3 has one vertex far out at level 6, its bulk tiny.
+  const noisy = index();
+  for (const p of noisy.parts) {
+    p.bulk_error = p.error / 2;
+    if (p.phase === 1 && p.chart === 3 && p.level === 6) [p.error, p.bulk_error] = [0.8, 0.01];
+  }
+  const t = nestedTable(noisy);
+  assert.deepEqual(t.own[0][0], [0.2, 0.1, 0], 'the bulk, where the largest is within 4 times it');
+  assert.deepEqual(t.ownBound[0][0], [0.4, 0.2, 0]);
+  assert.deepEqual(t.below[0], [0.05, 0.2], 'the feature refines by a quarter of its largest');
+  assert.deepEqual(t.belowBound[0], [0.1, 0.8]);
+  const node = { phase: 0, chart: 0, depth: 2, sphere: { centre: /** @type {[number, number, number]} */ ([0, 0, 0]), radius: 1 }, expanded: false, vertices: 100 };
+  assert.equal(errorLeft(t, node), 0.05);
+  assert.equal(occluderTolerance(t, node), 0.2, 'twice the largest left, not the bulk');
+  // An index measured before bulk errors refines by the largest, as then.
+  assert.deepEqual(nestedTable(index()).own, nestedTable(index()).ownBound);
+});
+
 test('the shown charts in view step, nearest and largest error first, not past the cap', () => {
   const t = nestedTable(index());
   /** @param {number} chart @param {number} z @param {number} depth */

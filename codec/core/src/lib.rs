@@ -56,7 +56,7 @@ pub use mesh::IndexedMesh;
 pub use meter::PassBits;
 pub use parts::{
     nested_part_table, part_table, NestedLayout, NestedPartTable, NestedSummary, PartRecord,
-    PartedLayout, SplitRecord,
+    PartedLayout, SplitRecord, BULK_SHARE,
 };
 pub use quantize::Quantization;
 

@@ -5,7 +5,7 @@
 
 use vitrine_codec::{
     encode, nested_part_table, part_table, Charts, Decoder, EncodeOptions, IndexedMesh, Limits,
-    NestedLayout, StreamIndex,
+    NestedLayout, StreamIndex, BULK_SHARE,
 };
 use vitrine_samples::{add_noise, punch_holes, torus};
 
@@ -151,8 +151,11 @@ fn each_nested_parts_error_bounds_the_whole_decoders_refinement() {
                 assert!(q[..old.len()] == old[..] && !faces.is_empty());
                 let point = |v: u32| q[v as usize].map(f64::from);
                 // The nearest coarse face anywhere is no farther than the
-                // nearest among the faces the vertex replaced.
-                for v in (old.len()..q.len()).step_by(5) {
+                // nearest among the faces the vertex replaced: every vertex
+                // within the part's error, and 90 % within its bulk error.
+                assert!(record.bulk_error_steps <= record.error_steps, "{record:?}");
+                let mut within_bulk = 0;
+                for v in old.len()..q.len() {
                     let nearest = old_faces
                         .chunks_exact(3)
                         .map(|t| distance(point(v as u32), [point(t[0]), point(t[1]), point(t[2])]))
@@ -161,8 +164,15 @@ fn each_nested_parts_error_bounds_the_whole_decoders_refinement() {
                         nearest <= f64::from(record.error_steps) + 1e-9,
                         "{record:?}: vertex {v} lies {nearest} from the coarser chart"
                     );
+                    within_bulk +=
+                        usize::from(nearest <= f64::from(record.bulk_error_steps) + 1e-9);
                     checked += 1;
                 }
+                let inserted = q.len() - old.len();
+                assert!(
+                    within_bulk as f64 >= BULK_SHARE * inserted as f64,
+                    "{record:?}: {within_bulk} of {inserted} within the bulk error"
+                );
             }
         }
         charts = after;

@@ -34,6 +34,7 @@ pub fn models_table(models: &[ModelSummary]) -> (String, usize) {
     let mut stale = 0;
     let mut unlicensed = 0;
     let mut partless = 0;
+    let mut unmeasured = 0;
     for m in models {
         let charted = m.kind == ModelKind::Mesh
             && (m.stream_format == CHARTED_VERSION || m.stream_format == NESTED_VERSION);
@@ -41,6 +42,13 @@ pub fn models_table(models: &[ModelSummary]) -> (String, usize) {
             partless += 1;
             format!(
                 "{} (no part index: ingest it again to refine where visitors look)",
+                m.stream_format
+            )
+        } else if charted && m.parts_lack_bulk_error {
+            unmeasured += 1;
+            format!(
+                "{} (parts without a bulk error: ingest it again so visitors' \
+                 viewers refine by it, not by each part's noisiest vertex)",
                 m.stream_format
             )
         } else if m.servable() {
@@ -71,7 +79,8 @@ pub fn models_table(models: &[ModelSummary]) -> (String, usize) {
         out,
         "{} model(s); {stale} stored in a stream format this build cannot serve; \
          {unlicensed} public without a stated licence; \
-         {partless} charted without a part index",
+         {partless} charted without a part index; \
+         {unmeasured} with parts measured before their bulk error",
         models.len()
     );
     (out, stale)

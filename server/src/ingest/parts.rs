@@ -45,6 +45,7 @@ pub(super) async fn measure(
                 bytes: narrow(p.bytes.len(), "size")?,
                 inserted: narrow(p.inserted, "vertex count")?,
                 error: f64::from(p.error_steps) * step,
+                bulk_error: Some(f64::from(p.bulk_error_steps) * step),
                 phase: narrow(p.phase, "phase")?,
                 parent: p.parent.map(|k| narrow(k, "parent")).transpose()?,
             })

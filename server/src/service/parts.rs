@@ -143,8 +143,12 @@ struct PartEntry {
     inserted: u32,
     /// The largest distance, in model units, from a vertex it inserts to
     /// the chart's coarser surface: divided by the distance to the camera
-    /// and times the view's pixels per radian, the pixels it changes.
+    /// and times the view's pixels per radian, the pixels it changes at
+    /// most: the bound occlusion needs.
     error: f64,
+    /// The distance within which 90 % of those vertices lie (`error` for a
+    /// part measured before it was): what the viewer refines by.
+    bulk_error: f64,
 }
 
 /// The index of a charted stream's parts.
@@ -229,6 +233,7 @@ fn part_index(id: i64, nested: bool, stored: &PartRows) -> Result<PartIndex, App
                 bytes: p.bytes,
                 inserted: p.inserted,
                 error: p.error,
+                bulk_error: p.bulk_error.unwrap_or(p.error),
             })
             .collect(),
         split_url: nested

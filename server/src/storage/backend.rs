@@ -249,6 +249,9 @@ macro_rules! sql_storage {
                             has_thumbnail: row.try_get("has_thumbnail").map_err(c)?,
                             licence: row.try_get("licence").map_err(c)?,
                             has_parts: row.try_get("has_parts").map_err(c)?,
+                            parts_lack_bulk_error: row
+                                .try_get("parts_lack_bulk_error")
+                                .map_err(c)?,
                         })
                     })
                     .collect()
@@ -311,6 +314,7 @@ macro_rules! sql_storage {
                             bytes: int("byte_len")?,
                             inserted: int("inserted")?,
                             error: row.try_get("error").map_err(c)?,
+                            bulk_error: row.try_get("bulk_error").map_err(c)?,
                             phase: int("phase")?,
                             parent: row
                                 .try_get::<Option<i64>, _>("parent")

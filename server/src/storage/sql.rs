@@ -42,7 +42,8 @@ pub(super) const TEXTURES: &str = "SELECT t.id, t.kind, t.media_type, t.byte_len
      WHERE tm.id = $1 ORDER BY t.id";
 pub(super) const LIST: &str = "SELECT m.slug, m.title, m.version, m.kind, m.created_at, p.public_access, c.batch_count, c.codec_version, m.licence, m.language, \
      (th.model_id IS NOT NULL) AS has_thumbnail, \
-     EXISTS (SELECT 1 FROM stream_part sp WHERE sp.compression_id = c.id) AS has_parts \
+     EXISTS (SELECT 1 FROM stream_part sp WHERE sp.compression_id = c.id) AS has_parts, \
+     EXISTS (SELECT 1 FROM stream_part sp WHERE sp.compression_id = c.id AND sp.bulk_error IS NULL) AS parts_lack_bulk_error \
      FROM model m JOIN audience_policy p ON p.id = m.policy_id JOIN compression c ON c.model_id = m.id \
      LEFT JOIN thumbnail th ON th.model_id = m.id \
      WHERE m.status = 'ready' \
@@ -86,10 +87,10 @@ pub(super) const INSERT_MAPPING: &str = "INSERT INTO texture_mapping \
      (model_id, cell_texture_id, colour_texture_id, colour_low_texture_id, parameters, created_at) \
      VALUES ($1, $2, $3, $4, $5, $6) RETURNING id";
 pub(super) const INSERT_PART: &str = "INSERT INTO stream_part \
-     (compression_id, iteration, chart, byte_len, inserted, error, phase, parent) \
-     VALUES ($1, $2, $3, $4, $5, $6, $7, $8)";
+     (compression_id, iteration, chart, byte_len, inserted, error, bulk_error, phase, parent) \
+     VALUES ($1, $2, $3, $4, $5, $6, $7, $8, $9)";
 pub(super) const PARTS: &str =
-    "SELECT iteration, chart, byte_len, inserted, error, phase, parent FROM stream_part \
+    "SELECT iteration, chart, byte_len, inserted, error, bulk_error, phase, parent FROM stream_part \
      WHERE compression_id = $1 ORDER BY iteration, chart";
 pub(super) const INSERT_SPLIT: &str = "INSERT INTO stream_split \
      (compression_id, iteration, parent, first_child, children, byte_len) \

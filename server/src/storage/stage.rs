@@ -148,6 +148,7 @@ macro_rules! stage_body {
                 .bind(i64::from(part.bytes))
                 .bind(i64::from(part.inserted))
                 .bind(part.error)
+                .bind(part.bulk_error)
                 .bind(i64::from(part.phase))
                 .bind(part.parent.map(i64::from))
                 .execute(&mut *$tx)

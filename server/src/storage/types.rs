@@ -223,6 +223,10 @@ pub struct ModelSummary {
     /// before they were has none, and streams whole batches only.
     #[serde(skip)]
     pub has_parts: bool,
+    /// Some of its parts were measured before their bulk error was: the
+    /// viewer refines them by their largest (ingest it again).
+    #[serde(skip)]
+    pub parts_lack_bulk_error: bool,
     /// The BCP 47 tag of `title`, when stated.
     #[serde(skip)]
     pub language: Option<String>,
@@ -415,8 +419,12 @@ pub struct PartRecord {
     /// Vertices it inserts (0: the chart sits this batch out).
     pub inserted: u32,
     /// The largest distance, in model units, from a vertex it inserts to
-    /// the chart's coarser surface: what a viewer turns into screen pixels.
+    /// the chart's coarser surface: the bound occlusion needs.
     pub error: f64,
+    /// The distance, in model units, within which 90 % of those vertices
+    /// lie (`vitrine_codec::BULK_SHARE`): what a viewer refines by. `None`
+    /// for a part measured before it was (the service sends `error`).
+    pub bulk_error: Option<f64>,
     /// The chart's phase: 0 in a charted stream (format 5) and for a
     /// nested stream's top charts (format 6).
     pub phase: u32,

@@ -48,7 +48,9 @@ pub async fn nested_parts_served_under_caps(db: TestDb) {
     let (listing, stale) = vitrine::models_table(&db.storage.list_models().await.unwrap());
     assert_eq!(stale, 0, "{listing}");
     assert!(
-        listing.ends_with("; 0 charted without a part index"),
+        listing.ends_with(
+            "; 0 charted without a part index; 0 with parts measured before their bulk error"
+        ),
         "{listing}"
     );
 
@@ -79,6 +81,9 @@ pub async fn nested_parts_served_under_caps(db: TestDb) {
         assert_eq!(entry["inserted"], record.inserted);
         let error = entry["error"].as_f64().unwrap();
         assert!((error - f64::from(record.error_steps) * step).abs() <= 1e-9 * error.max(1.0));
+        let bulk = entry["bulk_error"].as_f64().unwrap();
+        assert!((bulk - f64::from(record.bulk_error_steps) * step).abs() <= 1e-9 * bulk.max(1.0));
+        assert!(bulk <= error, "{entry}");
     }
     let splits = index["splits"].as_array().unwrap();
     assert_eq!(splits.len(), table.splits.len());
@@ -203,5 +208,21 @@ pub async fn nested_parts_served_under_caps(db: TestDb) {
             get(&app, &split_url(1, 0), &[]).await.status,
             StatusCode::NOT_FOUND
         );
+    }
+
+    // Parts measured before their bulk error was (the column empty): the
+    // listing names both models, and a service started afresh sends each
+    // part's largest error as its bulk, so a viewer refines by it as then.
+    db.execute("UPDATE stream_part SET bulk_error = NULL").await;
+    let (listing, _) = vitrine::models_table(&db.storage.list_models().await.unwrap());
+    assert!(
+        listing.ends_with("; 2 with parts measured before their bulk error"),
+        "{listing}"
+    );
+    assert!(listing.contains("parts without a bulk error"), "{listing}");
+    let fresh = vitrine::app(AppState::new(db.storage.clone(), test_config()));
+    let index = get(&fresh, &url, &[]).await.json();
+    for entry in index["parts"].as_array().unwrap() {
+        assert_eq!(entry["bulk_error"], entry["error"], "{entry}");
     }
 }

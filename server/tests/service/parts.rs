@@ -46,7 +46,9 @@ pub async fn parts_served_under_caps(db: TestDb) {
     let app = app(AppState::new(db.storage.clone(), test_config()));
     let (table, _) = vitrine::models_table(&db.storage.list_models().await.unwrap());
     assert!(
-        table.ends_with("; 0 charted without a part index"),
+        table.ends_with(
+            "; 0 charted without a part index; 0 with parts measured before their bulk error"
+        ),
         "{table}"
     );
 
@@ -79,6 +81,9 @@ pub async fn parts_served_under_caps(db: TestDb) {
         assert_eq!(entry["inserted"], record.inserted);
         let error = entry["error"].as_f64().unwrap();
         assert!((error - f64::from(record.error_steps) * step).abs() <= 1e-9 * error.max(1.0));
+        let bulk = entry["bulk_error"].as_f64().unwrap();
+        assert!((bulk - f64::from(record.bulk_error_steps) * step).abs() <= 1e-9 * bulk.max(1.0));
+        assert!(bulk <= error, "{entry}");
     }
 
     // Every part as served is the stream's bytes, revalidated without them.

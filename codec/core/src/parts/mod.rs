@@ -11,6 +11,7 @@ use std::ops::Range;
 
 use crate::format::{ChunkHeader, Reader, BATCH_TAG, NESTED_VERSION, PARTED_TAG};
 use crate::{Error, Result};
+pub use error::BULK_SHARE;
 pub use nested_table::{nested_part_table, NestedPartTable, SplitRecord};
 pub use table::{part_table, PartRecord};
 

@@ -126,7 +126,8 @@ fn measure(view: &mut NestedView, phase: usize, chart: usize, part: &[u8]) -> Re
         chart,
         bytes: 0..0,
         inserted: after.quantized.len() - before_vertices,
-        error_steps: error.ceil() as u32,
+        error_steps: error.largest.ceil() as u32,
+        bulk_error_steps: error.bulk.ceil() as u32,
         phase,
         parent: view.parent(phase, chart),
     })

@@ -24,6 +24,10 @@ pub struct PartRecord {
     /// it inserts to the chart's coarser surface (× the stream's step:
     /// model units).
     pub error_steps: u32,
+    /// The distance, in quantization steps rounded up, within which
+    /// [`super::BULK_SHARE`] of those vertices lie: what a viewer refines by
+    /// (`error_steps` bounds it).
+    pub bulk_error_steps: u32,
     /// Its chart's phase: 0 in a charted stream (format 5) and for a nested
     /// stream's top charts (format 6).
     pub phase: usize,
@@ -78,7 +82,8 @@ pub fn part_table(stream: &[u8], limits: Limits) -> Result<Vec<PartRecord>> {
                 chart,
                 bytes: range.start + part.start..range.start + part.end,
                 inserted: after.quantized.len() - before_vertices,
-                error_steps: error.ceil() as u32,
+                error_steps: error.largest.ceil() as u32,
+                bulk_error_steps: error.bulk.ceil() as u32,
                 phase: 0,
                 parent: None,
             });
