@@ -13,11 +13,21 @@
 //! cells, a cell usually holds one point, and which child holds it is
 //! predictable only across the surface, from where the neighbours put it.
 
+use super::surface::{Surface, CLASSES};
+
 /// Context classes where a cell has a known neighbour: the child's index
 /// (8) × bits set so far in the mask (0, 1, 2+) × the child's distance
 /// class from the neighbourhood's plane (5) × the child's coded face
 /// neighbours (8) × occupied parent neighbours on the child's sides (0..=3).
 pub(crate) const CONTEXTS: usize = 8 * 3 * 5 * 8 * 4;
+
+/// Version 3's plane classes: version 2's (0: no plane fitted, 1..=4),
+/// then, where no plane was fitted, 4 + the class of the child's distance
+/// from the plane its cell inherited (`surface.rs`, 1..=5).
+pub(crate) const PLANES_V3: usize = 5 + CLASSES - 1;
+
+/// Version 3's context classes: version 2's with `PLANES_V3` plane classes.
+pub(crate) const CONTEXTS_V3: usize = 8 * 3 * PLANES_V3 * 8 * 4;
 
 /// What is known around one cell when its children are coded
 /// (`Neighbourhood::around` in `neighbourhood.rs`).
@@ -32,6 +42,8 @@ pub(crate) struct Around {
     pub minus_edge: bool,
     /// Each child's distance class from the block's plane (`Block`).
     pub plane: [u8; 8],
+    /// Version 3: the block's plane (`surface.rs`), where one was fitted.
+    pub surface: Surface,
 }
 
 /// The occupied cells of a 3×3×3 block: count and moments of their offsets
@@ -70,9 +82,41 @@ impl Block {
     /// (so the normal is never shifted: 2^24 is its threshold), Σ F_ij² <
     /// 2^40, |t| < 3 · 2^19 · 63 < 2^27 and 4t² < 2^56.
     pub fn plane_bins(&self) -> [u8; 8] {
+        let Some((normal, len2)) = self.normal() else {
+            return [0; 8];
+        };
+        let n = self.count + 1;
+        let [s0, s1, s2] = self.sum;
+        debug_assert!(normal.iter().all(|v| v.abs() < 1 << 24), "never shifted");
+        // 4n × (child centre − centroid) · normal, in parent cells:
+        // Σ_a normal_a (±n − 4 S_a); child 7 − k has the opposite signs.
+        let [q0, q1, q2] = normal.map(|v| v * n);
+        let centroid = 4 * (normal[0] * s0 + normal[1] * s1 + normal[2] * s2);
+        // |dist| / (4n |normal|) against e/8: 4 dist² vs e² n² |normal|².
+        let unit = n * n * len2;
+        let class = |dist: i64| {
+            let lhs = 4 * dist * dist;
+            1 + u8::from(lhs >= unit) + u8::from(lhs >= 4 * unit) + u8::from(lhs >= 9 * unit)
+        };
+        let mut bins = [0u8; 8];
+        for (k, side) in [-q0 - q1 - q2, q0 - q1 - q2, -q0 + q1 - q2, q0 + q1 - q2]
+            .into_iter()
+            .enumerate()
+        {
+            bins[k] = class(side - centroid);
+            bins[7 - k] = class(-side - centroid);
+        }
+        bins
+    }
+
+    /// The normal of the plane fitted to the block's cells (the centre's
+    /// included) and its squared length, unnormalized (components below
+    /// 2^19, see [`plane_bins`](Self::plane_bins)); `None` with fewer
+    /// than 3 other cells or all of them on one line.
+    pub fn normal(&self) -> Option<([i64; 3], i64)> {
         let n = self.count + 1;
         if self.count < 3 {
-            return [0; 8];
+            return None;
         }
         debug_assert!(self.count <= 26);
         let [s0, s1, s2] = self.sum;
@@ -106,29 +150,7 @@ impl Block {
         } else {
             ([f00, f01, f02], l0)
         };
-        if len2 == 0 {
-            return [0; 8];
-        }
-        debug_assert!(normal.iter().all(|v| v.abs() < 1 << 24), "never shifted");
-        // 4n × (child centre − centroid) · normal, in parent cells:
-        // Σ_a normal_a (±n − 4 S_a); child 7 − k has the opposite signs.
-        let [q0, q1, q2] = normal.map(|v| v * n);
-        let centroid = 4 * (normal[0] * s0 + normal[1] * s1 + normal[2] * s2);
-        // |dist| / (4n |normal|) against e/8: 4 dist² vs e² n² |normal|².
-        let unit = n * n * len2;
-        let class = |dist: i64| {
-            let lhs = 4 * dist * dist;
-            1 + u8::from(lhs >= unit) + u8::from(lhs >= 4 * unit) + u8::from(lhs >= 9 * unit)
-        };
-        let mut bins = [0u8; 8];
-        for (k, side) in [-q0 - q1 - q2, q0 - q1 - q2, -q0 + q1 - q2, q0 + q1 - q2]
-            .into_iter()
-            .enumerate()
-        {
-            bins[k] = class(side - centroid);
-            bins[7 - k] = class(-side - centroid);
-        }
-        bins
+        (len2 != 0).then_some((normal, len2))
     }
 }
 
@@ -166,6 +188,24 @@ impl Around {
     /// on its low sides (from the −e_a neighbours' masks). Child k's
     /// context is `contexts()[k] + CODED[k][so_far]`.
     pub fn contexts(&self) -> [u16; 8] {
+        self.contexts_with(self.plane, 5)
+    }
+
+    /// Version 3's [`contexts`](Self::contexts): where no plane was fitted,
+    /// the classes of the plane the cell inherited (`inherited`, 0: none)
+    /// take the place of class 0. Child k's context is
+    /// `contexts_v3(..)[k] + CODED_V3[k][so_far]`.
+    pub fn contexts_v3(&self, inherited: [u8; 8]) -> [u16; 8] {
+        let mut plane = self.plane;
+        if plane[0] == 0 {
+            for (p, &c) in plane.iter_mut().zip(&inherited) {
+                *p = if c == 0 { 0 } else { 4 + c };
+            }
+        }
+        self.contexts_with(plane, PLANES_V3 as u16)
+    }
+
+    fn contexts_with(&self, plane: [u8; 8], planes: u16) -> [u16; 8] {
         // Byte k: child k's near faces; its face bits from the −e_a
         // neighbours' masks (for the k on the low side of axis a: bit
         // k + 2^a of minus[a]).
@@ -178,7 +218,7 @@ impl Around {
                 (near >> (8 * k)) as u16 & 0xFF,
                 (face >> (8 * k)) as u16 & 0xFF,
             );
-            *c = (k as u16 * 15 + u16::from(self.plane[k])) * 32 + face * 4 + near;
+            *c = (k as u16 * 3 * planes + u16::from(plane[k])) * 32 + face * 4 + near;
         }
         c
     }
@@ -225,7 +265,12 @@ const HIGH: [u8; 3] = [0xAA, 0xCC, 0xF0];
 /// The part of child k's context that the mask's bits below k
 /// (`so_far`) give: the bits set (0, 1, 2+) and the face bits on its high
 /// sides (its siblings at −e_a).
-pub(crate) static CODED: [[u16; 256]; 8] = {
+pub(crate) static CODED: [[u16; 256]; 8] = coded(5);
+
+/// `CODED` for version 3's `PLANES_V3` plane classes.
+pub(crate) static CODED_V3: [[u16; 256]; 8] = coded(PLANES_V3);
+
+const fn coded(planes: usize) -> [[u16; 256]; 8] {
     let mut t = [[0; 256]; 8];
     let mut k = 0;
     while k < 8 {
@@ -244,13 +289,13 @@ pub(crate) static CODED: [[u16; 256]; 8] = {
                 }
                 a += 1;
             }
-            t[k][so_far] = (set as usize * 160 + face * 4) as u16;
+            t[k][so_far] = (set as usize * planes * 32 + face * 4) as u16;
             so_far += 1;
         }
         k += 1;
     }
     t
-};
+}
 
 /// Morton key: x, y, z bits interleaved, x lowest.
 pub(crate) fn morton(q: [u32; 3]) -> u64 {
@@ -280,6 +325,7 @@ mod tests {
                 minus: [(r >> 8) as u8, (r >> 16) as u8, (r >> 24) as u8],
                 minus_edge: r >> 32 & 1 == 1,
                 plane: [0; 8].map(|_| (crate::testing::next(&mut s) % 5) as u8),
+                ..Default::default()
             };
             let parts = around.contexts();
             for k in 0..8u32 {

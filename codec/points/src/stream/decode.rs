@@ -7,6 +7,7 @@ use super::attr::octahedral_decode;
 use super::format::{read_chunk, PointHeader};
 use super::models::{root_prediction, Attr, Models};
 use super::neighbourhood::Neighbourhood;
+use super::surface::Surface;
 use crate::PointCloud;
 
 /// Budgets for decoding untrusted streams.
@@ -36,6 +37,8 @@ struct Cell {
     rep: u32,
     /// Parent's child count − 1.
     class: u8,
+    /// Version 3: the plane it inherits.
+    surface: Surface,
 }
 
 /// Decodes a stream level by level; after each level it holds every point
@@ -77,10 +80,15 @@ impl PointDecoder {
             )));
         }
         let models = Models::new(header.has_normals(), header.has_colours);
+        let neighbourhood = if header.version >= 3 {
+            Neighbourhood::with_surfaces()
+        } else {
+            Neighbourhood::default()
+        };
         Ok(PointDecoder {
             header,
             models,
-            neighbourhood: Neighbourhood::default(),
+            neighbourhood,
             level: 0,
             depth: 0,
             cells: Vec::new(),
@@ -196,13 +204,15 @@ impl PointDecoder {
                 at: [0; 3],
                 rep,
                 class: 7,
+                surface: Surface::default(),
             });
         }
         let last = self.header.level_depths[self.level];
         while self.depth < last {
             let cells = std::mem::take(&mut self.cells);
             let mut next = Vec::with_capacity(cells.len().min(count as usize));
-            let v2 = self.header.version >= 2;
+            let version = self.header.version;
+            let v2 = version >= 2;
             if v2 {
                 let depth = u32::from(self.depth);
                 self.neighbourhood
@@ -210,7 +220,19 @@ impl PointDecoder {
             }
             for cell in &cells {
                 dec.check_overrun()?;
-                let mask = if v2 {
+                let mut surface = cell.surface;
+                let mask = if version >= 3 {
+                    let around = self.neighbourhood.around(cell.at);
+                    let inherited = cell.surface.classes();
+                    let mask = self
+                        .models
+                        .decode_mask_v3(&mut dec, &around, inherited, cell.class);
+                    self.neighbourhood.record(mask);
+                    if around.surface.is_known() {
+                        surface = around.surface;
+                    }
+                    mask
+                } else if v2 {
                     let around = self.neighbourhood.around(cell.at);
                     let mask = self.models.decode_mask_v2(&mut dec, &around, cell.class);
                     self.neighbourhood.record(mask);
@@ -236,7 +258,12 @@ impl PointDecoder {
                     };
                     first = false;
                     let at = [0, 1, 2].map(|a| cell.at[a] * 2 + ((k >> a) & 1));
-                    next.push(Cell { at, rep, class });
+                    next.push(Cell {
+                        at,
+                        rep,
+                        class,
+                        surface: surface.child(k as usize),
+                    });
                 }
             }
             self.cells = next;

@@ -15,7 +15,7 @@ pub const MAGIC: [u8; 4] = *b"VPTS";
 pub const VERSION: u8 = 1;
 /// The format versions this crate reads and can write (they differ only in
 /// how child masks are coded, see `FORMAT.md`).
-pub const VERSIONS: std::ops::RangeInclusive<u8> = 1..=2;
+pub const VERSIONS: std::ops::RangeInclusive<u8> = 1..=3;
 
 /// Header flag: points carry normals.
 pub(crate) const FLAG_NORMALS: u8 = 1;

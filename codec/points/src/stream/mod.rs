@@ -25,6 +25,7 @@ mod format;
 mod models;
 mod neighbourhood;
 mod region;
+mod surface;
 
 pub use attr::{octahedral_decode, octahedral_encode};
 pub use decode::{decode, DecodedPoints, Limits, PointDecoder};

@@ -86,6 +86,9 @@ pub(crate) struct Neighbourhood {
     /// Whether the cells' neighbour lists are kept (not at the last depth
     /// whose masks are coded: nothing reads them).
     lists: bool,
+    /// Whether `around` fits the plane itself, not only its classes
+    /// (version 3).
+    surfaces: bool,
 }
 
 /// What a parent-level cell at `offset_code` from child k's parent gives
@@ -201,6 +204,14 @@ static SEEN_BY: [u8; 27] = {
 };
 
 impl Neighbourhood {
+    /// For version 3: [`around`](Self::around) also gives the fitted plane.
+    pub fn with_surfaces() -> Self {
+        Neighbourhood {
+            surfaces: true,
+            ..Default::default()
+        }
+    }
+
     /// Starts coding the masks of the cells at `depth` (the masks of
     /// depth − 1 were all recorded); `last`: no depth follows.
     pub fn start_depth(&mut self, depth: u32, last: bool) {
@@ -293,7 +304,7 @@ impl Neighbourhood {
         }
         self.side_count = n;
         self.k = k;
-        let mut r = describe(region, k);
+        let mut r = describe(region, k, self.surfaces);
         for (a, &j) in minus_parent[..3].iter().enumerate() {
             if r.faces >> (2 * a) & 1 == 1 {
                 // Child k ^ 2^a of the parent, or k | 2^a of the one at −e_a.

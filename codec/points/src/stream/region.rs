@@ -7,6 +7,7 @@
 //! plane's moments sums over its bytes of per-byte tables.
 
 use super::context::{Around, Block};
+use super::surface::Surface;
 
 /// Per child index k (the cell's corner in its parent): where its 3×3×3
 /// block lies in the 4×4×4 region (bit `8u + v`: child v of the region's
@@ -118,8 +119,8 @@ static MOMENTS: [[[u64; 2]; 256]; 8] = {
 };
 
 /// The contexts' inputs from the region around child `k`, but the masks of
-/// its −e_a neighbours.
-pub(super) fn describe(region: u64, k: usize) -> Around {
+/// its −e_a neighbours; with `surfaces`, the fitted plane as well.
+pub(super) fn describe(region: u64, k: usize, surfaces: bool) -> Around {
     let t = &TABLES[k];
     let mut r = Around::default();
     for (f, &bit) in t.faces.iter().enumerate() {
@@ -130,7 +131,11 @@ pub(super) fn describe(region: u64, k: usize) -> Around {
     let two = occupied & occupied.wrapping_sub(1);
     if two & two.wrapping_sub(1) != 0 {
         // At least 3 neighbours: a plane may be fitted.
-        r.plane = moments(occupied, k).plane_bins();
+        let block = moments(occupied, k);
+        r.plane = block.plane_bins();
+        if surfaces {
+            r.surface = Surface::fitted(&block);
+        }
     }
     r
 }
