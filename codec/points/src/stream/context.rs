@@ -13,18 +13,15 @@
 //! cells, a cell usually holds one point, and which child holds it is
 //! predictable only across the surface, from where the neighbours put it.
 
-use super::surface::{Surface, CLASSES};
-
 /// Context classes where a cell has a known neighbour: the child's index
 /// (8) × bits set so far in the mask (0, 1, 2+) × the child's distance
 /// class from the neighbourhood's plane (5) × the child's coded face
 /// neighbours (8) × occupied parent neighbours on the child's sides (0..=3).
 pub(crate) const CONTEXTS: usize = 8 * 3 * 5 * 8 * 4;
 
-/// Version 3's plane classes: version 2's (0: no plane fitted, 1..=4),
-/// then, where no plane was fitted, 4 + the class of the child's distance
-/// from the plane its cell inherited (`surface.rs`, 1..=5).
-pub(crate) const PLANES_V3: usize = 5 + CLASSES - 1;
+/// Version 3's plane classes: 0 (no plane), then 1 + the thresholds e/8,
+/// e = 1..=5, that the child's distance reaches.
+pub(crate) const PLANES_V3: usize = 7;
 
 /// Version 3's context classes: version 2's with `PLANES_V3` plane classes.
 pub(crate) const CONTEXTS_V3: usize = 8 * 3 * PLANES_V3 * 8 * 4;
@@ -42,8 +39,6 @@ pub(crate) struct Around {
     pub minus_edge: bool,
     /// Each child's distance class from the block's plane (`Block`).
     pub plane: [u8; 8],
-    /// Version 3: the block's plane (`surface.rs`), where one was fitted.
-    pub surface: Surface,
 }
 
 /// The occupied cells of a 3×3×3 block: count and moments of their offsets
@@ -85,9 +80,32 @@ impl Block {
         let Some((normal, len2)) = self.normal() else {
             return [0; 8];
         };
+        debug_assert!(normal.iter().all(|v| v.abs() < 1 << 24), "never shifted");
+        self.bins(normal, len2, 3)
+    }
+
+    /// Version 3: [`plane_bins`](Self::plane_bins) of up to 63 cells
+    /// (offsets in −2..=2), the normal shifted below 2^12 first: then
+    /// |t| < 3 · 2^12 · (64 + 4 · 126) < 2^23 and 4t² < 2^48.
+    pub fn plane_bins_wide(&self) -> [u8; 8] {
+        let Some((normal, _)) = self.normal() else {
+            return [0; 8];
+        };
+        let big = normal.iter().fold(0u64, |m, v| m.max(v.unsigned_abs()));
+        let shift = (64 - big.leading_zeros()).saturating_sub(12);
+        let normal = normal.map(|v| v >> shift);
+        let len2 = normal.iter().map(|v| v * v).sum::<i64>();
+        if len2 == 0 {
+            return [0; 8];
+        }
+        self.bins(normal, len2, PLANES_V3 as i64 - 2)
+    }
+
+    /// Classes 1 + the thresholds e/8 (e = 1..=`thresholds`) that the
+    /// child's distance reaches.
+    fn bins(&self, normal: [i64; 3], len2: i64, thresholds: i64) -> [u8; 8] {
         let n = self.count + 1;
         let [s0, s1, s2] = self.sum;
-        debug_assert!(normal.iter().all(|v| v.abs() < 1 << 24), "never shifted");
         // 4n × (child centre − centroid) · normal, in parent cells:
         // Σ_a normal_a (±n − 4 S_a); child 7 − k has the opposite signs.
         let [q0, q1, q2] = normal.map(|v| v * n);
@@ -96,7 +114,11 @@ impl Block {
         let unit = n * n * len2;
         let class = |dist: i64| {
             let lhs = 4 * dist * dist;
-            1 + u8::from(lhs >= unit) + u8::from(lhs >= 4 * unit) + u8::from(lhs >= 9 * unit)
+            let mut c = 1;
+            for e in 1..=thresholds {
+                c += u8::from(lhs >= e * e * unit);
+            }
+            c
         };
         let mut bins = [0u8; 8];
         for (k, side) in [-q0 - q1 - q2, q0 - q1 - q2, -q0 + q1 - q2, q0 + q1 - q2]
@@ -118,7 +140,7 @@ impl Block {
         if self.count < 3 {
             return None;
         }
-        debug_assert!(self.count <= 26);
+        debug_assert!(self.count <= 63);
         let [s0, s1, s2] = self.sum;
         let p = &self.products;
         // n² × the covariance; its adjugate's largest row is along the
@@ -137,6 +159,14 @@ impl Block {
         let f01 = c12 * c02 - c01 * c22;
         let f02 = c01 * c12 - c11 * c02;
         let f12 = c02 * c01 - c12 * c00;
+        // Up to 63 cells (`plane_bins_wide`) a cofactor may reach 2^31:
+        // shifted below 2^30 so that the rows' norms stay within 64 bits
+        // (never for the 3×3×3 block, whose cofactors stay below 2^19).
+        let big = [f00, f11, f22, f01, f02, f12]
+            .iter()
+            .fold(0u64, |m, v| m.max(v.unsigned_abs()));
+        let shift = (64 - big.leading_zeros()).saturating_sub(30);
+        let [f00, f11, f22, f01, f02, f12] = [f00, f11, f22, f01, f02, f12].map(|v| v >> shift);
         // The row with the largest norm, of equal ones the last.
         let (l0, l1, l2) = (
             f00 * f00 + f01 * f01 + f02 * f02,
@@ -191,18 +221,11 @@ impl Around {
         self.contexts_with(self.plane, 5)
     }
 
-    /// Version 3's [`contexts`](Self::contexts): where no plane was fitted,
-    /// the classes of the plane the cell inherited (`inherited`, 0: none)
-    /// take the place of class 0. Child k's context is
-    /// `contexts_v3(..)[k] + CODED_V3[k][so_far]`.
-    pub fn contexts_v3(&self, inherited: [u8; 8]) -> [u16; 8] {
-        let mut plane = self.plane;
-        if plane[0] == 0 {
-            for (p, &c) in plane.iter_mut().zip(&inherited) {
-                *p = if c == 0 { 0 } else { 4 + c };
-            }
-        }
-        self.contexts_with(plane, PLANES_V3 as u16)
+    /// Version 3's [`contexts`](Self::contexts) (`PLANES_V3` plane
+    /// classes); child k's context is `contexts_v3()[k] +
+    /// CODED_V3[k][so_far]`.
+    pub fn contexts_v3(&self) -> [u16; 8] {
+        self.contexts_with(self.plane, PLANES_V3 as u16)
     }
 
     fn contexts_with(&self, plane: [u8; 8], planes: u16) -> [u16; 8] {

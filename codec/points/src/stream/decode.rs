@@ -7,7 +7,6 @@ use super::attr::octahedral_decode;
 use super::format::{read_chunk, PointHeader};
 use super::models::{root_prediction, Attr, Models};
 use super::neighbourhood::Neighbourhood;
-use super::surface::Surface;
 use crate::PointCloud;
 
 /// Budgets for decoding untrusted streams.
@@ -37,8 +36,6 @@ struct Cell {
     rep: u32,
     /// Parent's child count − 1.
     class: u8,
-    /// Version 3: the plane it inherits.
-    surface: Surface,
 }
 
 /// Decodes a stream level by level; after each level it holds every point
@@ -81,7 +78,7 @@ impl PointDecoder {
         }
         let models = Models::new(header.has_normals(), header.has_colours);
         let neighbourhood = if header.version >= 3 {
-            Neighbourhood::with_surfaces()
+            Neighbourhood::wide()
         } else {
             Neighbourhood::default()
         };
@@ -204,15 +201,13 @@ impl PointDecoder {
                 at: [0; 3],
                 rep,
                 class: 7,
-                surface: Surface::default(),
             });
         }
         let last = self.header.level_depths[self.level];
         while self.depth < last {
             let cells = std::mem::take(&mut self.cells);
             let mut next = Vec::with_capacity(cells.len().min(count as usize));
-            let version = self.header.version;
-            let v2 = version >= 2;
+            let v2 = self.header.version >= 2;
             if v2 {
                 let depth = u32::from(self.depth);
                 self.neighbourhood
@@ -220,17 +215,10 @@ impl PointDecoder {
             }
             for cell in &cells {
                 dec.check_overrun()?;
-                let mut surface = cell.surface;
-                let mask = if version >= 3 {
+                let mask = if self.header.version >= 3 {
                     let around = self.neighbourhood.around(cell.at);
-                    let inherited = cell.surface.classes();
-                    let mask = self
-                        .models
-                        .decode_mask_v3(&mut dec, &around, inherited, cell.class);
+                    let mask = self.models.masks_v3.decode(&mut dec, &around, cell.class);
                     self.neighbourhood.record(mask);
-                    if around.surface.is_known() {
-                        surface = around.surface;
-                    }
                     mask
                 } else if v2 {
                     let around = self.neighbourhood.around(cell.at);
@@ -258,12 +246,7 @@ impl PointDecoder {
                     };
                     first = false;
                     let at = [0, 1, 2].map(|a| cell.at[a] * 2 + ((k >> a) & 1));
-                    next.push(Cell {
-                        at,
-                        rep,
-                        class,
-                        surface: surface.child(k as usize),
-                    });
+                    next.push(Cell { at, rep, class });
                 }
             }
             self.cells = next;

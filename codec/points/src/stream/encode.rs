@@ -8,7 +8,6 @@ use super::context::morton;
 use super::format::{PointHeader, MAX_BITS, VERSION, VERSIONS};
 use super::models::{root_prediction, Attr, Models};
 use super::neighbourhood::Neighbourhood;
-use super::surface::Surface;
 use crate::PointCloud;
 
 /// How to encode.
@@ -94,8 +93,6 @@ struct Cell {
     end: u32,
     /// Parent's child count − 1.
     class: u8,
-    /// Version 3: the plane it inherits.
-    surface: Surface,
 }
 
 /// Encodes a cloud (at least one point, finite) as a progressive stream.
@@ -181,7 +178,7 @@ pub fn encode(cloud: &PointCloud, opts: &EncodeOptions) -> Result<EncodedPoints>
     let mut models = Models::new(normals.is_some(), colours.is_some());
     let mut order: Vec<u32> = Vec::with_capacity(n);
     let mut neighbourhood = if header.version >= 3 {
-        Neighbourhood::with_surfaces()
+        Neighbourhood::wide()
     } else {
         Neighbourhood::default()
     };
@@ -190,7 +187,6 @@ pub fn encode(cloud: &PointCloud, opts: &EncodeOptions) -> Result<EncodedPoints>
         start: 0,
         end: n32,
         class: 7,
-        surface: Surface::default(),
     }];
     let mut chunks = Vec::new();
     let mut level_points = Vec::new();
@@ -208,8 +204,6 @@ pub fn encode(cloud: &PointCloud, opts: &EncodeOptions) -> Result<EncodedPoints>
             if header.version >= 2 {
                 neighbourhood.start_depth(depth, depth + 1 == b);
             }
-            let (mut dbg_known, mut dbg_empty, mut dbg_fit) = (0, 0, 0);
-            let dbg_start = enc.len_estimate();
             for cell in &cells {
                 let parent_rep = sorted[cell.start as usize].1;
                 let mut mask = 0u8;
@@ -225,18 +219,10 @@ pub fn encode(cloud: &PointCloud, opts: &EncodeOptions) -> Result<EncodedPoints>
                     children[k] = (s, e);
                     s = e;
                 }
-                let mut surface = cell.surface;
                 if header.version >= 3 {
                     let around = neighbourhood.around(cell.at);
-                    let inherited = cell.surface.classes();
-                    dbg_known += usize::from(cell.surface.is_known());
-                    dbg_empty += usize::from(around.is_empty());
-                    dbg_fit += usize::from(around.surface.is_known());
-                    models.encode_mask_v3(&mut enc, &around, inherited, cell.class, mask);
+                    models.masks_v3.encode(&mut enc, &around, cell.class, mask);
                     neighbourhood.record(mask);
-                    if around.surface.is_known() {
-                        surface = around.surface;
-                    }
                 } else if header.version >= 2 {
                     let around = neighbourhood.around(cell.at);
                     models.encode_mask_v2(&mut enc, &around, cell.class, mask);
@@ -263,12 +249,8 @@ pub fn encode(cloud: &PointCloud, opts: &EncodeOptions) -> Result<EncodedPoints>
                         start: s,
                         end: e,
                         class,
-                        surface: surface.child(k as usize),
                     });
                 }
-            }
-            if std::env::var_os("DBG").is_some() {
-                eprintln!("v{} depth {depth}: cells {} bytes {} known {dbg_known} empty {dbg_empty} fit {dbg_fit}", header.version, cells.len(), enc.len_estimate() - dbg_start);
             }
             cells = next;
             depth += 1;

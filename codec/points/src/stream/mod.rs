@@ -24,8 +24,9 @@ mod encode;
 mod format;
 mod models;
 mod neighbourhood;
+mod occupancy;
+mod probability;
 mod region;
-mod surface;
 
 pub use attr::{octahedral_decode, octahedral_encode};
 pub use decode::{decode, DecodedPoints, Limits, PointDecoder};

@@ -4,8 +4,8 @@
 use vitrine_codec::entropy::{BitModel, IntModel, RangeDecoder, RangeEncoder};
 
 use super::attr::{colour_apply, colour_residual};
-use super::context::{Around, CODED, CODED_V3, CONTEXTS, CONTEXTS_V3};
-use super::surface::CLASSES;
+use super::context::{Around, CODED, CONTEXTS};
+use super::occupancy::MaskCoder;
 
 /// Occupancy contexts: the parent's child count (1..=8) minus one.
 const PARENT_CLASSES: usize = 8;
@@ -36,11 +36,8 @@ pub(crate) struct Models {
     occupancy: Vec<BitModel>,
     /// Version 2: one model per neighbour context (`context.rs`).
     neighbour_occupancy: Vec<BitModel>,
-    /// Version 3: `neighbour_occupancy` with the inherited plane's classes.
-    surface_occupancy: Vec<BitModel>,
-    /// Version 3, where no neighbour is occupied: `occupancy`'s trees per
-    /// class of the child's distance from the inherited plane.
-    inherited_occupancy: Vec<BitModel>,
+    /// Version 3: version 2's contexts, mixed.
+    pub masks_v3: MaskCoder,
     duplicates: IntModel,
     normal: [IntModel; 2],
     colour: [IntModel; 3],
@@ -53,8 +50,7 @@ impl Models {
         Models {
             occupancy: vec![BitModel::new(); PARENT_CLASSES * 256],
             neighbour_occupancy: vec![BitModel::new(); CONTEXTS],
-            surface_occupancy: vec![BitModel::new(); CONTEXTS_V3],
-            inherited_occupancy: vec![BitModel::new(); PARENT_CLASSES * CLASSES * 256],
+            masks_v3: MaskCoder::new(),
             duplicates: IntModel::new(),
             normal: [IntModel::new(), IntModel::new()],
             colour: [IntModel::new(), IntModel::new(), IntModel::new()],
@@ -128,78 +124,6 @@ impl Models {
             }
             let context = contexts[k] + CODED[k][usize::from(mask)];
             let model = &mut self.neighbour_occupancy[usize::from(context)];
-            mask |= u8::from(dec.decode_bit(model)) << k;
-        }
-        mask
-    }
-
-    /// Version 3: codes a non-empty child mask with version 2's contexts,
-    /// the plane the cell inherited (`inherited`: each child's distance
-    /// class, `surface.rs`) standing in where none was fitted.
-    pub fn encode_mask_v3(
-        &mut self,
-        enc: &mut RangeEncoder,
-        around: &Around,
-        inherited: [u8; 8],
-        class: u8,
-        mask: u8,
-    ) {
-        debug_assert!(mask != 0);
-        if around.is_empty() {
-            let trees = &mut self.inherited_occupancy[usize::from(class) * CLASSES * 256..];
-            let mut node = 1usize;
-            for (k, &c) in inherited.iter().enumerate() {
-                if k == 7 && mask & 0x7F == 0 {
-                    break;
-                }
-                let bit = (mask >> k) & 1 == 1;
-                enc.encode_bit(&mut trees[usize::from(c) * 256 + node], bit);
-                node = node * 2 + usize::from(bit);
-            }
-            return;
-        }
-        let contexts = around.contexts_v3(inherited);
-        for k in 0..8 {
-            let so_far = mask & ((1u8 << k) - 1);
-            if k == 7 && so_far == 0 {
-                break;
-            }
-            let context = contexts[k] + CODED_V3[k][usize::from(so_far)];
-            let model = &mut self.surface_occupancy[usize::from(context)];
-            enc.encode_bit(model, (mask >> k) & 1 == 1);
-        }
-    }
-
-    /// Decodes a mask coded by [`encode_mask_v3`](Self::encode_mask_v3);
-    /// never 0.
-    pub fn decode_mask_v3(
-        &mut self,
-        dec: &mut RangeDecoder<'_>,
-        around: &Around,
-        inherited: [u8; 8],
-        class: u8,
-    ) -> u8 {
-        let mut mask = 0u8;
-        if around.is_empty() {
-            let trees = &mut self.inherited_occupancy[usize::from(class & 7) * CLASSES * 256..];
-            let mut node = 1usize;
-            for (k, &c) in inherited.iter().enumerate() {
-                if k == 7 && mask == 0 {
-                    return 0x80;
-                }
-                let bit = dec.decode_bit(&mut trees[usize::from(c) * 256 + node]);
-                mask |= u8::from(bit) << k;
-                node = node * 2 + usize::from(bit);
-            }
-            return mask;
-        }
-        let contexts = around.contexts_v3(inherited);
-        for k in 0..8 {
-            if k == 7 && mask == 0 {
-                return 0x80;
-            }
-            let context = contexts[k] + CODED_V3[k][usize::from(mask)];
-            let model = &mut self.surface_occupancy[usize::from(context)];
             mask |= u8::from(dec.decode_bit(model)) << k;
         }
         mask

@@ -86,9 +86,8 @@ pub(crate) struct Neighbourhood {
     /// Whether the cells' neighbour lists are kept (not at the last depth
     /// whose masks are coded: nothing reads them).
     lists: bool,
-    /// Whether `around` fits the plane itself, not only its classes
-    /// (version 3).
-    surfaces: bool,
+    /// Version 3: planes fitted to the whole 4×4×4 region.
+    wide: bool,
 }
 
 /// What a parent-level cell at `offset_code` from child k's parent gives
@@ -204,10 +203,10 @@ static SEEN_BY: [u8; 27] = {
 };
 
 impl Neighbourhood {
-    /// For version 3: [`around`](Self::around) also gives the fitted plane.
-    pub fn with_surfaces() -> Self {
+    /// Version 3's: planes fitted to the 4×4×4 region of the cell.
+    pub fn wide() -> Self {
         Neighbourhood {
-            surfaces: true,
+            wide: true,
             ..Default::default()
         }
     }
@@ -304,7 +303,7 @@ impl Neighbourhood {
         }
         self.side_count = n;
         self.k = k;
-        let mut r = describe(region, k, self.surfaces);
+        let mut r = describe(region, k, self.wide);
         for (a, &j) in minus_parent[..3].iter().enumerate() {
             if r.faces >> (2 * a) & 1 == 1 {
                 // Child k ^ 2^a of the parent, or k | 2^a of the one at −e_a.
