@@ -81,7 +81,7 @@ impl Block {
             return [0; 8];
         };
         debug_assert!(normal.iter().all(|v| v.abs() < 1 << 24), "never shifted");
-        self.bins(normal, len2, 3)
+        self.bins::<3>(normal, len2)
     }
 
     /// Version 3: [`plane_bins`](Self::plane_bins) of up to 63 cells
@@ -98,12 +98,12 @@ impl Block {
         if len2 == 0 {
             return [0; 8];
         }
-        self.bins(normal, len2, PLANES_V3 as i64 - 2)
+        self.bins::<{ PLANES_V3 - 2 }>(normal, len2)
     }
 
-    /// Classes 1 + the thresholds e/8 (e = 1..=`thresholds`) that the
-    /// child's distance reaches.
-    fn bins(&self, normal: [i64; 3], len2: i64, thresholds: i64) -> [u8; 8] {
+    /// Classes 1 + the thresholds e/8 (e = 1..=`T`) that the child's
+    /// distance reaches.
+    fn bins<const T: usize>(&self, normal: [i64; 3], len2: i64) -> [u8; 8] {
         let n = self.count + 1;
         let [s0, s1, s2] = self.sum;
         // 4n × (child centre − centroid) · normal, in parent cells:
@@ -112,13 +112,10 @@ impl Block {
         let centroid = 4 * (normal[0] * s0 + normal[1] * s1 + normal[2] * s2);
         // |dist| / (4n |normal|) against e/8: 4 dist² vs e² n² |normal|².
         let unit = n * n * len2;
+        let limits: [i64; T] = std::array::from_fn(|e| (e as i64 + 1).pow(2) * unit);
         let class = |dist: i64| {
             let lhs = 4 * dist * dist;
-            let mut c = 1;
-            for e in 1..=thresholds {
-                c += u8::from(lhs >= e * e * unit);
-            }
-            c
+            1 + limits.iter().map(|&l| u8::from(lhs >= l)).sum::<u8>()
         };
         let mut bins = [0u8; 8];
         for (k, side) in [-q0 - q1 - q2, q0 - q1 - q2, -q0 + q1 - q2, q0 + q1 - q2]

@@ -58,6 +58,21 @@ impl Counter {
         u32::from(self.p1 >> 4)
     }
 
+    /// Codes `bit` with this counter alone, and updates it.
+    pub fn encode(&mut self, enc: &mut RangeEncoder, bit: bool) {
+        let p0 = 4096 - self.p1().clamp(1, 4095);
+        enc.encode_bit(&mut BitModel::with_p0_4096(p0 as u16), bit);
+        self.update(bit);
+    }
+
+    /// Decodes a bit coded by [`encode`](Self::encode).
+    pub fn decode(&mut self, dec: &mut RangeDecoder<'_>) -> bool {
+        let p0 = 4096 - self.p1().clamp(1, 4095);
+        let bit = dec.decode_bit(&mut BitModel::with_p0_4096(p0 as u16));
+        self.update(bit);
+        bit
+    }
+
     pub fn update(&mut self, bit: bool) {
         let rate = RATE[usize::from(self.seen)];
         let p = i64::from(self.p1);
@@ -99,6 +114,17 @@ static STRETCH: [i16; 4096] = {
             t[p as usize] = x as i16;
             p += 1;
         }
+        x += 1;
+    }
+    t
+};
+
+/// `SQUASH[x + 2047]` = squash(x).
+static SQUASH: [i16; 4095] = {
+    let mut t = [0; 4095];
+    let mut x = -2047;
+    while x <= 2047 {
+        t[(x + 2047) as usize] = squash(x) as i16;
         x += 1;
     }
     t
@@ -151,7 +177,7 @@ impl Mixer {
             .map(|i| i64::from(w[i]) * i64::from(stretched[i]))
             .sum();
         let x = (dot >> 16).clamp(-2047, 2047) as i32;
-        let mixed = squash(x);
+        let mixed = i32::from(SQUASH[(x + 2047) as usize]);
         let at = ((x + 2048) >> 7) as usize;
         let above = (x + 2048) & 127;
         let t = &self.refine[set];
