@@ -24,7 +24,7 @@ pub struct EncodeOptions {
     pub normals: bool,
     /// Code the cloud's colours, when it has them.
     pub colours: bool,
-    /// Stream format version to write (1 or 2; 2 codes positions smaller).
+    /// Stream format version to write (1, 2 or 3; 2 and 3 code positions smaller).
     pub version: u8,
 }
 

@@ -34,7 +34,7 @@ pub(crate) const CHUNK_FRAME: usize = 8;
 /// What the header says.
 #[derive(Clone, Debug, PartialEq)]
 pub struct PointHeader {
-    /// Format version (1 or 2).
+    /// Format version (1, 2 or 3).
     pub version: u8,
     /// Position bits per axis; the octree has this depth.
     pub bits: u8,

@@ -396,7 +396,90 @@ mod tests {
     }
 
     /// `FORMAT.md`'s definition, cell by cell through a map of the depth.
-    fn reference(cells: &HashMap<[u32; 3], usize>, masks: &[u8], at: [u32; 3], i: usize) -> Around {
+    /// `FORMAT.md`'s version 3 plane classes: the cofactors in 128 bits,
+    /// shifted below 2^30, the normal below 2^12, five thresholds.
+    fn plane_bins_v3_i128(block: &Block) -> [u8; 8] {
+        let n = block.count + 1;
+        if block.count < 3 {
+            return [0; 8];
+        }
+        let c = |a: usize, b: usize| n * block.products[a][b] - block.sum[a] * block.sum[b];
+        let cof = |i: usize, j: usize| {
+            let (i1, i2, j1, j2) = ((i + 1) % 3, (i + 2) % 3, (j + 1) % 3, (j + 2) % 3);
+            i128::from(c(i1, j1)) * i128::from(c(i2, j2))
+                - i128::from(c(i1, j2)) * i128::from(c(i2, j1))
+        };
+        let rows = [0, 1, 2].map(|i| [0, 1, 2].map(|j| cof(i, j)));
+        let big = rows
+            .iter()
+            .flatten()
+            .map(|v| v.unsigned_abs())
+            .max()
+            .unwrap();
+        let shift = (128 - big.leading_zeros()).saturating_sub(30);
+        let rows = rows.map(|r| r.map(|v| v >> shift));
+        let norm2 = |r: &[i128; 3]| r.iter().map(|v| v * v).sum::<i128>();
+        let mut normal = [0; 3];
+        for r in &rows {
+            if norm2(r) >= norm2(&normal) {
+                normal = *r;
+            }
+        }
+        let big = normal.iter().map(|v| v.unsigned_abs()).max().unwrap();
+        let shift = (128 - big.leading_zeros()).saturating_sub(12);
+        let normal = normal.map(|v| v >> shift);
+        let len2 = norm2(&normal);
+        if len2 == 0 {
+            return [0; 8];
+        }
+        let n = i128::from(n);
+        let mut bins = [0u8; 8];
+        for (k, bin) in bins.iter_mut().enumerate() {
+            let dist: i128 = (0..3)
+                .map(|a| {
+                    let o = if (k >> a) & 1 == 1 { 1 } else { -1 };
+                    normal[a] * (o * n - 4 * i128::from(block.sum[a]))
+                })
+                .sum();
+            let lhs = 4 * dist * dist;
+            *bin = 1 + (1..=5).filter(|&e| lhs >= e * e * n * n * len2).count() as u8;
+        }
+        bins
+    }
+
+    /// Version 3's plane: the 26 neighbours if at least 5 are occupied,
+    /// else the 4×4×4 block of `at`'s side of its parent.
+    fn plane_v3(cells: &HashMap<[u32; 3], usize>, at: [u32; 3], near: &Block) -> [u8; 8] {
+        let block = if near.count >= 5 {
+            Block { ..*near }
+        } else {
+            let mut wide = Block::default();
+            let low = at.map(|v| if v % 2 == 0 { -2 } else { -1 });
+            for dz in low[2]..low[2] + 4 {
+                for dy in low[1]..low[1] + 4 {
+                    for dx in low[0]..low[0] + 4 {
+                        let d = [dx, dy, dz];
+                        let q = [0, 1, 2].map(|a| at[a].wrapping_add_signed(d[a]));
+                        if d != [0; 3] && cells.contains_key(&q) {
+                            wide.add(d);
+                        }
+                    }
+                }
+            }
+            wide
+        };
+        let bins = plane_bins_v3_i128(&block);
+        assert_eq!(bins, block.plane_bins_wide(), "64-bit plane classes");
+        bins
+    }
+
+    fn reference(
+        cells: &HashMap<[u32; 3], usize>,
+        masks: &[u8],
+        at: [u32; 3],
+        i: usize,
+        wide: bool,
+    ) -> Around {
         let mut r = Around::default();
         let mut block = Block::default();
         for dz in -1..=1i32 {
@@ -422,18 +505,26 @@ mod tests {
                 }
             }
         }
-        r.plane = plane_bins_i128(&block);
-        assert_eq!(r.plane, block.plane_bins(), "64-bit plane classes");
+        if wide {
+            r.plane = plane_v3(cells, at, &block);
+        } else {
+            r.plane = plane_bins_i128(&block);
+            assert_eq!(r.plane, block.plane_bins(), "64-bit plane classes");
+        }
         r
     }
 
     /// Builds the octree of `points` (coordinates below 2^bits) depth by
     /// depth and checks every cell's `Around` against the reference.
-    fn check_cloud(points: &[[u32; 3]], bits: u32) {
+    fn check_cloud(points: &[[u32; 3]], bits: u32, wide: bool) {
         let mut keys: Vec<u64> = points.iter().map(|&p| morton(p)).collect();
         keys.sort_unstable();
         keys.dedup();
-        let mut n = Neighbourhood::default();
+        let mut n = if wide {
+            Neighbourhood::wide()
+        } else {
+            Neighbourhood::default()
+        };
         let mut planes = 0;
         for depth in 0..bits {
             let shift = 3 * (bits - depth);
@@ -451,7 +542,7 @@ mod tests {
             let masks: Vec<u8> = cells.iter().map(|c| c.1).collect();
             n.start_depth(depth, depth + 1 == bits);
             for (i, &q) in at.iter().enumerate() {
-                let want = reference(&map, &masks, q, i);
+                let want = reference(&map, &masks, q, i, wide);
                 assert_eq!(n.around(q), want, "depth {depth} cell {q:?}");
                 planes += usize::from(want.plane != [0; 8]);
                 n.record(masks[i]);
@@ -486,6 +577,7 @@ mod tests {
             .collect();
         points.extend((0..400).map(|_| [0; 3].map(|_| (next(&mut s) % 8) as u32)));
         points.extend((0..300).map(|_| [0; 3].map(|_| (next(&mut s) % 256) as u32)));
-        check_cloud(&points, bits);
+        check_cloud(&points, bits, false);
+        check_cloud(&points, bits, true);
     }
 }
