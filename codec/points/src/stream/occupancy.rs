@@ -1,9 +1,9 @@
 //! Version 3's child masks (`FORMAT.md` "Version 3"): version 2's bits and
 //! contexts (with version 3's plane classes), each bit's probability mixed
-//! (`probability.rs`) from four counters: the full context, the same
-//! without the face bits (fewer, so it learns sooner), version 1's tree
-//! (the parent's child count and the exact bits so far), and the full
-//! context with the child's occupied near faces as bits, not a count.
+//! (`probability.rs`) from three counters: the full context, version 1's
+//! tree (the parent's child count and the exact bits so far), and the
+//! full context with the child's occupied near faces as bits, not a count.
+//! (A fourth, the context without its face bits, saved 0.07 %.)
 //! Where no neighbour is occupied (most cells of the deepest depths, whose
 //! bits no context predicts much), version 1's tree alone, with an
 //! adaptive-rate counter: mixing there saved 0.05 % for a third of the
@@ -16,15 +16,12 @@ use super::probability::{Counter, Mix, Mixer, INPUTS};
 
 /// Parent classes (child count − 1) of the tree contexts.
 const PARENT_CLASSES: usize = 8;
-/// The contexts without their 8 face-bit combinations.
-const SMALL: usize = CONTEXTS_V3 / 8;
-/// Weight sets: one per small context without its near faces (child,
-/// bits set, plane class).
-const SETS: usize = SMALL / 4;
+/// Weight sets: one per child, bits set and plane class (the context
+/// without its face bits and near faces).
+const SETS: usize = CONTEXTS_V3 / 32;
 
 pub(crate) struct MaskCoder {
     context: Vec<Counter>,
-    small: Vec<Counter>,
     tree: Vec<Counter>,
     sides: Vec<Counter>,
     /// Where no neighbour is occupied: version 1's tree, one counter alone.
@@ -52,7 +49,6 @@ impl MaskCoder {
     pub fn new() -> Self {
         MaskCoder {
             context: vec![Counter::default(); CONTEXTS_V3],
-            small: vec![Counter::default(); SMALL],
             tree: vec![Counter::default(); PARENT_CLASSES * 256],
             sides: vec![Counter::default(); CONTEXTS_V3 / 4 * 8],
             lone_tree: vec![Counter::default(); PARENT_CLASSES * 256],
@@ -71,7 +67,6 @@ impl MaskCoder {
         Slots {
             counters: [
                 context,
-                context / 32 * 4 + context % 4,
                 class * 256 + node,
                 context / 4 * 8 + near_sides(around.faces, k),
             ],
@@ -80,16 +75,15 @@ impl MaskCoder {
     }
 
     fn predict(&self, s: &Slots) -> Mix {
-        let [a, b, c, d] = s.counters;
-        let inputs = [self.context[a], self.small[b], self.tree[c], self.sides[d]];
+        let [a, c, d] = s.counters;
+        let inputs = [self.context[a], self.tree[c], self.sides[d]];
         self.mixer.predict(s.set, inputs)
     }
 
     fn learn(&mut self, s: &Slots, mix: &Mix, bit: bool) {
         self.mixer.learn(mix, bit);
-        let [a, b, c, d] = s.counters;
+        let [a, c, d] = s.counters;
         self.context[a].update(bit);
-        self.small[b].update(bit);
         self.tree[c].update(bit);
         self.sides[d].update(bit);
     }

@@ -137,7 +137,7 @@ fn stretch(p1: u32) -> i32 {
 }
 
 /// Inputs mixed per bit.
-pub(crate) const INPUTS: usize = 4;
+pub(crate) const INPUTS: usize = 3;
 
 /// Weights of the mix, 16.16 fixed point, one set per mixing context.
 pub(crate) struct Mixer {
@@ -268,7 +268,7 @@ mod tests {
             right.p1 = if bit { 60000 } else { 5000 };
             wrong.p1 = if bit { 5000 } else { 60000 };
             let unsure = Counter::default();
-            let mix = mixer.predict(0, [right, wrong, unsure, unsure]);
+            let mix = mixer.predict(0, [right, wrong, unsure]);
             if i > 1000 {
                 bits += u32::from((mix.p1 > 2048) == bit);
             }
