@@ -26,11 +26,12 @@ const LEARNING_SHIFT: u32 = 13;
 /// 5: +0.3 %).
 const REFINE_SHIFT: u32 = 7;
 
-/// `RATE[n]`: 2^16 / (n + 1.5), the step of a counter that has seen n bits.
-static RATE: [u32; LIMIT + 1] = {
-    let mut t = [0; LIMIT + 1];
+/// `RATE[n]`: 2^16 / (n + 1.5), the step of a counter that has seen n bits
+/// (256 entries, so that a `u8` count needs no bounds check).
+static RATE: [u32; 256] = {
+    let mut t = [0; 256];
     let mut n = 0;
-    while n <= LIMIT {
+    while n < 256 {
         t[n] = (2 << 16) / (2 * n as u32 + 3);
         n += 1;
     }
@@ -179,8 +180,9 @@ impl Mixer {
             .map(|i| i64::from(w[i]) * i64::from(stretched[i]))
             .sum();
         let x = (dot >> 16).clamp(-2047, 2047) as i32;
-        let mixed = i32::from(SQUASH[(x + 2047) as usize]);
-        let at = ((x + 2048) >> 7) as usize;
+        // (x is in −2047..=2047: the masks only spare bounds checks.)
+        let mixed = i32::from(SQUASH[((x + 2047) as usize).min(4094)]);
+        let at = ((x + 2048) >> 7) as usize & 31;
         let above = (x + 2048) & 127;
         let t = &self.refine[set];
         let refined = (i32::from(t[at]) * (128 - above) + i32::from(t[at + 1]) * above) >> 11;
@@ -200,7 +202,7 @@ impl Mixer {
         let err = (i32::from(bit) << 12) - mix.mixed;
         let t = &mut self.refine[mix.set];
         let target = if bit { 65535 } else { 0 };
-        let near = mix.at + usize::from(mix.above >= 64);
+        let near = (mix.at + usize::from(mix.above >= 64)).min(32);
         let v = i32::from(t[near]);
         t[near] = (v + ((target - v) >> REFINE_SHIFT)) as u16;
         let w = &mut self.weights[mix.set];
