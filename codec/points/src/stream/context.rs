@@ -41,7 +41,8 @@ pub(crate) struct Around {
     pub plane: [u8; 8],
 }
 
-/// The occupied cells of a 3×3×3 block: count and moments of their offsets
+/// The occupied cells of a 3×3×3 block (version 3: the points of
+/// `plane_bins_quarters`): count and moments of their offsets
 /// (the centre cell counted, at offset 0).
 #[derive(Debug, Default, PartialEq, Eq)]
 pub(crate) struct Block {
@@ -81,13 +82,15 @@ impl Block {
             return [0; 8];
         };
         debug_assert!(normal.iter().all(|v| v.abs() < 1 << 24), "never shifted");
-        self.bins::<3>(normal, len2)
+        self.bins::<3, 4>(normal, len2)
     }
 
-    /// Version 3: [`plane_bins`](Self::plane_bins) of up to 63 cells
-    /// (offsets in −2..=2), the normal shifted below 2^12 first: then
-    /// |t| < 3 · 2^12 · (64 + 4 · 126) < 2^23 and 4t² < 2^48.
-    pub fn plane_bins_wide(&self) -> [u8; 8] {
+    /// Version 3: [`plane_bins`](Self::plane_bins) of points given in
+    /// quarters of a cell (up to 504 besides the centre, coordinates in
+    /// −9..=9: |C_ab| < 2^26, so the cofactors stay below 2^53 before
+    /// `normal`'s shift), the normal shifted below 2^12 first: then
+    /// |t| < 3 · 2^12 · (505 + 4545) < 2^26 and 4t² < 2^54.
+    pub fn plane_bins_quarters(&self) -> [u8; 8] {
         let Some((normal, _)) = self.normal() else {
             return [0; 8];
         };
@@ -98,18 +101,19 @@ impl Block {
         if len2 == 0 {
             return [0; 8];
         }
-        self.bins::<{ PLANES_V3 - 2 }>(normal, len2)
+        self.bins::<{ PLANES_V3 - 2 }, 1>(normal, len2)
     }
 
     /// Classes 1 + the thresholds e/8 (e = 1..=`T`) that the child's
-    /// distance reaches.
-    fn bins<const T: usize>(&self, normal: [i64; 3], len2: i64) -> [u8; 8] {
+    /// distance reaches; offsets in cells (`SCALE` 4) or quarters (1).
+    fn bins<const T: usize, const SCALE: i64>(&self, normal: [i64; 3], len2: i64) -> [u8; 8] {
         let n = self.count + 1;
         let [s0, s1, s2] = self.sum;
-        // 4n × (child centre − centroid) · normal, in parent cells:
-        // Σ_a normal_a (±n − 4 S_a); child 7 − k has the opposite signs.
+        // 4n × (child centre − centroid) · normal, in parent cells (child
+        // centres at ±1/4, ±1 quarter): Σ_a normal_a (±n − SCALE · S_a);
+        // child 7 − k has the opposite signs.
         let [q0, q1, q2] = normal.map(|v| v * n);
-        let centroid = 4 * (normal[0] * s0 + normal[1] * s1 + normal[2] * s2);
+        let centroid = SCALE * (normal[0] * s0 + normal[1] * s1 + normal[2] * s2);
         // |dist| / (4n |normal|) against e/8: 4 dist² vs e² n² |normal|².
         let unit = n * n * len2;
         let limits: [i64; T] = std::array::from_fn(|e| (e as i64 + 1).pow(2) * unit);
@@ -137,7 +141,7 @@ impl Block {
         if self.count < 3 {
             return None;
         }
-        debug_assert!(self.count <= 63);
+        debug_assert!(self.count <= 504);
         let [s0, s1, s2] = self.sum;
         let p = &self.products;
         // n² × the covariance; its adjugate's largest row is along the
@@ -156,9 +160,9 @@ impl Block {
         let f01 = c12 * c02 - c01 * c22;
         let f02 = c01 * c12 - c11 * c02;
         let f12 = c02 * c01 - c12 * c00;
-        // Up to 63 cells (`plane_bins_wide`) a cofactor may reach 2^31:
-        // shifted below 2^30 so that the rows' norms stay within 64 bits
-        // (never for the 3×3×3 block, whose cofactors stay below 2^19).
+        // Version 3's points (`plane_bins_quarters`) bring a cofactor up
+        // to 2^53: shifted below 2^30 so that the rows' norms stay within
+        // 64 bits (never for version 2's 26 cells, below 2^19).
         let big = [f00, f11, f22, f01, f02, f12]
             .iter()
             .fold(0u64, |m, v| m.max(v.unsigned_abs()));
@@ -345,7 +349,6 @@ mod tests {
                 minus: [(r >> 8) as u8, (r >> 16) as u8, (r >> 24) as u8],
                 minus_edge: r >> 32 & 1 == 1,
                 plane: [0; 8].map(|_| (crate::testing::next(&mut s) % 5) as u8),
-                ..Default::default()
             };
             let parts = around.contexts();
             for k in 0..8u32 {

@@ -16,7 +16,8 @@
 //! are coded.
 
 use super::context::Around;
-use super::region::describe;
+use super::context::Block;
+use super::region::{describe, describe_v3, offset_in_region};
 
 /// The cells of one depth, in coding order.
 #[derive(Default)]
@@ -86,7 +87,8 @@ pub(crate) struct Neighbourhood {
     /// Whether the cells' neighbour lists are kept (not at the last depth
     /// whose masks are coded: nothing reads them).
     lists: bool,
-    /// Version 3: planes fitted to the whole 4×4×4 region.
+    /// Version 3: planes fitted to the 4×4×4 region and the children
+    /// already coded.
     wide: bool,
 }
 
@@ -259,6 +261,53 @@ impl Neighbourhood {
         cells.start.push(cells.neighbours.len() as u32);
     }
 
+    /// Version 3's plane classes for the cell `i`, child `k` of its
+    /// parent: the plane fitted to the region's cells `fitted` (region
+    /// bits), each as its centre or, where its mask is coded (before `i`),
+    /// as the centres of its children, in quarter cells about `i`'s centre
+    /// (`FORMAT.md` "Version 3").
+    fn plane_v3(&self, fitted: u64, k: usize, i: u32) -> [u8; 8] {
+        // Each region byte's parent-level cell: its first child and mask.
+        let mut bytes = [(0u32, 0u8); 8];
+        for &(cell, code) in &self.sides[..self.side_count] {
+            bytes[usize::from(REACH[k][usize::from(code)].u)] = ((cell >> 8) as u32, cell as u8);
+        }
+        let mut block = Block::default();
+        let mut add = |q: [i64; 3]| {
+            block.count += 1;
+            for a in 0..3 {
+                block.sum[a] += q[a];
+                for b in a..3 {
+                    block.products[a][b] += q[a] * q[b];
+                }
+            }
+        };
+        let mut rest = fitted;
+        while rest != 0 {
+            let b = rest.trailing_zeros();
+            rest &= rest - 1;
+            let d = offset_in_region(b, k).map(|v| 4 * i64::from(v));
+            let (first, m) = bytes[(b >> 3) as usize];
+            let index = first + u32::from(RANK[usize::from(m)][(b & 7) as usize]);
+            if index < i {
+                let mut children = self.cells.mask(index as usize);
+                while children != 0 {
+                    let w = children.trailing_zeros() as i64;
+                    children &= children - 1;
+                    add([0, 1, 2].map(|a| d[a] + 2 * (w >> a & 1) - 1));
+                }
+            } else {
+                add(d);
+            }
+        }
+        for a in 0..3 {
+            for b in 0..a {
+                block.products[a][b] = block.products[b][a];
+            }
+        }
+        block.plane_bins_quarters()
+    }
+
     /// What is known around the next cell to code (coding order), at `at`
     /// (coordinates at this depth): the masks of depth − 1 and those
     /// recorded at this depth. Must be followed by its [`record`](Self::record).
@@ -268,7 +317,6 @@ impl Neighbourhood {
             return Around::default();
         }
         let parents = &self.parents;
-        let cells = &mut self.cells;
         // Every parent has a child: the next cell's parent is this one or
         // the next.
         let mut p = self.parent;
@@ -303,7 +351,16 @@ impl Neighbourhood {
         }
         self.side_count = n;
         self.k = k;
-        let mut r = describe(region, k, self.wide);
+        let mut r = if self.wide {
+            let (mut r, fitted) = describe_v3(region, k);
+            if fitted != 0 {
+                r.plane = self.plane_v3(fitted, k, i);
+            }
+            r
+        } else {
+            describe(region, k)
+        };
+        let (parents, cells) = (&self.parents, &self.cells);
         for (a, &j) in minus_parent[..3].iter().enumerate() {
             if r.faces >> (2 * a) & 1 == 1 {
                 // Child k ^ 2^a of the parent, or k | 2^a of the one at −e_a.
@@ -396,8 +453,9 @@ mod tests {
     }
 
     /// `FORMAT.md`'s definition, cell by cell through a map of the depth.
-    /// `FORMAT.md`'s version 3 plane classes: the cofactors in 128 bits,
-    /// shifted below 2^30, the normal below 2^12, five thresholds.
+    /// `FORMAT.md`'s version 3 plane classes (points in quarter cells):
+    /// the cofactors in 128 bits, shifted below 2^30, the normal below
+    /// 2^12, five thresholds.
     fn plane_bins_v3_i128(block: &Block) -> [u8; 8] {
         let n = block.count + 1;
         if block.count < 3 {
@@ -438,7 +496,7 @@ mod tests {
             let dist: i128 = (0..3)
                 .map(|a| {
                     let o = if (k >> a) & 1 == 1 { 1 } else { -1 };
-                    normal[a] * (o * n - 4 * i128::from(block.sum[a]))
+                    normal[a] * (o * n - i128::from(block.sum[a]))
                 })
                 .sum();
             let lhs = 4 * dist * dist;
@@ -447,29 +505,49 @@ mod tests {
         bins
     }
 
-    /// Version 3's plane: the 26 neighbours if at least 5 are occupied,
-    /// else the 4×4×4 block of `at`'s side of its parent.
-    fn plane_v3(cells: &HashMap<[u32; 3], usize>, at: [u32; 3], near: &Block) -> [u8; 8] {
-        let block = if near.count >= 5 {
-            Block { ..*near }
-        } else {
-            let mut wide = Block::default();
-            let low = at.map(|v| if v % 2 == 0 { -2 } else { -1 });
-            for dz in low[2]..low[2] + 4 {
-                for dy in low[1]..low[1] + 4 {
-                    for dx in low[0]..low[0] + 4 {
-                        let d = [dx, dy, dz];
-                        let q = [0, 1, 2].map(|a| at[a].wrapping_add_signed(d[a]));
-                        if d != [0; 3] && cells.contains_key(&q) {
-                            wide.add(d);
+    /// Version 3's plane: of the 26 neighbours if at least 5 are occupied,
+    /// else of the 4×4×4 block on `at`'s side of its parent; each cell
+    /// as its centre or, if coded before cell `i`, its children's centres,
+    /// in quarter cells.
+    fn plane_v3(
+        cells: &HashMap<[u32; 3], usize>,
+        masks: &[u8],
+        at: [u32; 3],
+        i: usize,
+        near: &Block,
+    ) -> [u8; 8] {
+        let low = at.map(|v| if v % 2 == 0 { -2 } else { -1 });
+        let mut block = Block::default();
+        let mut used = 0;
+        for dz in low[2]..low[2] + 4 {
+            for dy in low[1]..low[1] + 4 {
+                for dx in low[0]..low[0] + 4 {
+                    let d = [dx, dy, dz];
+                    let q = [0, 1, 2].map(|a| at[a].wrapping_add_signed(d[a]));
+                    let Some(&j) = cells.get(&q).filter(|_| d != [0; 3]) else {
+                        continue;
+                    };
+                    if near.count >= 5 && d.iter().any(|v| v.abs() > 1) {
+                        continue;
+                    }
+                    used += 1;
+                    if j < i {
+                        for w in 0..8 {
+                            if masks[j] >> w & 1 == 1 {
+                                block.add([0, 1, 2].map(|a| 4 * d[a] + 2 * (w >> a & 1) - 1));
+                            }
                         }
+                    } else {
+                        block.add(d.map(|v| 4 * v));
                     }
                 }
             }
-            wide
-        };
+        }
+        if used < 3 {
+            return [0; 8];
+        }
         let bins = plane_bins_v3_i128(&block);
-        assert_eq!(bins, block.plane_bins_wide(), "64-bit plane classes");
+        assert_eq!(bins, block.plane_bins_quarters(), "64-bit plane classes");
         bins
     }
 
@@ -506,7 +584,7 @@ mod tests {
             }
         }
         if wide {
-            r.plane = plane_v3(cells, at, &block);
+            r.plane = plane_v3(cells, masks, at, i, &block);
         } else {
             r.plane = plane_bins_i128(&block);
             assert_eq!(r.plane, block.plane_bins(), "64-bit plane classes");

@@ -80,7 +80,7 @@ impl Counter {
         let rate = RATE[usize::from(self.seen)];
         let p = i64::from(self.p1);
         let target = if bit { 65535 } else { 0 };
-        self.p1 = (p + ((target - p) * i64::from(rate) >> 16)) as u16;
+        self.p1 = (p + (((target - p) * i64::from(rate)) >> 16)) as u16;
         self.seen += u8::from(usize::from(self.seen) < LIMIT);
     }
 }

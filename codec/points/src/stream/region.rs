@@ -127,10 +127,8 @@ static MOMENTS: [[[u64; 2]; 256]; 8] = {
 const WIDE_BELOW: u32 = 5;
 
 /// The contexts' inputs from the region around child `k`, but the masks of
-/// its −e_a neighbours. `wide` (version 3): where the 3×3×3 block holds
-/// fewer than `WIDE_BELOW` neighbours, the plane is fitted to the whole
-/// region (up to 63 cells), and the classes are version 3's.
-pub(super) fn describe(region: u64, k: usize, wide: bool) -> Around {
+/// its −e_a neighbours.
+pub(super) fn describe(region: u64, k: usize) -> Around {
     let t = &TABLES[k];
     let mut r = Around::default();
     for (f, &bit) in t.faces.iter().enumerate() {
@@ -139,21 +137,43 @@ pub(super) fn describe(region: u64, k: usize, wide: bool) -> Around {
     r.minus_edge = region & t.minus_edges != 0;
     let occupied = region & t.neighbours;
     let two = occupied & occupied.wrapping_sub(1);
-    if wide && occupied.count_ones() < WIDE_BELOW {
-        let all = region & t.others;
-        if all.count_ones() >= 3 {
-            r.plane = moments(all, k).plane_bins_wide();
-        }
-    } else if two & two.wrapping_sub(1) != 0 {
+    if two & two.wrapping_sub(1) != 0 {
         // At least 3 neighbours: a plane may be fitted.
-        let block = moments(occupied, k);
-        r.plane = if wide {
-            block.plane_bins_wide()
-        } else {
-            block.plane_bins()
-        };
+        r.plane = moments(occupied, k).plane_bins();
     }
     r
+}
+
+/// Version 3: [`describe`] but the plane classes, and the region's cells
+/// the plane is fitted to (`Neighbourhood::around` adds what is known of
+/// their children): the 3×3×3 block's if it holds at least `WIDE_BELOW`
+/// neighbours, else the whole region's but the cell's own; none if fewer
+/// than 3.
+pub(super) fn describe_v3(region: u64, k: usize) -> (Around, u64) {
+    let t = &TABLES[k];
+    let mut r = Around::default();
+    for (f, &bit) in t.faces.iter().enumerate() {
+        r.faces |= ((region >> bit & 1) as u8) << f;
+    }
+    r.minus_edge = region & t.minus_edges != 0;
+    let occupied = region & t.neighbours;
+    let fitted = if occupied.count_ones() >= WIDE_BELOW {
+        occupied
+    } else {
+        region & t.others
+    };
+    (r, if fitted.count_ones() >= 3 { fitted } else { 0 })
+}
+
+/// The offset of region bit `b` from the region's cell of child `k`.
+pub(super) fn offset_in_region(b: u32, k: usize) -> [i32; 3] {
+    let (u, v) = (b >> 3, b & 7);
+    let c = centre(k);
+    [
+        (2 * (u & 1) + (v & 1)) as i32 - c[0],
+        (2 * (u >> 1 & 1) + (v >> 1 & 1)) as i32 - c[1],
+        (2 * (u >> 2) + (v >> 2)) as i32 - c[2],
+    ]
 }
 
 /// The moments of the occupied cells in `neighbours` (a region's bits)
