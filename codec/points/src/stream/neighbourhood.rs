@@ -17,7 +17,7 @@
 
 use super::context::Around;
 use super::context::Block;
-use super::region::{describe, describe_v3, offset_in_region};
+use super::region::{describe, describe_v3, moments, offset_in_region};
 
 /// The cells of one depth, in coding order.
 #[derive(Default)]
@@ -263,16 +263,22 @@ impl Neighbourhood {
 
     /// Version 3's plane classes for the cell `i`, child `k` of its
     /// parent: the plane fitted to the region's cells `fitted` (region
-    /// bits), each as its centre or, where its mask is coded (before `i`),
-    /// as the centres of its children, in quarter cells about `i`'s centre
-    /// (`FORMAT.md` "Version 3").
-    fn plane_v3(&self, fitted: u64, k: usize, i: u32) -> [u8; 8] {
+    /// bits), each as its centre or, where its mask is coded (`coded`,
+    /// before `i`), as the centres of its children, in quarter cells about
+    /// `i`'s centre (`FORMAT.md` "Version 3").
+    fn plane_v3(&self, fitted: u64, coded: u64, k: usize, i: u32) -> [u8; 8] {
         // Each region byte's parent-level cell: its first child and mask.
         let mut bytes = [(0u32, 0u8); 8];
         for &(cell, code) in &self.sides[..self.side_count] {
             bytes[usize::from(REACH[k][usize::from(code)].u)] = ((cell >> 8) as u32, cell as u8);
         }
-        let mut block = Block::default();
+        // The cells not coded yet from the per-byte tables, in quarters.
+        let far = moments(fitted & !coded, k);
+        let mut block = Block {
+            count: far.count,
+            sum: far.sum.map(|s| 4 * s),
+            products: far.products.map(|row| row.map(|p| 16 * p)),
+        };
         let mut add = |q: [i64; 3]| {
             block.count += 1;
             for a in 0..3 {
@@ -282,22 +288,19 @@ impl Neighbourhood {
                 }
             }
         };
-        let mut rest = fitted;
+        let mut rest = fitted & coded;
         while rest != 0 {
             let b = rest.trailing_zeros();
             rest &= rest - 1;
             let d = offset_in_region(b, k).map(|v| 4 * i64::from(v));
             let (first, m) = bytes[(b >> 3) as usize];
             let index = first + u32::from(RANK[usize::from(m)][(b & 7) as usize]);
-            if index < i {
-                let mut children = self.cells.mask(index as usize);
-                while children != 0 {
-                    let w = children.trailing_zeros() as i64;
-                    children &= children - 1;
-                    add([0, 1, 2].map(|a| d[a] + 2 * (w >> a & 1) - 1));
-                }
-            } else {
-                add(d);
+            debug_assert!(index < i);
+            let mut children = self.cells.mask(index as usize);
+            while children != 0 {
+                let w = children.trailing_zeros() as i64;
+                children &= children - 1;
+                add([0, 1, 2].map(|a| d[a] + 2 * (w >> a & 1) - 1));
             }
         }
         for a in 0..3 {
@@ -335,6 +338,9 @@ impl Neighbourhood {
         // (written without branches, the next write overwriting an unused
         // one).
         let mut n = 0;
+        // The region's cells whose masks are coded: all children of the
+        // parent-level cells before the parent, the siblings before k.
+        let mut coded = ((1u64 << k) - 1) << (8 * reach[13].u);
         for e in 0..=listed_len(parents, p) {
             let (j, code) = if e == 0 {
                 (p, 13)
@@ -345,6 +351,7 @@ impl Neighbourhood {
             let cell = parents.cells[j];
             let r = &reach[usize::from(code)];
             region |= (cell << (8 * r.u)) & r.keep;
+            coded |= r.keep & 0u64.wrapping_sub(u64::from(j < p));
             minus_parent[usize::from(r.minus)] = j;
             self.sides[n] = (cell, code);
             n += usize::from(r.keep != 0);
@@ -354,7 +361,7 @@ impl Neighbourhood {
         let mut r = if self.wide {
             let (mut r, fitted) = describe_v3(region, k);
             if fitted != 0 {
-                r.plane = self.plane_v3(fitted, k, i);
+                r.plane = self.plane_v3(fitted, coded, k, i);
             }
             r
         } else {

@@ -178,7 +178,7 @@ pub(super) fn offset_in_region(b: u32, k: usize) -> [i32; 3] {
 
 /// The moments of the occupied cells in `neighbours` (a region's bits)
 /// about child `k`'s centre.
-fn moments(neighbours: u64, k: usize) -> Block {
+pub(super) fn moments(neighbours: u64, k: usize) -> Block {
     let mut lanes = [0u64; 2];
     for (u, byte) in neighbours.to_le_bytes().into_iter().enumerate() {
         let m = &MOMENTS[u][usize::from(byte)];
