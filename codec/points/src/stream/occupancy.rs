@@ -12,20 +12,25 @@
 use vitrine_codec::entropy::{RangeDecoder, RangeEncoder};
 
 use super::context::{Around, CODED_V3, CONTEXTS_V3};
-use super::probability::{Counter, Mix, Mixer, INPUTS};
+use super::probability::{Counters, Mix, Mixer, INPUTS, SETS};
 
 /// Parent classes (child count − 1) of the tree contexts.
 const PARENT_CLASSES: usize = 8;
 /// Weight sets: one per child, bits set and plane class (the context
 /// without its face bits and near faces).
-const SETS: usize = CONTEXTS_V3 / 32;
+const _: () = assert!(CONTEXTS_V3 / 32 <= SETS);
+/// Counter tables, powers of two at least the contexts (`Counters`).
+const CONTEXT_SLOTS: usize = 8192;
+const SIDES_SLOTS: usize = 16384;
+const _: () = assert!(CONTEXTS_V3 <= CONTEXT_SLOTS && CONTEXTS_V3 / 4 * 8 <= SIDES_SLOTS);
+const TREE_SLOTS: usize = PARENT_CLASSES * 256;
 
 pub(crate) struct MaskCoder {
-    context: Vec<Counter>,
-    tree: Vec<Counter>,
-    sides: Vec<Counter>,
+    context: Counters<CONTEXT_SLOTS>,
+    tree: Counters<TREE_SLOTS>,
+    sides: Counters<SIDES_SLOTS>,
     /// Where no neighbour is occupied: version 1's tree, one counter alone.
-    lone_tree: Vec<Counter>,
+    lone_tree: Counters<TREE_SLOTS>,
     mixer: Mixer,
 }
 
@@ -48,11 +53,11 @@ struct Slots {
 impl MaskCoder {
     pub fn new() -> Self {
         MaskCoder {
-            context: vec![Counter::default(); CONTEXTS_V3],
-            tree: vec![Counter::default(); PARENT_CLASSES * 256],
-            sides: vec![Counter::default(); CONTEXTS_V3 / 4 * 8],
-            lone_tree: vec![Counter::default(); PARENT_CLASSES * 256],
-            mixer: Mixer::new(SETS),
+            context: Counters::new(),
+            tree: Counters::new(),
+            sides: Counters::new(),
+            lone_tree: Counters::new(),
+            mixer: Mixer::new(),
         }
     }
 
@@ -76,29 +81,30 @@ impl MaskCoder {
 
     fn predict(&self, s: &Slots) -> Mix {
         let [a, c, d] = s.counters;
-        let inputs = [self.context[a], self.tree[c], self.sides[d]];
+        let inputs = [self.context.get(a), self.tree.get(c), self.sides.get(d)];
         self.mixer.predict(s.set, inputs)
     }
 
     fn learn(&mut self, s: &Slots, mix: &Mix, bit: bool) {
         self.mixer.learn(mix, bit);
         let [a, c, d] = s.counters;
-        self.context[a].update(bit);
-        self.tree[c].update(bit);
-        self.sides[d].update(bit);
+        self.context.at(a).update(bit);
+        self.tree.at(c).update(bit);
+        self.sides.at(d).update(bit);
     }
 
     /// Codes a non-empty child mask; `class` is the parent's child count − 1.
     pub fn encode(&mut self, enc: &mut RangeEncoder, around: &Around, class: u8, mask: u8) {
         debug_assert!(mask != 0);
         if around.is_empty() {
-            let tree = &mut self.lone_tree[usize::from(class & 7) * 256..][..256];
+            let tree = usize::from(class & 7) * 256;
             for k in 0..8 {
                 let so_far = mask & ((1u8 << k) - 1);
                 if k == 7 && so_far == 0 {
                     break;
                 }
-                tree[1 << k | usize::from(so_far)].encode(enc, (mask >> k) & 1 == 1);
+                let node = tree + (1 << k | usize::from(so_far));
+                self.lone_tree.at(node).encode(enc, (mask >> k) & 1 == 1);
             }
             return;
         }
@@ -121,12 +127,13 @@ impl MaskCoder {
     pub fn decode(&mut self, dec: &mut RangeDecoder<'_>, around: &Around, class: u8) -> u8 {
         let mut mask = 0u8;
         if around.is_empty() {
-            let tree = &mut self.lone_tree[usize::from(class & 7) * 256..][..256];
+            let tree = usize::from(class & 7) * 256;
             for k in 0..8 {
                 if k == 7 && mask == 0 {
                     return 0x80;
                 }
-                mask |= u8::from(tree[1 << k | usize::from(mask)].decode(dec)) << k;
+                let node = tree + (1 << k | usize::from(mask));
+                mask |= u8::from(self.lone_tree.at(node).decode(dec)) << k;
             }
             return mask;
         }

@@ -85,6 +85,30 @@ impl Counter {
     }
 }
 
+/// `N` counters (a power of two) indexed modulo `N`, which spares the
+/// bounds checks of the hot loop; callers' indices are below their
+/// context counts, so no two contexts share a counter.
+pub(crate) struct Counters<const N: usize>(Box<[Counter; N]>);
+
+impl<const N: usize> Counters<N> {
+    pub fn new() -> Self {
+        const { assert!(N.is_power_of_two()) };
+        let all: Box<[Counter]> = vec![Counter::default(); N].into_boxed_slice();
+        Counters(
+            all.try_into()
+                .unwrap_or_else(|_| unreachable!("N counters")),
+        )
+    }
+
+    pub fn get(&self, i: usize) -> Counter {
+        self.0[i & (N - 1)]
+    }
+
+    pub fn at(&mut self, i: usize) -> &mut Counter {
+        &mut self.0[i & (N - 1)]
+    }
+}
+
 /// The logistic function at x/2 for x = −16..=16, × 4096 (rounded):
 /// `squash` interpolates it, steps of 128 in its argument.
 const LOGISTIC: [i32; 33] = [
@@ -141,11 +165,15 @@ fn stretch(p1: u32) -> i32 {
 pub(crate) const INPUTS: usize = 3;
 
 /// Weights of the mix, 16.16 fixed point, one set per mixing context.
+/// Weight sets of a [`Mixer`] (indices taken modulo: the callers' are
+/// below 168).
+pub(crate) const SETS: usize = 256;
+
 pub(crate) struct Mixer {
-    weights: Vec<[i32; INPUTS]>,
+    weights: Box<[[i32; INPUTS]; SETS]>,
     /// Per set, a secondary estimate of P(bit = 1) (16-bit) at 33 points
     /// of the mix's stretched probability, interpolated.
-    refine: Vec<[u16; 33]>,
+    refine: Box<[[u16; 33]; SETS]>,
 }
 
 /// One bit's mix, kept between predicting and learning.
@@ -162,18 +190,23 @@ pub(crate) struct Mix {
 }
 
 impl Mixer {
-    pub fn new(sets: usize) -> Self {
+    pub fn new() -> Self {
+        let weights: Box<[_]> = vec![[FIRST_WEIGHT; INPUTS]; SETS].into_boxed_slice();
+        let first: [u16; 33] = std::array::from_fn(|j| (squash((j as i32 - 16) * 128) * 16) as u16);
+        let refine: Box<[_]> = vec![first; SETS].into_boxed_slice();
         Mixer {
-            weights: vec![[FIRST_WEIGHT; INPUTS]; sets],
-            refine: vec![
-                std::array::from_fn(|j| (squash((j as i32 - 16) * 128) * 16) as u16);
-                sets
-            ],
+            weights: weights
+                .try_into()
+                .unwrap_or_else(|_| unreachable!("SETS sets")),
+            refine: refine
+                .try_into()
+                .unwrap_or_else(|_| unreachable!("SETS sets")),
         }
     }
 
     /// The mixed P(bit = 1) of the counters in weight set `set`.
     pub fn predict(&self, set: usize, inputs: [Counter; INPUTS]) -> Mix {
+        let set = set & (SETS - 1);
         let stretched = inputs.map(|c| stretch(c.p1()));
         let w = &self.weights[set];
         let dot: i64 = (0..INPUTS)
@@ -262,7 +295,7 @@ mod tests {
     #[test]
     fn the_mix_follows_the_input_that_predicts() {
         // Input 0 always right, input 1 always wrong, the others unsure.
-        let mut mixer = Mixer::new(1);
+        let mut mixer = Mixer::new();
         let (mut right, mut wrong) = (Counter::default(), Counter::default());
         let mut bits = 0u32;
         for i in 0..2000 {
