@@ -104,7 +104,7 @@ fn main() {
             normals: attrs.then_some(nrm),
             ..vitrine_points::PointCloud::from_positions(pos)
         };
-        // Both stream versions (2: neighbour-dependent mask contexts).
+        // Every stream version (2 and 3: neighbour-dependent mask contexts).
         for version in vitrine_points::stream::VERSIONS {
             let opts = vitrine_points::stream::EncodeOptions {
                 bits: 10,

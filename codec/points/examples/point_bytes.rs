@@ -2,19 +2,20 @@
 //! triangles (area-weighted, seeded), as a positions-only scan arrives:
 //!
 //! ```sh
-//! cargo run --release -p vitrine-points --example point_bytes -- MESH [POINTS] [--write DIR]
+//! cargo run --release -p vitrine-points --example point_bytes -- MESH [POINTS] [--write DIR] [--positions-only]
 //! ```
 //! For 12 and 14 bits and each stream version, prints positions-only bytes,
 //! the bytes that normals (estimated as at ingest) add, encode and decode ms
 //! (median of 3), and (stderr) the time normal estimation takes. Colours: the
 //! sampled cloud has none (0 bytes). With
 //! `--write DIR`, writes DIR/NAME-POINTS.f32 (x y z little-endian f32) for
-//! the Draco comparison.
+//! the Draco comparison. With `--positions-only`, only the positions' bytes
+//! (each version's stream decoded once to check it; no normals, no times).
 
 use std::time::Instant;
 
 use vitrine_mesh::import::{import_path, ImportOptions};
-use vitrine_points::stream::{decode, encode, EncodeOptions, Limits};
+use vitrine_points::stream::{decode, encode, EncodeOptions, Limits, VERSIONS};
 use vitrine_points::testing::{next, unit};
 use vitrine_points::{estimate_normals, PointCloud, DEFAULT_K};
 
@@ -71,6 +72,9 @@ fn main() {
         args.drain(i..i + 2);
         std::path::PathBuf::from(dir)
     });
+    let positions_only = args.iter().position(|a| a == "--positions-only").map(|i| {
+        args.remove(i);
+    });
     let path = args.first().expect("usage: point_bytes MESH [POINTS]");
     let n: usize = args.get(1).map_or(300_000, |a| a.parse().expect("POINTS"));
     let mesh = import_path(path.as_ref(), &ImportOptions::default()).expect("import");
@@ -88,6 +92,28 @@ fn main() {
             .collect();
         std::fs::write(dir.join(format!("{name}-{n}.f32")), raw).expect("write");
     }
+    if positions_only.is_some() {
+        let cloud = PointCloud::from_positions(positions);
+        println!("cloud\tpoints\tbits\tversion\tposition_bytes\tpos_bits_per_point");
+        for bits in [12u8, 14] {
+            for version in VERSIONS {
+                let opts = EncodeOptions {
+                    bits,
+                    version,
+                    ..Default::default()
+                };
+                let pos = encode(&cloud, &opts).expect("encode");
+                let d = decode(&pos.bytes, None, Limits::default()).expect("decode");
+                assert_eq!(d.quantized(), &pos.quantized[..], "round trip");
+                println!(
+                    "{name}\t{n}\t{bits}\tv{version}\t{}\t{:.2}",
+                    pos.bytes.len(),
+                    pos.bytes.len() as f64 * 8.0 / n as f64,
+                );
+            }
+        }
+        return;
+    }
     // What the ingest (and, for a stream without normals, the viewer's
     // WebAssembly session) spends estimating them.
     let started = Instant::now();
@@ -103,7 +129,7 @@ fn main() {
     };
     println!("cloud\tpoints\tbits\tversion\tposition_bytes\tpos_bits_per_point\tnormal_bytes\tencode_ms\tdecode_ms");
     for bits in [12u8, 14] {
-        for version in [1u8, 2] {
+        for version in VERSIONS {
             let opts = EncodeOptions {
                 bits,
                 version,

@@ -4,11 +4,13 @@
 //! same bytes):
 //!
 //! ```sh
-//! cargo run --release -p vitrine-points --example point_time -- MESH [POINTS] [RUNS]
+//! cargo run --release -p vitrine-points --example point_time -- MESH [POINTS] [RUNS] [VERSIONS]
 //! ```
-//! Prints, for 12 and 14 bits and each version: bytes, fnv1a64 of the
-//! bytes, encode and decode ms (median of RUNS, default 7, the versions
-//! interleaved run by run so that load on a shared machine falls on all).
+//! Prints, for 12 and 14 bits and each version (VERSIONS: a comma list,
+//! default all; e.g. `3` alone to count one version's instructions under
+//! callgrind): bytes, fnv1a64 of the bytes, encode and decode ms (median of
+//! RUNS, default 7, the versions interleaved run by run so that load on a
+//! shared machine falls on all), and decode time against the first listed.
 
 use std::time::Instant;
 
@@ -76,6 +78,9 @@ fn main() {
         .expect("usage: point_time MESH [POINTS] [RUNS]");
     let n: usize = args.get(1).map_or(300_000, |a| a.parse().expect("POINTS"));
     let runs: usize = args.get(2).map_or(7, |a| a.parse().expect("RUNS"));
+    let versions: Vec<u8> = args.get(3).map_or(VERSIONS.collect(), |a| {
+        a.split(',').map(|v| v.parse().expect("VERSIONS")).collect()
+    });
     let mesh = import_path(path.as_ref(), &ImportOptions::default()).expect("import");
     let cloud = PointCloud::from_positions(sample(&mesh.positions, &mesh.triangles, n, 0x5eed));
     let name = std::path::Path::new(path)
@@ -83,15 +88,16 @@ fn main() {
         .unwrap()
         .to_string_lossy()
         .to_string();
-    println!("cloud\tpoints\tbits\tversion\tbytes\tfnv1a64\tencode_ms\tdecode_ms\tdecode_vs_v1");
+    println!("cloud\tpoints\tbits\tversion\tbytes\tfnv1a64\tencode_ms\tdecode_ms\tdecode_vs_first");
     for bits in [12u8, 14] {
         let opts = |version| EncodeOptions {
             bits,
             version,
             ..Default::default()
         };
-        let streams: Vec<_> = VERSIONS
-            .map(|v| encode(&cloud, &opts(v)).expect("encode"))
+        let streams: Vec<_> = versions
+            .iter()
+            .map(|&v| encode(&cloud, &opts(v)).expect("encode"))
             .collect();
         for s in &streams {
             let d = decode(&s.bytes, None, Limits::default()).expect("decode");
@@ -100,7 +106,7 @@ fn main() {
         let mut enc_ms = vec![Vec::new(); streams.len()];
         let mut dec_ms = vec![Vec::new(); streams.len()];
         for _ in 0..runs {
-            for (i, v) in VERSIONS.enumerate() {
+            for (i, &v) in versions.iter().enumerate() {
                 enc_ms[i].push(ms(|| {
                     std::hint::black_box(encode(&cloud, &opts(v)).expect("encode"));
                 }));
@@ -110,15 +116,15 @@ fn main() {
                 }));
             }
         }
-        let v1_decode = median(dec_ms[0].clone());
-        for (i, v) in VERSIONS.enumerate() {
+        let first_decode = median(dec_ms[0].clone());
+        for (i, v) in versions.iter().enumerate() {
             let decode_ms = median(dec_ms[i].clone());
             println!(
                 "{name}\t{n}\t{bits}\tv{v}\t{}\t{:016x}\t{:.0}\t{decode_ms:.0}\t{:.2}",
                 streams[i].bytes.len(),
                 fnv1a64(&streams[i].bytes),
                 median(enc_ms[i].clone()),
-                decode_ms / v1_decode,
+                decode_ms / first_decode,
             );
         }
     }

@@ -39,6 +39,10 @@ fn clouds() -> Vec<(&'static str, PointCloud, EncodeOptions)> {
         version: 2,
         ..small.clone()
     };
+    let small_v3 = EncodeOptions {
+        version: 3,
+        ..small.clone()
+    };
     let cube = PointCloud::from_positions(cube_pos);
     vec![
         (
@@ -53,15 +57,28 @@ fn clouds() -> Vec<(&'static str, PointCloud, EncodeOptions)> {
         ),
         (
             "v2-sphere-5000-normals-colours-14bit",
-            painted,
+            painted.clone(),
             small_v2.clone(),
         ),
         (
             "v2-cube-8000-positions-11bit",
-            cube,
+            cube.clone(),
             EncodeOptions {
                 bits: 11,
                 ..small_v2
+            },
+        ),
+        (
+            "v3-sphere-5000-normals-colours-14bit",
+            painted,
+            small_v3.clone(),
+        ),
+        (
+            "v3-cube-8000-positions-11bit",
+            cube,
+            EncodeOptions {
+                bits: 11,
+                ..small_v3
             },
         ),
     ]

@@ -2,7 +2,9 @@
 //! stream's order; every level a prefix and one point per occupied cell;
 //! truncated and corrupted streams give errors.
 
-use vitrine_points::stream::{decode, encode, split, EncodeOptions, Limits, PointDecoder};
+use vitrine_points::stream::{
+    decode, encode, split, EncodeOptions, Limits, PointDecoder, VERSIONS,
+};
 use vitrine_points::testing::{next, sphere, unit};
 use vitrine_points::PointCloud;
 
@@ -34,7 +36,10 @@ fn coloured_sphere(n: usize, seed: u64) -> PointCloud {
 #[test]
 fn stream_round_trip_is_bit_exact() {
     let cloud = coloured_sphere(20_000, 1);
-    for (bits, version) in [6u8, 11, 16].into_iter().flat_map(|b| [(b, 1u8), (b, 2)]) {
+    for (bits, version) in [6u8, 11, 16]
+        .into_iter()
+        .flat_map(|b| [(b, 1u8), (b, 2), (b, 3)])
+    {
         let opts = EncodeOptions {
             bits,
             base_points: 500,
@@ -100,7 +105,7 @@ fn stream_positions_only_round_trip_and_split() {
 
 #[test]
 fn stream_levels_are_prefixes_with_one_point_per_occupied_cell() {
-    for version in [1, 2] {
+    for version in [1, 2, 3] {
         levels_are_prefixes(version);
     }
 }
@@ -160,7 +165,7 @@ fn levels_are_prefixes(version: u8) {
 
 #[test]
 fn stream_truncated_or_corrupt_gives_errors() {
-    for version in [1, 2] {
+    for version in [1, 2, 3] {
         truncated_or_corrupt_gives_errors(version);
     }
 }
@@ -234,7 +239,7 @@ fn stream_single_point_and_all_duplicates() {
 }
 
 #[test]
-fn stream_v2_positions_only_is_smaller_and_levels_count_alike() {
+fn stream_v2_and_v3_positions_only_are_smaller_and_levels_count_alike() {
     // A surface sampled at random, as positions-only scans arrive.
     let (pos, _) = sphere(30_000, [0.0; 3], 1.0, 11);
     let cloud = PointCloud::from_positions(pos);
@@ -247,40 +252,54 @@ fn stream_v2_positions_only_is_smaller_and_levels_count_alike() {
         };
         encode(&cloud, &opts).unwrap()
     };
-    let (v1, v2) = (at(1), at(2));
+    let (v1, v2, v3) = (at(1), at(2), at(3));
     // The version changes only how masks are coded: same points, same order.
-    assert_eq!(v1.level_points, v2.level_points);
-    assert_eq!(v1.order, v2.order);
-    assert!(
-        v2.bytes.len() < v1.bytes.len(),
-        "v2 {} bytes, v1 {}",
-        v2.bytes.len(),
-        v1.bytes.len()
-    );
-    for level in 0..v2.header.levels() {
-        let d = decode(&v2.bytes, Some(level + 1), Limits::default()).unwrap();
-        assert_eq!(d.point_count(), v2.level_points[level] as usize);
+    for v in [&v2, &v3] {
+        assert_eq!(v1.level_points, v.level_points);
+        assert_eq!(v1.order, v.order);
+        for level in 0..v.header.levels() {
+            let d = decode(&v.bytes, Some(level + 1), Limits::default()).unwrap();
+            assert_eq!(d.point_count(), v.level_points[level] as usize);
+        }
     }
+    let (b1, b2, b3) = (v1.bytes.len(), v2.bytes.len(), v3.bytes.len());
+    assert!(b3 < b2 && b2 < b1, "v1 {b1} bytes, v2 {b2}, v3 {b3}");
 }
 
 #[test]
-fn stream_v2_hostile_header_and_version_byte() {
+fn stream_v2_and_v3_hostile_header_and_version_byte() {
+    for version in [2, 3] {
+        hostile_header_and_version_byte(version);
+    }
+}
+
+fn hostile_header_and_version_byte(version: u8) {
     let cloud = coloured_sphere(2_000, 4);
-    let v2 = EncodeOptions {
-        version: 2,
+    let opts = EncodeOptions {
+        version,
         ..EncodeOptions::default()
     };
-    let enc = encode(&cloud, &v2).unwrap();
-    assert_eq!(enc.header.version, 2);
-    // A v2 body read as v1 (or the reverse) must fail or stay in bounds.
-    let mut b = enc.bytes.clone();
-    b[4] = 1;
-    if let Ok(d) = decode(&b, None, Limits::default()) {
-        assert_eq!(d.point_count(), cloud.len());
-    }
-    for version in [0u8, 3, 255] {
+    let enc = encode(&cloud, &opts).unwrap();
+    assert_eq!(enc.header.version, version);
+    // A body read as another version's must fail or stay in bounds.
+    for other in VERSIONS.filter(|&v| v != version) {
         let mut b = enc.bytes.clone();
-        b[4] = version;
+        b[4] = other;
+        if let Ok(d) = decode(&b, None, Limits::default()) {
+            assert_eq!(d.point_count(), cloud.len());
+        }
+    }
+    // A chunk declaring a huge cumulative count, or a huge payload: errors.
+    let (_, chunks) = split(&enc.bytes).unwrap();
+    for field in [0, 4] {
+        let mut b = enc.bytes.clone();
+        let at = chunks[chunks.len() - 1].start + field;
+        b[at..at + 4].copy_from_slice(&u32::MAX.to_le_bytes());
+        assert!(decode(&b, None, Limits::default()).is_err());
+    }
+    for bad in [0u8, *VERSIONS.end() + 1, 255] {
+        let mut b = enc.bytes.clone();
+        b[4] = bad;
         assert!(decode(&b, None, Limits::default()).is_err());
     }
     // Every chunk's payload replaced by noise: errors, never a panic.
@@ -301,7 +320,7 @@ fn stream_v2_hostile_header_and_version_byte() {
     let r = encode(
         &cloud,
         &EncodeOptions {
-            version: 3,
+            version: VERSIONS.end() + 1,
             ..Default::default()
         },
     );

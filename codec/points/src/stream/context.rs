@@ -19,6 +19,13 @@
 /// neighbours (8) × occupied parent neighbours on the child's sides (0..=3).
 pub(crate) const CONTEXTS: usize = 8 * 3 * 5 * 8 * 4;
 
+/// Version 3's plane classes: 0 (no plane), then 1 + the thresholds e/8,
+/// e = 1..=5, that the child's distance reaches.
+pub(crate) const PLANES_V3: usize = 7;
+
+/// Version 3's context classes: version 2's with `PLANES_V3` plane classes.
+pub(crate) const CONTEXTS_V3: usize = 8 * 3 * PLANES_V3 * 8 * 4;
+
 /// What is known around one cell when its children are coded
 /// (`Neighbourhood::around` in `neighbourhood.rs`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -34,7 +41,8 @@ pub(crate) struct Around {
     pub plane: [u8; 8],
 }
 
-/// The occupied cells of a 3×3×3 block: count and moments of their offsets
+/// The occupied cells of a 3×3×3 block (version 3: the points of
+/// `plane_bins_quarters`): count and moments of their offsets
 /// (the centre cell counted, at offset 0).
 #[derive(Debug, Default, PartialEq, Eq)]
 pub(crate) struct Block {
@@ -70,11 +78,70 @@ impl Block {
     /// (so the normal is never shifted: 2^24 is its threshold), Σ F_ij² <
     /// 2^40, |t| < 3 · 2^19 · 63 < 2^27 and 4t² < 2^56.
     pub fn plane_bins(&self) -> [u8; 8] {
-        let n = self.count + 1;
-        if self.count < 3 {
+        let Some((normal, len2)) = self.normal() else {
+            return [0; 8];
+        };
+        debug_assert!(normal.iter().all(|v| v.abs() < 1 << 24), "never shifted");
+        self.bins::<3, 4>(normal, len2)
+    }
+
+    /// Version 3: [`plane_bins`](Self::plane_bins) of points given in
+    /// quarters of a cell (up to 504 besides the centre, coordinates in
+    /// −9..=9: |C_ab| < 2^26, so the cofactors stay below 2^53 before
+    /// `normal`'s shift), the normal shifted below 2^12 first: then
+    /// |t| < 3 · 2^12 · (505 + 4545) < 2^26 and 4t² < 2^54.
+    pub fn plane_bins_quarters(&self) -> [u8; 8] {
+        let Some((normal, _)) = self.normal() else {
+            return [0; 8];
+        };
+        let big = normal.iter().fold(0u64, |m, v| m.max(v.unsigned_abs()));
+        let shift = (64 - big.leading_zeros()).saturating_sub(12);
+        let normal = normal.map(|v| v >> shift);
+        let len2 = normal.iter().map(|v| v * v).sum::<i64>();
+        if len2 == 0 {
             return [0; 8];
         }
-        debug_assert!(self.count <= 26);
+        self.bins::<{ PLANES_V3 - 2 }, 1>(normal, len2)
+    }
+
+    /// Classes 1 + the thresholds e/8 (e = 1..=`T`) that the child's
+    /// distance reaches; offsets in cells (`SCALE` 4) or quarters (1).
+    fn bins<const T: usize, const SCALE: i64>(&self, normal: [i64; 3], len2: i64) -> [u8; 8] {
+        let n = self.count + 1;
+        let [s0, s1, s2] = self.sum;
+        // 4n × (child centre − centroid) · normal, in parent cells (child
+        // centres at ±1/4, ±1 quarter): Σ_a normal_a (±n − SCALE · S_a);
+        // child 7 − k has the opposite signs.
+        let [q0, q1, q2] = normal.map(|v| v * n);
+        let centroid = SCALE * (normal[0] * s0 + normal[1] * s1 + normal[2] * s2);
+        // |dist| / (4n |normal|) against e/8: 4 dist² vs e² n² |normal|².
+        let unit = n * n * len2;
+        let limits: [i64; T] = std::array::from_fn(|e| (e as i64 + 1).pow(2) * unit);
+        let class = |dist: i64| {
+            let lhs = 4 * dist * dist;
+            1 + limits.iter().map(|&l| u8::from(lhs >= l)).sum::<u8>()
+        };
+        let mut bins = [0u8; 8];
+        for (k, side) in [-q0 - q1 - q2, q0 - q1 - q2, -q0 + q1 - q2, q0 + q1 - q2]
+            .into_iter()
+            .enumerate()
+        {
+            bins[k] = class(side - centroid);
+            bins[7 - k] = class(-side - centroid);
+        }
+        bins
+    }
+
+    /// The normal of the plane fitted to the block's cells (the centre's
+    /// included) and its squared length, unnormalized (components below
+    /// 2^19, see [`plane_bins`](Self::plane_bins)); `None` with fewer
+    /// than 3 other cells or all of them on one line.
+    pub fn normal(&self) -> Option<([i64; 3], i64)> {
+        let n = self.count + 1;
+        if self.count < 3 {
+            return None;
+        }
+        debug_assert!(self.count <= 504);
         let [s0, s1, s2] = self.sum;
         let p = &self.products;
         // n² × the covariance; its adjugate's largest row is along the
@@ -93,6 +160,14 @@ impl Block {
         let f01 = c12 * c02 - c01 * c22;
         let f02 = c01 * c12 - c11 * c02;
         let f12 = c02 * c01 - c12 * c00;
+        // Version 3's points (`plane_bins_quarters`) bring a cofactor up
+        // to 2^53: shifted below 2^30 so that the rows' norms stay within
+        // 64 bits (never for version 2's 26 cells, below 2^19).
+        let big = [f00, f11, f22, f01, f02, f12]
+            .iter()
+            .fold(0u64, |m, v| m.max(v.unsigned_abs()));
+        let shift = (64 - big.leading_zeros()).saturating_sub(30);
+        let [f00, f11, f22, f01, f02, f12] = [f00, f11, f22, f01, f02, f12].map(|v| v >> shift);
         // The row with the largest norm, of equal ones the last.
         let (l0, l1, l2) = (
             f00 * f00 + f01 * f01 + f02 * f02,
@@ -106,29 +181,7 @@ impl Block {
         } else {
             ([f00, f01, f02], l0)
         };
-        if len2 == 0 {
-            return [0; 8];
-        }
-        debug_assert!(normal.iter().all(|v| v.abs() < 1 << 24), "never shifted");
-        // 4n × (child centre − centroid) · normal, in parent cells:
-        // Σ_a normal_a (±n − 4 S_a); child 7 − k has the opposite signs.
-        let [q0, q1, q2] = normal.map(|v| v * n);
-        let centroid = 4 * (normal[0] * s0 + normal[1] * s1 + normal[2] * s2);
-        // |dist| / (4n |normal|) against e/8: 4 dist² vs e² n² |normal|².
-        let unit = n * n * len2;
-        let class = |dist: i64| {
-            let lhs = 4 * dist * dist;
-            1 + u8::from(lhs >= unit) + u8::from(lhs >= 4 * unit) + u8::from(lhs >= 9 * unit)
-        };
-        let mut bins = [0u8; 8];
-        for (k, side) in [-q0 - q1 - q2, q0 - q1 - q2, -q0 + q1 - q2, q0 + q1 - q2]
-            .into_iter()
-            .enumerate()
-        {
-            bins[k] = class(side - centroid);
-            bins[7 - k] = class(-side - centroid);
-        }
-        bins
+        (len2 != 0).then_some((normal, len2))
     }
 }
 
@@ -166,6 +219,17 @@ impl Around {
     /// on its low sides (from the −e_a neighbours' masks). Child k's
     /// context is `contexts()[k] + CODED[k][so_far]`.
     pub fn contexts(&self) -> [u16; 8] {
+        self.contexts_with(self.plane, 5)
+    }
+
+    /// Version 3's [`contexts`](Self::contexts) (`PLANES_V3` plane
+    /// classes); child k's context is `contexts_v3()[k] +
+    /// CODED_V3[k][so_far]`.
+    pub fn contexts_v3(&self) -> [u16; 8] {
+        self.contexts_with(self.plane, PLANES_V3 as u16)
+    }
+
+    fn contexts_with(&self, plane: [u8; 8], planes: u16) -> [u16; 8] {
         // Byte k: child k's near faces; its face bits from the −e_a
         // neighbours' masks (for the k on the low side of axis a: bit
         // k + 2^a of minus[a]).
@@ -178,7 +242,7 @@ impl Around {
                 (near >> (8 * k)) as u16 & 0xFF,
                 (face >> (8 * k)) as u16 & 0xFF,
             );
-            *c = (k as u16 * 15 + u16::from(self.plane[k])) * 32 + face * 4 + near;
+            *c = (k as u16 * 3 * planes + u16::from(plane[k])) * 32 + face * 4 + near;
         }
         c
     }
@@ -225,7 +289,12 @@ const HIGH: [u8; 3] = [0xAA, 0xCC, 0xF0];
 /// The part of child k's context that the mask's bits below k
 /// (`so_far`) give: the bits set (0, 1, 2+) and the face bits on its high
 /// sides (its siblings at −e_a).
-pub(crate) static CODED: [[u16; 256]; 8] = {
+pub(crate) static CODED: [[u16; 256]; 8] = coded(5);
+
+/// `CODED` for version 3's `PLANES_V3` plane classes.
+pub(crate) static CODED_V3: [[u16; 256]; 8] = coded(PLANES_V3);
+
+const fn coded(planes: usize) -> [[u16; 256]; 8] {
     let mut t = [[0; 256]; 8];
     let mut k = 0;
     while k < 8 {
@@ -244,13 +313,13 @@ pub(crate) static CODED: [[u16; 256]; 8] = {
                 }
                 a += 1;
             }
-            t[k][so_far] = (set as usize * 160 + face * 4) as u16;
+            t[k][so_far] = (set as usize * planes * 32 + face * 4) as u16;
             so_far += 1;
         }
         k += 1;
     }
     t
-};
+}
 
 /// Morton key: x, y, z bits interleaved, x lowest.
 pub(crate) fn morton(q: [u32; 3]) -> u64 {

@@ -77,10 +77,15 @@ impl PointDecoder {
             )));
         }
         let models = Models::new(header.has_normals(), header.has_colours);
+        let neighbourhood = if header.version >= 3 {
+            Neighbourhood::wide()
+        } else {
+            Neighbourhood::default()
+        };
         Ok(PointDecoder {
             header,
             models,
-            neighbourhood: Neighbourhood::default(),
+            neighbourhood,
             level: 0,
             depth: 0,
             cells: Vec::new(),
@@ -210,7 +215,12 @@ impl PointDecoder {
             }
             for cell in &cells {
                 dec.check_overrun()?;
-                let mask = if v2 {
+                let mask = if self.header.version >= 3 {
+                    let around = self.neighbourhood.around(cell.at);
+                    let mask = self.models.masks_v3.decode(&mut dec, &around, cell.class);
+                    self.neighbourhood.record(mask);
+                    mask
+                } else if v2 {
                     let around = self.neighbourhood.around(cell.at);
                     let mask = self.models.decode_mask_v2(&mut dec, &around, cell.class);
                     self.neighbourhood.record(mask);

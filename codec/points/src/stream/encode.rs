@@ -24,7 +24,7 @@ pub struct EncodeOptions {
     pub normals: bool,
     /// Code the cloud's colours, when it has them.
     pub colours: bool,
-    /// Stream format version to write (1 or 2; 2 codes positions smaller).
+    /// Stream format version to write (1, 2 or 3; 2 and 3 code positions smaller).
     pub version: u8,
 }
 
@@ -177,7 +177,11 @@ pub fn encode(cloud: &PointCloud, opts: &EncodeOptions) -> Result<EncodedPoints>
     header.write(&mut bytes);
     let mut models = Models::new(normals.is_some(), colours.is_some());
     let mut order: Vec<u32> = Vec::with_capacity(n);
-    let mut neighbourhood = Neighbourhood::default();
+    let mut neighbourhood = if header.version >= 3 {
+        Neighbourhood::wide()
+    } else {
+        Neighbourhood::default()
+    };
     let mut cells = vec![Cell {
         at: [0; 3],
         start: 0,
@@ -215,7 +219,11 @@ pub fn encode(cloud: &PointCloud, opts: &EncodeOptions) -> Result<EncodedPoints>
                     children[k] = (s, e);
                     s = e;
                 }
-                if header.version >= 2 {
+                if header.version >= 3 {
+                    let around = neighbourhood.around(cell.at);
+                    models.masks_v3.encode(&mut enc, &around, cell.class, mask);
+                    neighbourhood.record(mask);
+                } else if header.version >= 2 {
                     let around = neighbourhood.around(cell.at);
                     models.encode_mask_v2(&mut enc, &around, cell.class, mask);
                     neighbourhood.record(mask);

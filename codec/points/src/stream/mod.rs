@@ -24,6 +24,8 @@ mod encode;
 mod format;
 mod models;
 mod neighbourhood;
+mod occupancy;
+mod probability;
 mod region;
 
 pub use attr::{octahedral_decode, octahedral_encode};

@@ -5,6 +5,7 @@ use vitrine_codec::entropy::{BitModel, IntModel, RangeDecoder, RangeEncoder};
 
 use super::attr::{colour_apply, colour_residual};
 use super::context::{Around, CODED, CONTEXTS};
+use super::occupancy::MaskCoder;
 
 /// Occupancy contexts: the parent's child count (1..=8) minus one.
 const PARENT_CLASSES: usize = 8;
@@ -35,6 +36,8 @@ pub(crate) struct Models {
     occupancy: Vec<BitModel>,
     /// Version 2: one model per neighbour context (`context.rs`).
     neighbour_occupancy: Vec<BitModel>,
+    /// Version 3: version 2's contexts, mixed.
+    pub masks_v3: MaskCoder,
     duplicates: IntModel,
     normal: [IntModel; 2],
     colour: [IntModel; 3],
@@ -47,6 +50,7 @@ impl Models {
         Models {
             occupancy: vec![BitModel::new(); PARENT_CLASSES * 256],
             neighbour_occupancy: vec![BitModel::new(); CONTEXTS],
+            masks_v3: MaskCoder::new(),
             duplicates: IntModel::new(),
             normal: [IntModel::new(), IntModel::new()],
             colour: [IntModel::new(), IntModel::new(), IntModel::new()],

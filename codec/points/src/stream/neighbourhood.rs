@@ -16,7 +16,8 @@
 //! are coded.
 
 use super::context::Around;
-use super::region::describe;
+use super::context::Block;
+use super::region::{describe, describe_v3, moments, offset_in_region};
 
 /// The cells of one depth, in coding order.
 #[derive(Default)]
@@ -86,6 +87,9 @@ pub(crate) struct Neighbourhood {
     /// Whether the cells' neighbour lists are kept (not at the last depth
     /// whose masks are coded: nothing reads them).
     lists: bool,
+    /// Version 3: planes fitted to the 4×4×4 region and the children
+    /// already coded.
+    wide: bool,
 }
 
 /// What a parent-level cell at `offset_code` from child k's parent gives
@@ -201,6 +205,14 @@ static SEEN_BY: [u8; 27] = {
 };
 
 impl Neighbourhood {
+    /// Version 3's: planes fitted to the 4×4×4 region of the cell.
+    pub fn wide() -> Self {
+        Neighbourhood {
+            wide: true,
+            ..Default::default()
+        }
+    }
+
     /// Starts coding the masks of the cells at `depth` (the masks of
     /// depth − 1 were all recorded); `last`: no depth follows.
     pub fn start_depth(&mut self, depth: u32, last: bool) {
@@ -249,6 +261,56 @@ impl Neighbourhood {
         cells.start.push(cells.neighbours.len() as u32);
     }
 
+    /// Version 3's plane classes for the cell `i`, child `k` of its
+    /// parent: the plane fitted to the region's cells `fitted` (region
+    /// bits), each as its centre or, where its mask is coded (`coded`,
+    /// before `i`), as the centres of its children, in quarter cells about
+    /// `i`'s centre (`FORMAT.md` "Version 3").
+    fn plane_v3(&self, fitted: u64, coded: u64, k: usize, i: u32) -> [u8; 8] {
+        // Each region byte's parent-level cell: its first child and mask.
+        let mut bytes = [(0u32, 0u8); 8];
+        for &(cell, code) in &self.sides[..self.side_count] {
+            bytes[usize::from(REACH[k][usize::from(code)].u)] = ((cell >> 8) as u32, cell as u8);
+        }
+        // The cells not coded yet from the per-byte tables, in quarters.
+        let far = moments(fitted & !coded, k);
+        let mut block = Block {
+            count: far.count,
+            sum: far.sum.map(|s| 4 * s),
+            products: far.products.map(|row| row.map(|p| 16 * p)),
+        };
+        let mut add = |q: [i64; 3]| {
+            block.count += 1;
+            for a in 0..3 {
+                block.sum[a] += q[a];
+                for b in a..3 {
+                    block.products[a][b] += q[a] * q[b];
+                }
+            }
+        };
+        let mut rest = fitted & coded;
+        while rest != 0 {
+            let b = rest.trailing_zeros();
+            rest &= rest - 1;
+            let d = offset_in_region(b, k).map(|v| 4 * i64::from(v));
+            let (first, m) = bytes[(b >> 3) as usize];
+            let index = first + u32::from(RANK[usize::from(m)][(b & 7) as usize]);
+            debug_assert!(index < i);
+            let mut children = self.cells.mask(index as usize);
+            while children != 0 {
+                let w = children.trailing_zeros() as i64;
+                children &= children - 1;
+                add([0, 1, 2].map(|a| d[a] + 2 * (w >> a & 1) - 1));
+            }
+        }
+        for a in 0..3 {
+            for b in 0..a {
+                block.products[a][b] = block.products[b][a];
+            }
+        }
+        block.plane_bins_quarters()
+    }
+
     /// What is known around the next cell to code (coding order), at `at`
     /// (coordinates at this depth): the masks of depth − 1 and those
     /// recorded at this depth. Must be followed by its [`record`](Self::record).
@@ -258,7 +320,6 @@ impl Neighbourhood {
             return Around::default();
         }
         let parents = &self.parents;
-        let cells = &mut self.cells;
         // Every parent has a child: the next cell's parent is this one or
         // the next.
         let mut p = self.parent;
@@ -277,6 +338,9 @@ impl Neighbourhood {
         // (written without branches, the next write overwriting an unused
         // one).
         let mut n = 0;
+        // The region's cells whose masks are coded: all children of the
+        // parent-level cells before the parent, the siblings before k.
+        let mut coded = ((1u64 << k) - 1) << (8 * reach[13].u);
         for e in 0..=listed_len(parents, p) {
             let (j, code) = if e == 0 {
                 (p, 13)
@@ -287,13 +351,23 @@ impl Neighbourhood {
             let cell = parents.cells[j];
             let r = &reach[usize::from(code)];
             region |= (cell << (8 * r.u)) & r.keep;
+            coded |= r.keep & 0u64.wrapping_sub(u64::from(j < p));
             minus_parent[usize::from(r.minus)] = j;
             self.sides[n] = (cell, code);
             n += usize::from(r.keep != 0);
         }
         self.side_count = n;
         self.k = k;
-        let mut r = describe(region, k);
+        let mut r = if self.wide {
+            let (mut r, fitted) = describe_v3(region, k);
+            if fitted != 0 {
+                r.plane = self.plane_v3(fitted, coded, k, i);
+            }
+            r
+        } else {
+            describe(region, k)
+        };
+        let (parents, cells) = (&self.parents, &self.cells);
         for (a, &j) in minus_parent[..3].iter().enumerate() {
             if r.faces >> (2 * a) & 1 == 1 {
                 // Child k ^ 2^a of the parent, or k | 2^a of the one at −e_a.
@@ -386,7 +460,111 @@ mod tests {
     }
 
     /// `FORMAT.md`'s definition, cell by cell through a map of the depth.
-    fn reference(cells: &HashMap<[u32; 3], usize>, masks: &[u8], at: [u32; 3], i: usize) -> Around {
+    /// `FORMAT.md`'s version 3 plane classes (points in quarter cells):
+    /// the cofactors in 128 bits, shifted below 2^30, the normal below
+    /// 2^12, five thresholds.
+    fn plane_bins_v3_i128(block: &Block) -> [u8; 8] {
+        let n = block.count + 1;
+        if block.count < 3 {
+            return [0; 8];
+        }
+        let c = |a: usize, b: usize| n * block.products[a][b] - block.sum[a] * block.sum[b];
+        let cof = |i: usize, j: usize| {
+            let (i1, i2, j1, j2) = ((i + 1) % 3, (i + 2) % 3, (j + 1) % 3, (j + 2) % 3);
+            i128::from(c(i1, j1)) * i128::from(c(i2, j2))
+                - i128::from(c(i1, j2)) * i128::from(c(i2, j1))
+        };
+        let rows = [0, 1, 2].map(|i| [0, 1, 2].map(|j| cof(i, j)));
+        let big = rows
+            .iter()
+            .flatten()
+            .map(|v| v.unsigned_abs())
+            .max()
+            .unwrap();
+        let shift = (128 - big.leading_zeros()).saturating_sub(30);
+        let rows = rows.map(|r| r.map(|v| v >> shift));
+        let norm2 = |r: &[i128; 3]| r.iter().map(|v| v * v).sum::<i128>();
+        let mut normal = [0; 3];
+        for r in &rows {
+            if norm2(r) >= norm2(&normal) {
+                normal = *r;
+            }
+        }
+        let big = normal.iter().map(|v| v.unsigned_abs()).max().unwrap();
+        let shift = (128 - big.leading_zeros()).saturating_sub(12);
+        let normal = normal.map(|v| v >> shift);
+        let len2 = norm2(&normal);
+        if len2 == 0 {
+            return [0; 8];
+        }
+        let n = i128::from(n);
+        let mut bins = [0u8; 8];
+        for (k, bin) in bins.iter_mut().enumerate() {
+            let dist: i128 = (0..3)
+                .map(|a| {
+                    let o = if (k >> a) & 1 == 1 { 1 } else { -1 };
+                    normal[a] * (o * n - i128::from(block.sum[a]))
+                })
+                .sum();
+            let lhs = 4 * dist * dist;
+            *bin = 1 + (1..=5).filter(|&e| lhs >= e * e * n * n * len2).count() as u8;
+        }
+        bins
+    }
+
+    /// Version 3's plane: of the 26 neighbours if at least 5 are occupied,
+    /// else of the 4×4×4 block on `at`'s side of its parent; each cell
+    /// as its centre or, if coded before cell `i`, its children's centres,
+    /// in quarter cells.
+    fn plane_v3(
+        cells: &HashMap<[u32; 3], usize>,
+        masks: &[u8],
+        at: [u32; 3],
+        i: usize,
+        near: &Block,
+    ) -> [u8; 8] {
+        let low = at.map(|v| if v % 2 == 0 { -2 } else { -1 });
+        let mut block = Block::default();
+        let mut used = 0;
+        for dz in low[2]..low[2] + 4 {
+            for dy in low[1]..low[1] + 4 {
+                for dx in low[0]..low[0] + 4 {
+                    let d = [dx, dy, dz];
+                    let q = [0, 1, 2].map(|a| at[a].wrapping_add_signed(d[a]));
+                    let Some(&j) = cells.get(&q).filter(|_| d != [0; 3]) else {
+                        continue;
+                    };
+                    if near.count >= 5 && d.iter().any(|v| v.abs() > 1) {
+                        continue;
+                    }
+                    used += 1;
+                    if j < i {
+                        for w in 0..8 {
+                            if masks[j] >> w & 1 == 1 {
+                                block.add([0, 1, 2].map(|a| 4 * d[a] + 2 * (w >> a & 1) - 1));
+                            }
+                        }
+                    } else {
+                        block.add(d.map(|v| 4 * v));
+                    }
+                }
+            }
+        }
+        if used < 3 {
+            return [0; 8];
+        }
+        let bins = plane_bins_v3_i128(&block);
+        assert_eq!(bins, block.plane_bins_quarters(), "64-bit plane classes");
+        bins
+    }
+
+    fn reference(
+        cells: &HashMap<[u32; 3], usize>,
+        masks: &[u8],
+        at: [u32; 3],
+        i: usize,
+        wide: bool,
+    ) -> Around {
         let mut r = Around::default();
         let mut block = Block::default();
         for dz in -1..=1i32 {
@@ -412,18 +590,26 @@ mod tests {
                 }
             }
         }
-        r.plane = plane_bins_i128(&block);
-        assert_eq!(r.plane, block.plane_bins(), "64-bit plane classes");
+        if wide {
+            r.plane = plane_v3(cells, masks, at, i, &block);
+        } else {
+            r.plane = plane_bins_i128(&block);
+            assert_eq!(r.plane, block.plane_bins(), "64-bit plane classes");
+        }
         r
     }
 
     /// Builds the octree of `points` (coordinates below 2^bits) depth by
     /// depth and checks every cell's `Around` against the reference.
-    fn check_cloud(points: &[[u32; 3]], bits: u32) {
+    fn check_cloud(points: &[[u32; 3]], bits: u32, wide: bool) {
         let mut keys: Vec<u64> = points.iter().map(|&p| morton(p)).collect();
         keys.sort_unstable();
         keys.dedup();
-        let mut n = Neighbourhood::default();
+        let mut n = if wide {
+            Neighbourhood::wide()
+        } else {
+            Neighbourhood::default()
+        };
         let mut planes = 0;
         for depth in 0..bits {
             let shift = 3 * (bits - depth);
@@ -441,7 +627,7 @@ mod tests {
             let masks: Vec<u8> = cells.iter().map(|c| c.1).collect();
             n.start_depth(depth, depth + 1 == bits);
             for (i, &q) in at.iter().enumerate() {
-                let want = reference(&map, &masks, q, i);
+                let want = reference(&map, &masks, q, i, wide);
                 assert_eq!(n.around(q), want, "depth {depth} cell {q:?}");
                 planes += usize::from(want.plane != [0; 8]);
                 n.record(masks[i]);
@@ -476,6 +662,7 @@ mod tests {
             .collect();
         points.extend((0..400).map(|_| [0; 3].map(|_| (next(&mut s) % 8) as u32)));
         points.extend((0..300).map(|_| [0; 3].map(|_| (next(&mut s) % 256) as u32)));
-        check_cloud(&points, bits);
+        check_cloud(&points, bits, false);
+        check_cloud(&points, bits, true);
     }
 }
