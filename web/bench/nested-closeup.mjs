@@ -40,6 +40,7 @@ const { values, positionals } = parseArgs({
     slug: { type: 'string', default: 'scan' },
     reference: { type: 'string' },
     orbit: { type: 'string' },
+    uniform: { type: 'boolean', default: false },
   },
 });
 const mesh = positionals[0] ?? values.db;
@@ -131,9 +132,43 @@ try {
   if (values.reference) await checkLeaf(page, closeup, target, values.reference);
   console.log(`  watertight after the zoom ${describeSeams(await seams(page))}`);
   if (values.orbit) await orbit(page, Number(values.orbit), bounds, size);
+  if (values.uniform) await uniform(cdpOptions(mbits), slug, manifest);
 } finally {
   await browser.close();
   await service.stop();
+}
+
+/**
+ * Emulated network conditions at `mbits` (0: none).
+ * @param {number} mbits
+ */
+function cdpOptions(mbits) {
+  const bytesPerSecond = (mbits * 1e6) / 8;
+  return mbits > 0 ? { offline: false, latency: 20, downloadThroughput: bytesPerSecond, uploadThroughput: bytesPerSecond } : null;
+}
+
+/**
+ * Today's uniform refinement of the same model for comparison
+ * (`?refine=uniform`, the same network): the time from navigation to the
+ * last level on screen, and the bytes it fetched.
+ * @param {ReturnType<typeof cdpOptions>} conditions
+ * @param {string} slug
+ * @param {any} manifest
+ */
+async function uniform(conditions, slug, manifest) {
+  const page = await browser.context.newPage();
+  const cdp = await browser.context.newCDPSession(page);
+  await cdp.send('Network.enable');
+  await cdp.send('Network.setCacheDisabled', { cacheDisabled: true });
+  if (conditions) await cdp.send('Network.emulateNetworkConditions', conditions);
+  const last = manifest.levels.length - 1;
+  const started = performance.now();
+  await page.goto(`${service.url}/m/${slug}?refine=uniform`);
+  await page.waitForFunction((last) => /** @type {any} */ (document.querySelector('vitrine-viewer'))?.viewer?.state.shownLevel === last, last, { timeout: 600_000, polling: 100 });
+  const ms = performance.now() - started;
+  const received = await page.evaluate(() => /** @type {any} */ (document.querySelector('vitrine-viewer')).viewer.state.received);
+  console.log(`  uniform refinement        the last level on screen ${(ms / 1000).toFixed(1)} s after navigation, ${(received / 1e6).toFixed(2)} MB fetched`);
+  await page.close();
 }
 
 /**
