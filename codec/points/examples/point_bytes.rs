@@ -15,7 +15,7 @@
 use std::time::Instant;
 
 use vitrine_mesh::import::{import_path, ImportOptions};
-use vitrine_points::stream::{decode, encode, EncodeOptions, Limits, VERSIONS};
+use vitrine_points::stream::{decode, encode, EncodeOptions, EncodedPoints, Limits, VERSIONS};
 use vitrine_points::testing::{next, unit};
 use vitrine_points::{estimate_normals, PointCloud, DEFAULT_K};
 
@@ -97,14 +97,7 @@ fn main() {
         println!("cloud\tpoints\tbits\tversion\tposition_bytes\tpos_bits_per_point");
         for bits in [12u8, 14] {
             for version in VERSIONS {
-                let opts = EncodeOptions {
-                    bits,
-                    version,
-                    ..Default::default()
-                };
-                let pos = encode(&cloud, &opts).expect("encode");
-                let d = decode(&pos.bytes, None, Limits::default()).expect("decode");
-                assert_eq!(d.quantized(), &pos.quantized[..], "round trip");
+                let (_, pos) = round_trip(&cloud, bits, version);
                 println!(
                     "{name}\t{n}\t{bits}\tv{version}\t{}\t{:.2}",
                     pos.bytes.len(),
@@ -130,14 +123,7 @@ fn main() {
     println!("cloud\tpoints\tbits\tversion\tposition_bytes\tpos_bits_per_point\tnormal_bytes\tencode_ms\tdecode_ms");
     for bits in [12u8, 14] {
         for version in VERSIONS {
-            let opts = EncodeOptions {
-                bits,
-                version,
-                ..Default::default()
-            };
-            let pos = encode(&bare, &opts).expect("encode");
-            let d = decode(&pos.bytes, None, Limits::default()).expect("decode");
-            assert_eq!(d.quantized(), &pos.quantized[..], "round trip");
+            let (opts, pos) = round_trip(&bare, bits, version);
             let encode_ms = median_ms(|| {
                 std::hint::black_box(encode(&bare, &opts).expect("encode"));
             });
@@ -154,4 +140,18 @@ fn main() {
             );
         }
     }
+}
+
+/// The cloud encoded at `bits` in `version`, checked to decode to the same
+/// grid points.
+fn round_trip(cloud: &PointCloud, bits: u8, version: u8) -> (EncodeOptions, EncodedPoints) {
+    let opts = EncodeOptions {
+        bits,
+        version,
+        ..Default::default()
+    };
+    let pos = encode(cloud, &opts).expect("encode");
+    let d = decode(&pos.bytes, None, Limits::default()).expect("decode");
+    assert_eq!(d.quantized(), &pos.quantized[..], "round trip");
+    (opts, pos)
 }

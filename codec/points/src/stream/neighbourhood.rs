@@ -416,12 +416,12 @@ mod tests {
         }
     }
 
-    /// `FORMAT.md`'s plane classes as first written: 128-bit cofactors and
-    /// the normal's shift.
-    fn plane_bins_i128(block: &Block) -> [u8; 8] {
+    /// The cofactors of the block's scatter matrix (times the cell count
+    /// squared), in 128 bits; `None` under three cells.
+    fn cofactor_rows_i128(block: &Block) -> Option<[[i128; 3]; 3]> {
         let n = block.count + 1;
         if block.count < 3 {
-            return [0; 8];
+            return None;
         }
         let c = |a: usize, b: usize| n * block.products[a][b] - block.sum[a] * block.sum[b];
         let cof = |i: usize, j: usize| {
@@ -429,7 +429,16 @@ mod tests {
             i128::from(c(i1, j1)) * i128::from(c(i2, j2))
                 - i128::from(c(i1, j2)) * i128::from(c(i2, j1))
         };
-        let rows = [0, 1, 2].map(|i| [0, 1, 2].map(|j| cof(i, j)));
+        Some([0, 1, 2].map(|i| [0, 1, 2].map(|j| cof(i, j))))
+    }
+
+    /// `FORMAT.md`'s plane classes as first written: 128-bit cofactors and
+    /// the normal's shift.
+    fn plane_bins_i128(block: &Block) -> [u8; 8] {
+        let n = block.count + 1;
+        let Some(rows) = cofactor_rows_i128(block) else {
+            return [0; 8];
+        };
         let norm2 = |r: &[i128; 3]| r.iter().map(|v| v * v).sum::<i128>();
         let mut normal = [0; 3];
         for r in &rows {
@@ -465,16 +474,9 @@ mod tests {
     /// 2^12, five thresholds.
     fn plane_bins_v3_i128(block: &Block) -> [u8; 8] {
         let n = block.count + 1;
-        if block.count < 3 {
+        let Some(rows) = cofactor_rows_i128(block) else {
             return [0; 8];
-        }
-        let c = |a: usize, b: usize| n * block.products[a][b] - block.sum[a] * block.sum[b];
-        let cof = |i: usize, j: usize| {
-            let (i1, i2, j1, j2) = ((i + 1) % 3, (i + 2) % 3, (j + 1) % 3, (j + 2) % 3);
-            i128::from(c(i1, j1)) * i128::from(c(i2, j2))
-                - i128::from(c(i1, j2)) * i128::from(c(i2, j1))
         };
-        let rows = [0, 1, 2].map(|i| [0, 1, 2].map(|j| cof(i, j)));
         let big = rows
             .iter()
             .flatten()

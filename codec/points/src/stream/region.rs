@@ -126,16 +126,23 @@ static MOMENTS: [[[u64; 2]; 256]; 8] = {
 /// 8 0.1 %; bunny 100 k preferred 8 by 0.15 %).
 const WIDE_BELOW: u32 = 5;
 
-/// The contexts' inputs from the region around child `k`, but the masks of
-/// its −e_a neighbours.
-pub(super) fn describe(region: u64, k: usize) -> Around {
+/// Child `k`'s face neighbours and −e edge flag from the region, with the
+/// region's cells that neighbour it.
+#[inline]
+fn faces_and_edges(region: u64, k: usize) -> (Around, u64) {
     let t = &TABLES[k];
     let mut r = Around::default();
     for (f, &bit) in t.faces.iter().enumerate() {
         r.faces |= ((region >> bit & 1) as u8) << f;
     }
     r.minus_edge = region & t.minus_edges != 0;
-    let occupied = region & t.neighbours;
+    (r, region & t.neighbours)
+}
+
+/// The contexts' inputs from the region around child `k`, but the masks of
+/// its −e_a neighbours.
+pub(super) fn describe(region: u64, k: usize) -> Around {
+    let (mut r, occupied) = faces_and_edges(region, k);
     let two = occupied & occupied.wrapping_sub(1);
     if two & two.wrapping_sub(1) != 0 {
         // At least 3 neighbours: a plane may be fitted.
@@ -150,17 +157,11 @@ pub(super) fn describe(region: u64, k: usize) -> Around {
 /// neighbours, else the whole region's but the cell's own; none if fewer
 /// than 3.
 pub(super) fn describe_v3(region: u64, k: usize) -> (Around, u64) {
-    let t = &TABLES[k];
-    let mut r = Around::default();
-    for (f, &bit) in t.faces.iter().enumerate() {
-        r.faces |= ((region >> bit & 1) as u8) << f;
-    }
-    r.minus_edge = region & t.minus_edges != 0;
-    let occupied = region & t.neighbours;
+    let (r, occupied) = faces_and_edges(region, k);
     let fitted = if occupied.count_ones() >= WIDE_BELOW {
         occupied
     } else {
-        region & t.others
+        region & TABLES[k].others
     };
     (r, if fitted.count_ones() >= 3 { fitted } else { 0 })
 }
