@@ -66,6 +66,8 @@ pub struct PartRows {
     batches: std::collections::BTreeMap<u32, (usize, usize)>,
     /// The index as served (`parts::index`), serialized on first use.
     pub index_json: std::sync::OnceLock<Bytes>,
+    /// Its compressed copies, each made on first use.
+    pub index_coded: super::precompressed::Precompressed,
 }
 
 impl PartRows {
@@ -82,6 +84,7 @@ impl PartRows {
             splits,
             batches,
             index_json: Default::default(),
+            index_coded: Default::default(),
         }
     }
 

@@ -26,6 +26,7 @@ mod oembed;
 mod ops;
 mod parts;
 mod payload;
+mod precompressed;
 mod routes;
 mod scene;
 mod servable;

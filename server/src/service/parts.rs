@@ -23,6 +23,7 @@ use super::payload::{
     cache_control, level_bytes, not_modified, not_modified_response, parse_id, payload_response,
     within_cap, OCTET_STREAM,
 };
+use super::precompressed::{coding_headers, preferred};
 use super::servable::{PathParams, ServableModel};
 use super::visitor::{HintQuery, VisitorHints};
 use super::AppState;
@@ -169,6 +170,7 @@ pub async fn index(
     State(state): State<AppState>,
     PathParams(IndexParams { id }): PathParams<IndexParams>,
     hints: VisitorHints,
+    request: HeaderMap,
 ) -> Result<Response, AppError> {
     let id = parse_id(&id, "compression id")?;
     let record = state.record_by_compression(id).await?;
@@ -199,7 +201,11 @@ pub async fn index(
         (axum::http::header::CACHE_CONTROL, cache),
         (axum::http::header::CONTENT_TYPE, "application/json"),
     ];
-    Ok((headers, json).into_response())
+    // Compressed once per coding, not by the compression layer per request.
+    let coding = preferred(&request);
+    let mut response = (headers, stored.index_coded.encoded(&json, coding)).into_response();
+    coding_headers(coding, response.headers_mut());
+    Ok(response)
 }
 
 /// The index of a compression's parts, from its stored rows.

@@ -64,6 +64,34 @@ pub async fn nested_parts_served_under_caps(db: TestDb) {
     let reply = get(&app, &url, &[]).await;
     assert_eq!(reply.status, StatusCode::OK);
     let index = reply.json();
+    // Compressed once per coding, as the client asks: the same JSON once
+    // decoded; nothing compressed for a client that asks for no coding.
+    assert_eq!(reply.header(header::CONTENT_ENCODING), "");
+    for (accept, coding) in [
+        ("gzip, deflate, br, zstd", "br"),
+        ("gzip;q=1, br;q=0", "gzip"),
+    ] {
+        let coded = get(&app, &url, &[("accept-encoding", accept)]).await;
+        assert_eq!(coded.status, StatusCode::OK);
+        assert_eq!(coded.header(header::CONTENT_ENCODING), coding, "{accept}");
+        let vary = coded.header(header::VARY).to_ascii_lowercase();
+        assert!(vary.contains("accept-encoding"), "{vary}");
+        let mut plain = Vec::new();
+        let read = if coding == "br" {
+            std::io::Read::read_to_end(
+                &mut brotli::Decompressor::new(&coded.body[..], 4096),
+                &mut plain,
+            )
+        } else {
+            std::io::Read::read_to_end(
+                &mut flate2::read::GzDecoder::new(&coded.body[..]),
+                &mut plain,
+            )
+        };
+        read.unwrap();
+        assert_eq!(plain, reply.body, "{accept}");
+        assert!(coded.body.len() < reply.body.len() / 3, "{accept}");
+    }
     let table = nested_part_table(stream, Limits::default()).unwrap();
     let step = f64::from(StreamIndex::parse(stream).unwrap().header.quantization.step);
     assert_eq!(
