@@ -16,7 +16,7 @@
  * keeps the largest errors, a bound.
  */
 
-import { SCREEN_ERROR_PX, byLeastNeeded, byNeed, frustumPlanes, onScreen, refinementError, sight } from './part-selection.js';
+import { SCREEN_ERROR_PX, byLeastNeeded, byNeed, frustumPlanes, onScreen, refinementError, remainingMax, sight } from './part-selection.js';
 
 /**
  * The part index of a nested stream as the service sends it (`GET …/parts`).
@@ -104,14 +104,7 @@ export function nestedTable(index) {
     children[phase][s.parent] = [s.first_child, s.first_child + s.children];
   }
   /** @param {(part: NestedPartEntry) => number} of */
-  const suffixMax = (of) =>
-    parts.map((phase) =>
-      phase.map((chart) => {
-        const r = new Array(chart.length + 1).fill(0);
-        for (let d = chart.length - 1; d >= 0; d--) r[d] = Math.max(of(chart[d]), r[d + 1]);
-        return r;
-      }),
-    );
+  const suffixMax = (of) => parts.map((phase) => phase.map((chart) => remainingMax(chart, of)));
   /** @param {number[][][]} own */
   const descendants = (own) => {
     const below = charts.map((n) => new Array(n).fill(0));

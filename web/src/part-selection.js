@@ -259,14 +259,26 @@ export function partTable(index) {
   for (const [chart, parts] of table.entries()) {
     for (let d = 0; d < depths; d++) if (!parts[d]) throw new Error(`the part index has no part for chart ${chart} at level ${index.first_level + d}`);
   }
-  /** @param {(part: PartIndex['parts'][number]) => number} of */
-  const suffixMax = (of) =>
-    table.map((parts) => {
-      const r = new Array(depths + 1).fill(0);
-      for (let d = depths - 1; d >= 0; d--) r[d] = Math.max(of(parts[d]), r[d + 1]);
-      return r;
-    });
-  return { table, remaining: suffixMax(refinementError), bound: suffixMax((p) => p.error), finalDepth: depths };
+  return {
+    table,
+    remaining: table.map((parts) => remainingMax(parts, refinementError)),
+    bound: table.map((parts) => remainingMax(parts, (p) => p.error)),
+    finalDepth: depths,
+  };
+}
+
+/**
+ * For a chart's parts in order, `r[d]` is the largest `of(part)` over part
+ * `d` and every later one (`r[parts.length]` is 0): the error still to come
+ * once `d` parts are applied.
+ * @template T
+ * @param {T[]} parts
+ * @param {(part: T) => number} of
+ */
+export function remainingMax(parts, of) {
+  const r = new Array(parts.length + 1).fill(0);
+  for (let d = parts.length - 1; d >= 0; d--) r[d] = Math.max(of(parts[d]), r[d + 1]);
+  return r;
 }
 
 /**
