@@ -33,7 +33,7 @@ pub mod storage;
 pub mod study;
 
 pub use commands::ingest::{run as run_ingest, IngestArgs};
-pub use commands::models::models_table;
+pub use commands::models::models_listing;
 pub use commands::token::new_token;
 pub use commands::Command;
 #[cfg(feature = "dev-tools")]

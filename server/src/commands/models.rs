@@ -4,7 +4,7 @@
 //! models that state none are counted).
 
 use crate::database::open_storage;
-use crate::storage::{ConnectOptions, ModelKind, ModelSummary};
+use crate::storage::{ConnectOptions, ModelKind, ModelSummary, Storage};
 use std::fmt::Write as _;
 use vitrine_codec::{CHARTED_VERSION, NESTED_VERSION};
 
@@ -18,9 +18,18 @@ pub struct ModelsArgs {
     pub check: bool,
 }
 
+/// What `vitrine models` prints for `storage`, and how many models must be
+/// ingested again because this build does not read their stream format.
+pub async fn models_listing(storage: &dyn Storage) -> crate::storage::Result<(String, usize)> {
+    let models = storage.list_models().await?;
+    let unmeasured = storage.slugs_with_unmeasured_parts().await?;
+    Ok(models_table(&models, &unmeasured))
+}
+
 /// One line per model (its visible version), and how many must be ingested
-/// again because this build does not read their stream format.
-pub fn models_table(models: &[ModelSummary]) -> (String, usize) {
+/// again because this build does not read their stream format;
+/// `unmeasured_slugs` names the models whose parts lack a bulk error.
+fn models_table(models: &[ModelSummary], unmeasured_slugs: &[String]) -> (String, usize) {
     let width = models
         .iter()
         .map(|m| m.slug.len())
@@ -44,7 +53,7 @@ pub fn models_table(models: &[ModelSummary]) -> (String, usize) {
                 "{} (no part index: ingest it again to refine where visitors look)",
                 m.stream_format
             )
-        } else if charted && m.parts_lack_bulk_error {
+        } else if charted && unmeasured_slugs.contains(&m.slug) {
             unmeasured += 1;
             format!(
                 "{} (parts without a bulk error: ingest it again so visitors' \
@@ -89,7 +98,7 @@ pub fn models_table(models: &[ModelSummary]) -> (String, usize) {
 pub async fn run(args: ModelsArgs) -> anyhow::Result<()> {
     super::init_tracing();
     let storage = open_storage(&args.db, &ConnectOptions::default(), false).await?;
-    let (table, stale) = models_table(&storage.list_models().await?);
+    let (table, stale) = models_listing(&*storage).await?;
     println!("{table}");
     if args.check && stale > 0 {
         anyhow::bail!("{stale} model(s) must be ingested again (vitrine ingest … --new-version)");

@@ -64,10 +64,9 @@ pub struct PartRows {
     /// Each parted batch's phase and chart count, by batch: what slicing
     /// the batch after it needs, looked up per part request.
     batches: std::collections::BTreeMap<u32, (usize, usize)>,
-    /// The index as served (`parts::index`), serialized on first use.
-    pub index_json: std::sync::OnceLock<Bytes>,
-    /// Its compressed copies, each made on first use.
-    pub index_coded: super::precompressed::Precompressed,
+    /// The index as served (`parts::index`): its JSON and compressed
+    /// copies, each made on first use.
+    pub index: super::precompressed::Precompressed,
 }
 
 impl PartRows {
@@ -83,8 +82,7 @@ impl PartRows {
             parts,
             splits,
             batches,
-            index_json: Default::default(),
-            index_coded: Default::default(),
+            index: Default::default(),
         }
     }
 

@@ -62,21 +62,48 @@ pub fn preferred(headers: &HeaderMap) -> Coding {
     }
 }
 
-/// One answer's body, and its compressed copies once asked for.
+/// One answer's body, serialized on first use, and its compressed copies
+/// once asked for.
 #[derive(Debug, Default)]
 pub struct Precompressed {
+    body: OnceLock<Bytes>,
     brotli: OnceLock<Bytes>,
     gzip: OnceLock<Bytes>,
 }
 
 impl Precompressed {
-    /// `body` in `coding`, compressed on the first call for that coding.
-    pub fn encoded(&self, body: &Bytes, coding: Coding) -> Bytes {
+    /// The body in `coding`, if it was already made: what a request task
+    /// may take without blocking.
+    pub fn ready(&self, coding: Coding) -> Option<Bytes> {
         match coding {
-            Coding::Identity => body.clone(),
-            Coding::Gzip => self.gzip.get_or_init(|| gzip(body)).clone(),
-            Coding::Brotli => self.brotli.get_or_init(|| brotli(body)).clone(),
+            Coding::Identity => &self.body,
+            Coding::Gzip => &self.gzip,
+            Coding::Brotli => &self.brotli,
         }
+        .get()
+        .cloned()
+    }
+
+    /// The body in `coding`: made by `make` and compressed on the first
+    /// call for that coding. Brotli of a large index takes some 0.1 s, so
+    /// call this where blocking is allowed (`spawn_blocking`).
+    pub fn encoded<E>(
+        &self,
+        coding: Coding,
+        make: impl FnOnce() -> Result<Bytes, E>,
+    ) -> Result<Bytes, E> {
+        let body = match self.body.get() {
+            Some(body) => body.clone(),
+            None => {
+                let made = make()?;
+                self.body.get_or_init(|| made).clone()
+            }
+        };
+        Ok(match coding {
+            Coding::Identity => body,
+            Coding::Gzip => self.gzip.get_or_init(|| gzip(&body)).clone(),
+            Coding::Brotli => self.brotli.get_or_init(|| brotli(&body)).clone(),
+        })
     }
 }
 
@@ -138,8 +165,11 @@ mod tests {
     fn copies_decode_to_the_body_and_are_made_once() {
         let body = Bytes::from(br#"{"parts":[1,2,3,1,2,3,1,2,3,1,2,3]}"#.repeat(200));
         let kept = Precompressed::default();
-        let gz = kept.encoded(&body, Coding::Gzip);
-        let br = kept.encoded(&body, Coding::Brotli);
+        assert_eq!(kept.ready(Coding::Identity), None);
+        let made = || Ok::<_, ()>(body.clone());
+        let gz = kept.encoded(Coding::Gzip, made).unwrap();
+        assert_eq!(kept.ready(Coding::Brotli), None);
+        let br = kept.encoded(Coding::Brotli, made).unwrap();
         assert!(gz.len() < body.len() / 10 && br.len() < body.len() / 10);
         let mut plain = Vec::new();
         std::io::Read::read_to_end(&mut flate2::read::GzDecoder::new(&gz[..]), &mut plain).unwrap();
@@ -148,8 +178,13 @@ mod tests {
         std::io::Read::read_to_end(&mut brotli::Decompressor::new(&br[..], 4096), &mut plain)
             .unwrap();
         assert_eq!(plain, body);
-        // The same bytes, not compressed again.
-        assert_eq!(kept.encoded(&body, Coding::Gzip).as_ptr(), gz.as_ptr());
-        assert_eq!(kept.encoded(&body, Coding::Identity), body);
+        // The same bytes, not made or compressed again.
+        let never = || Err::<Bytes, _>("made twice");
+        assert_eq!(
+            kept.encoded(Coding::Gzip, never).unwrap().as_ptr(),
+            gz.as_ptr()
+        );
+        assert_eq!(kept.ready(Coding::Brotli).unwrap().as_ptr(), br.as_ptr());
+        assert_eq!(kept.encoded(Coding::Identity, never).unwrap(), body);
     }
 }

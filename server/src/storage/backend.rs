@@ -249,12 +249,16 @@ macro_rules! sql_storage {
                             has_thumbnail: row.try_get("has_thumbnail").map_err(c)?,
                             licence: row.try_get("licence").map_err(c)?,
                             has_parts: row.try_get("has_parts").map_err(c)?,
-                            parts_lack_bulk_error: row
-                                .try_get("parts_lack_bulk_error")
-                                .map_err(c)?,
                         })
                     })
                     .collect()
+            }
+
+            async fn slugs_with_unmeasured_parts(&self) -> $crate::storage::Result<Vec<String>> {
+                sqlx::query_scalar($crate::storage::sql::UNMEASURED_PARTS)
+                    .fetch_all(&self.pool)
+                    .await
+                    .map_err(Self::classify)
             }
 
             async fn model_by_slug(

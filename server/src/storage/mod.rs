@@ -109,6 +109,13 @@ pub trait Storage:
     /// The visible version of every model, by slug.
     async fn list_models(&self) -> Result<Vec<ModelSummary>>;
 
+    /// The models whose visible version has parts measured before their bulk
+    /// error was: viewers refine those by the largest error (ingest again).
+    /// Reads every part row: for `vitrine models`, not the visitors' list.
+    async fn slugs_with_unmeasured_parts(&self) -> Result<Vec<String>> {
+        Ok(Vec::new())
+    }
+
     /// The visible version of `slug` with its newest compression.
     async fn model_by_slug(&self, slug: &str) -> Result<Option<ModelRecord>>;
 

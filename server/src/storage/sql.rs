@@ -42,11 +42,20 @@ pub(super) const TEXTURES: &str = "SELECT t.id, t.kind, t.media_type, t.byte_len
      WHERE tm.id = $1 ORDER BY t.id";
 pub(super) const LIST: &str = "SELECT m.slug, m.title, m.version, m.kind, m.created_at, p.public_access, c.batch_count, c.codec_version, m.licence, m.language, \
      (th.model_id IS NOT NULL) AS has_thumbnail, \
-     EXISTS (SELECT 1 FROM stream_part sp WHERE sp.compression_id = c.id) AS has_parts, \
-     EXISTS (SELECT 1 FROM stream_part sp WHERE sp.compression_id = c.id AND sp.bulk_error IS NULL) AS parts_lack_bulk_error \
+     EXISTS (SELECT 1 FROM stream_part sp WHERE sp.compression_id = c.id) AS has_parts \
      FROM model m JOIN audience_policy p ON p.id = m.policy_id JOIN compression c ON c.model_id = m.id \
      LEFT JOIN thumbnail th ON th.model_id = m.id \
      WHERE m.status = 'ready' \
+     AND m.version = (SELECT MAX(m2.version) FROM model m2 WHERE m2.slug = m.slug AND m2.status = 'ready') \
+     AND c.id = (SELECT MAX(c2.id) FROM compression c2 WHERE c2.model_id = m.id) \
+     ORDER BY m.slug";
+/// The slugs whose visible version's newest compression has parts measured
+/// before their bulk error was (`vitrine models` only: it reads every part
+/// row, which the model list served to visitors must not).
+pub(super) const UNMEASURED_PARTS: &str = "SELECT DISTINCT m.slug FROM model m \
+     JOIN compression c ON c.model_id = m.id \
+     JOIN stream_part sp ON sp.compression_id = c.id \
+     WHERE m.status = 'ready' AND sp.bulk_error IS NULL \
      AND m.version = (SELECT MAX(m2.version) FROM model m2 WHERE m2.slug = m.slug AND m2.status = 'ready') \
      AND c.id = (SELECT MAX(c2.id) FROM compression c2 WHERE c2.model_id = m.id) \
      ORDER BY m.slug";

@@ -223,10 +223,6 @@ pub struct ModelSummary {
     /// before they were has none, and streams whole batches only.
     #[serde(skip)]
     pub has_parts: bool,
-    /// Some of its parts were measured before their bulk error was: the
-    /// viewer refines them by their largest (ingest it again).
-    #[serde(skip)]
-    pub parts_lack_bulk_error: bool,
     /// The BCP 47 tag of `title`, when stated.
     #[serde(skip)]
     pub language: Option<String>,

@@ -45,7 +45,7 @@ pub async fn nested_parts_served_under_caps(db: TestDb) {
         .expect("ingest");
     }
     let app = app(AppState::new(db.storage.clone(), test_config()));
-    let (listing, stale) = vitrine::models_table(&db.storage.list_models().await.unwrap());
+    let (listing, stale) = vitrine::models_listing(&*db.storage).await.unwrap();
     assert_eq!(stale, 0, "{listing}");
     assert!(
         listing.ends_with(
@@ -242,7 +242,7 @@ pub async fn nested_parts_served_under_caps(db: TestDb) {
     // listing names both models, and a service started afresh sends each
     // part's largest error as its bulk, so a viewer refines by it as then.
     db.execute("UPDATE stream_part SET bulk_error = NULL").await;
-    let (listing, _) = vitrine::models_table(&db.storage.list_models().await.unwrap());
+    let (listing, _) = vitrine::models_listing(&*db.storage).await.unwrap();
     assert!(
         listing.ends_with("; 2 with parts measured before their bulk error"),
         "{listing}"

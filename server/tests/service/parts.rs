@@ -44,7 +44,7 @@ pub async fn parts_served_under_caps(db: TestDb) {
         .expect("ingest");
     }
     let app = app(AppState::new(db.storage.clone(), test_config()));
-    let (table, _) = vitrine::models_table(&db.storage.list_models().await.unwrap());
+    let (table, _) = vitrine::models_listing(&*db.storage).await.unwrap();
     assert!(
         table.ends_with(
             "; 0 charted without a part index; 0 with parts measured before their bulk error"

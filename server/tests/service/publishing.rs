@@ -83,7 +83,7 @@ pub async fn rights_served_and_carried(db: TestDb) {
         .await
         .unwrap();
     // `vitrine models`: the licence of each, and the public ones without.
-    let (table, _) = vitrine::models_table(&db.storage.list_models().await.unwrap());
+    let (table, _) = vitrine::models_listing(&*db.storage).await.unwrap();
     let licence_of = |slug: &str| {
         let line = table.lines().find(|l| l.starts_with(slug)).unwrap();
         line.split_whitespace().nth(5).unwrap().to_owned()
