@@ -17,15 +17,19 @@
 # the bound, nobody mixes versions), rolling (SIGTERM, restart, next, under a
 # crowd: no request lost), pg_restart (cached batches flow, uncached answers
 # 503 + Retry-After, recovery without restarting Vitrine), leak (a
-# researcher's manifest never reaches a public visitor through the cache).
+# researcher's manifest never reaches a public visitor through the cache),
+# versus (the same crowds against nginx serving the same bytes as static
+# files, alternated: what Vitrine adds to the proxy's cost).
 #
 # Environment: VISITORS (5000; short 300), TOPO_PG_PORT (25533), TOPO_PORT
 # (18200: nginx; +1, +2 the instances), NO_BUILD (use the built binaries),
-# KEEP_WORK (keep the work directory), COHERENCE_BOUND_S (5), BIN_DIR
+# KEEP_WORK (keep the work directory), TOPO_CHECKS (the checks to run, by
+# name: "versus_static" alone for issue 46's benchmark), COHERENCE_BOUND_S (5), BIN_DIR
 # (target/release: where vitrine and vitrine-load are).
 # Never touches the shared PostgreSQL on 5432. Needs root for runuser
 # (PostgreSQL refuses to run as root) and installs nginx with apt-get when
-# it is missing.
+# it is missing. Check 8 (versus) and its environment are in
+# scripts/topology-versus-static.sh.
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 cd "$root"
@@ -145,12 +149,19 @@ sed -e "s|^pid .*|pid $work/nginx/nginx.pid;|" \
     -e "s|listen 80 |listen 127.0.0.1:$port |" \
     -e "s|^worker_processes .*|worker_processes 2;|" \
     -e "s|^http {|http {\n    client_body_temp_path $work/nginx/tmp/body;\n    proxy_temp_path $work/nginx/tmp/proxy;\n    fastcgi_temp_path $work/nginx/tmp/fastcgi;\n    uwsgi_temp_path $work/nginx/tmp/uwsgi;\n    scgi_temp_path $work/nginx/tmp/scgi;|" \
-    "$root/deploy/nginx.conf" >"$work/nginx/nginx.conf"
+    "$root/deploy/nginx.conf" >"$work/nginx/rendered.conf"
+# Check 8's static server block in the same nginx, before the last `}`.
+# shellcheck source=scripts/topology-versus-static.sh
+source "$root/scripts/topology-versus-static.sh"
+{ sed '$d' "$work/nginx/rendered.conf"; versus_static_server; } >"$work/nginx/nginx.conf"
 # As root nginx's workers would run as nobody; keep them ours.
 "$nginx_bin" -p "$work/nginx" -c "$work/nginx/nginx.conf" -t -q -g "user $(id -un);"
-"$nginx_bin" -p "$work/nginx" -c "$work/nginx/nginx.conf" -g "daemon off; user $(id -un);" 2>>"$work/nginx/logs/stderr.log" &
-nginx_pid=$!
-for _ in $(seq 1 100); do [ "$(code "$proxy/nginx-healthz")" = 200 ] && break; sleep 0.1; done
+start_nginx() {
+    "$nginx_bin" -p "$work/nginx" -c "$work/nginx/nginx.conf" -g "daemon off; user $(id -un);" 2>>"$work/nginx/logs/stderr.log" &
+    nginx_pid=$!
+    for _ in $(seq 1 100); do [ "$(code "$proxy/nginx-healthz")" = 200 ] && break; sleep 0.1; done
+}
+start_nginx
 access=$work/nginx/logs/access.log
 
 profile=$work/profile.json
@@ -472,13 +483,10 @@ AGENTS
 }
 
 started=$(now)
-check_leak
-check_device
-check_crowd
-check_kill
-check_ingest
-check_rolling
-check_pg_restart
+for check in ${TOPO_CHECKS:-leak device crowd kill ingest rolling pg_restart versus_static}; do
+    [ "$check" != versus_static ] || versus_fill_static_root
+    "check_$check"
+done
 echo
 echo "topology checks took $(since "$started") s (after setup); results: $results"
 cat "$results"
