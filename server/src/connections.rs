@@ -2,11 +2,13 @@
 //! a deadline (axum `examples/serve-with-hyper`, `examples/graceful-shutdown`).
 
 use crate::service::PeerAddr;
-use axum::Router;
+use axum::response::Response;
+use hyper::body::Incoming;
 use hyper_util::rt::{TokioExecutor, TokioIo, TokioTimer};
 use hyper_util::server::conn::auto::Builder;
 use hyper_util::server::graceful::GracefulShutdown;
 use hyper_util::service::TowerToHyperService;
+use std::convert::Infallible;
 use std::future::Future;
 use std::time::Duration;
 use tokio::net::TcpListener;
@@ -35,14 +37,23 @@ impl Default for ServeLimits {
     }
 }
 
-/// Serves `app` on `listener` until `shutdown` resolves, then lets open
-/// requests finish for up to `limits.shutdown_grace`.
-pub async fn serve(
+/// Serves `app` (a router, or one behind the payload fast path) on
+/// `listener` until `shutdown` resolves, then lets open requests finish for
+/// up to `limits.shutdown_grace`.
+pub async fn serve<S>(
     listener: TcpListener,
-    app: Router,
+    app: S,
     limits: ServeLimits,
     shutdown: impl Future<Output = ()>,
-) -> std::io::Result<()> {
+) -> std::io::Result<()>
+where
+    S: tower::Service<axum::http::Request<Incoming>, Response = Response, Error = Infallible>
+        + Clone
+        + Send
+        + Sync
+        + 'static,
+    S::Future: Send + 'static,
+{
     let mut builder = Builder::new(TokioExecutor::new());
     builder
         .http1()
@@ -71,7 +82,7 @@ pub async fn serve(
         let _ = stream.set_nodelay(true);
         // The peer, for the visitor's address (service::visitor).
         let service = TowerToHyperService::new(app.clone().map_request(
-            move |mut request: axum::http::Request<hyper::body::Incoming>| {
+            move |mut request: axum::http::Request<Incoming>| {
                 request.extensions_mut().insert(PeerAddr(peer));
                 request
             },

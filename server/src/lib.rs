@@ -40,4 +40,4 @@ pub use commands::Command;
 pub use commands::DevCommand;
 pub use connections::{serve, shutdown_signal, ServeLimits};
 pub use database::open_storage;
-pub use service::{app, ops_app, AppState, ServiceConfig, UiStrings};
+pub use service::{app, ops_app, serving, AppState, ServiceConfig, UiStrings};

@@ -8,7 +8,7 @@ use crate::database::{open_storage, redact};
 use crate::service::admission::AdmissionConfig;
 use crate::service::cap::CapRules;
 use crate::service::load::LoadConfig;
-use crate::service::{app, AppState, CacheConfig, RequestLimits, ServiceConfig};
+use crate::service::{serving, AppState, CacheConfig, RequestLimits, ServiceConfig};
 use crate::storage::ConnectOptions;
 use std::net::SocketAddr;
 use std::path::PathBuf;
@@ -310,7 +310,7 @@ pub async fn run(args: ServeArgs) -> anyhow::Result<()> {
         );
         tokio::time::sleep(delay).await;
     };
-    serve(listener, app(state), args.serve_limits(), shutdown).await?;
+    serve(listener, serving(state), args.serve_limits(), shutdown).await?;
     Ok(())
 }
 

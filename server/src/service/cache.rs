@@ -189,6 +189,29 @@ impl Caches {
         }
     }
 
+    /// `key`'s payload if the cache holds it now: never waits, never loads
+    /// (the fast path's read, [`super::fast_payload`]).
+    pub fn payload_now(&self, metrics: &Metrics, key: PayloadKey) -> Option<Payload> {
+        use futures_util::FutureExt;
+        let payload = self.payloads.as_ref()?.get(&key).now_or_never().flatten()?;
+        metrics.cache_lookup("payload", true);
+        Some(payload)
+    }
+
+    /// Compression `id`'s model record if the cache holds it now (and it
+    /// is a visible version), without waiting or loading.
+    pub fn record_now(&self, metrics: &Metrics, id: i64) -> Option<Arc<ModelRecord>> {
+        use futures_util::FutureExt;
+        let record = self
+            .by_compression
+            .get(&id)
+            .now_or_never()
+            .flatten()
+            .flatten()?;
+        metrics.cache_lookup("record", true);
+        Some(record)
+    }
+
     /// Every cached model record, for the per-model gauges.
     pub fn cached_records(&self) -> Vec<Arc<ModelRecord>> {
         self.by_slug.iter().filter_map(|(_, v)| v).collect()

@@ -97,12 +97,7 @@ pub async fn admit(State(state): State<AppState>, request: Request, next: Next) 
                     // count that ended when the handler returned never saw it.
                     // (The concurrency permit is released now, so a client that
                     // reads slowly cannot hold the service's capacity.)
-                    Ok(response) => response.map(|body| {
-                        Body::new(Tracked {
-                            body,
-                            _inflight: inflight,
-                        })
-                    }),
+                    Ok(response) => counted(response, inflight),
                     Err(_) => AppError::Timeout.into_response(),
                 }
             }
@@ -230,6 +225,16 @@ async fn discard_body(request: Request) {
 
 fn has_length(request: &Request) -> bool {
     request.headers().contains_key(header::CONTENT_LENGTH)
+}
+
+/// `response`, its request counted in flight until its body is sent.
+pub(super) fn counted(response: Response, inflight: Option<InflightGuard>) -> Response {
+    response.map(|body| {
+        Body::new(Tracked {
+            body,
+            _inflight: inflight,
+        })
+    })
 }
 
 /// A response body that keeps its request counted in flight until the body

@@ -27,15 +27,35 @@ struct RouteLabels {
 /// bounded by the route list), or `unmatched` (fallbacks: the viewer's files,
 /// 404s).
 #[derive(Clone, Debug)]
-pub struct Route(Option<MatchedPath>);
+pub struct Route(RouteName);
+
+#[derive(Clone, Debug)]
+enum RouteName {
+    Matched(MatchedPath),
+    /// A template answered before the router ([`super::fast_payload`]).
+    Known(&'static str),
+    Unmatched,
+}
 
 impl Route {
     pub fn of(request: &Request) -> Route {
-        Route(request.extensions().get::<MatchedPath>().cloned())
+        Route(match request.extensions().get::<MatchedPath>() {
+            Some(matched) => RouteName::Matched(matched.clone()),
+            None => RouteName::Unmatched,
+        })
+    }
+
+    /// One of the router's templates, named without the router.
+    pub fn known(template: &'static str) -> Route {
+        Route(RouteName::Known(template))
     }
 
     pub fn as_str(&self) -> &str {
-        self.0.as_ref().map_or("unmatched", MatchedPath::as_str)
+        match &self.0 {
+            RouteName::Matched(matched) => matched.as_str(),
+            RouteName::Known(template) => template,
+            RouteName::Unmatched => "unmatched",
+        }
     }
 }
 
@@ -86,6 +106,7 @@ pub struct Metrics {
     latency: Family<RouteLabels, Histogram, fn() -> Histogram>,
     cache: Family<CacheLabels, Counter>,
     capped: Family<ReasonLabels, Counter>,
+    fast_path: Counter,
     inflight: Gauge,
     pressure: Gauge,
     latency_ewma: Gauge<f64, AtomicU64>,
@@ -104,6 +125,7 @@ impl Default for Metrics {
             latency: Family::new_with_constructor(latency_histogram),
             cache: Family::default(),
             capped: Family::default(),
+            fast_path: Counter::default(),
             inflight: Gauge::default(),
             pressure: Gauge::default(),
             latency_ewma: Gauge::default(),
@@ -133,6 +155,11 @@ impl Default for Metrics {
             "level_capped",
             "Batch requests refused above the level cap, by reason",
             m.capped.clone(),
+        );
+        r.register(
+            "fast_path_answers",
+            "Cached public payloads answered before the router (also counted in http_requests)",
+            m.fast_path.clone(),
         );
         r.register(
             "inflight_requests",
@@ -195,6 +222,11 @@ impl Metrics {
         self.requests
             .get_or_create(&RequestLabels { route, status })
             .inc();
+    }
+
+    /// One answer from the fast path ([`super::fast_payload`]).
+    pub fn fast_path_answer(&self) {
+        self.fast_path.inc();
     }
 
     pub fn capped(&self, reason: &'static str) {

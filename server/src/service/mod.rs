@@ -15,6 +15,7 @@ mod crawl;
 pub mod curator;
 mod download;
 mod error;
+mod fast_payload;
 mod guard;
 mod iiif;
 mod language;
@@ -49,6 +50,7 @@ use admission::{Admission, AdmissionConfig};
 use axum::Router;
 use cache::{through, Caches};
 use cap::{Audience, CapRules, DeviceClass, LevelCap};
+pub use fast_payload::FastPayload;
 use load::{LoadConfig, LoadMonitor};
 use metrics::Metrics;
 use std::path::PathBuf;
@@ -326,6 +328,12 @@ impl AppState {
 /// The whole service as one router.
 pub fn app(state: AppState) -> Router {
     layers::apply(routes::all(state.config()), &state).with_state(state)
+}
+
+/// What `vitrine serve` answers with: [`app`] behind the fast path for
+/// cached public payloads ([`fast_payload`]).
+pub fn serving(state: AppState) -> FastPayload<Router> {
+    FastPayload::new(app(state.clone()), state)
 }
 
 /// Only `/healthz`, `/readyz`, `/metrics` and the OpenAPI description, for a

@@ -8,6 +8,7 @@ mod colour;
 mod curation;
 mod curators;
 mod download;
+mod fast_path;
 mod harness;
 mod http;
 mod iiif;
@@ -66,6 +67,7 @@ on_both_backends!(
     story::etags_and_not_modified,
     story::stale_stream_format_is_refused,
     caps::caps_by_audience_and_device,
+    fast_path::fast_path_answers_as_the_router,
     caps::load_caps_fall_and_recover,
     caps::bad_ids_and_slugs,
     http::end_to_end,
