@@ -55,5 +55,6 @@ pub use feature_search::{
     GuardSearch, GuardSetting, LevelMeasure, DEFAULT_CONNECTIVITY_BUDGET, SEARCHED_SETTINGS,
 };
 pub use voronoi::{
-    simplify_voronoi, Distance, Order, Radius, VoronoiOptions, VoronoiSimplified, SHARP_DEGREES,
+    simplify_voronoi, Distance, Order, Radius, VoronoiOptions, VoronoiPlacement, VoronoiSimplified,
+    SHARP_DEGREES,
 };

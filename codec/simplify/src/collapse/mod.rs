@@ -32,7 +32,7 @@
 
 mod cleanup;
 mod pass;
-mod quadric;
+pub(crate) mod quadric;
 pub(crate) mod topology;
 pub(crate) mod working;
 

@@ -31,7 +31,7 @@ const NIL_AREA: f64 = 1e-12;
 pub(super) struct FaceChecks<'a> {
     surface: &'a Surface,
     /// Each vertex's unit normal (area-weighted over its real faces).
-    normals: Vec<DVec3>,
+    pub normals: Vec<DVec3>,
     /// The input vertices (not the cones), for nearest-vertex queries. An
     /// R-tree (rstar) rather than a hand-made grid: scans are far from
     /// uniform, and the queries ask for the nearest few in order.
