@@ -28,6 +28,9 @@ pub(super) struct Pass<'a> {
     costs: Option<Vec<f64>>,
     /// With quadric placement, the dearest merge this round may make.
     cap: f64,
+    /// Whether a pass whose cheaper half merged nothing may make dear
+    /// merges (else it ends, and features are freed first).
+    dear: bool,
 }
 
 impl<'a> Pass<'a> {
@@ -36,6 +39,7 @@ impl<'a> Pass<'a> {
         options: &SimplifyOptions,
         threshold: f64,
         target: usize,
+        dear: bool,
     ) -> Self {
         let frozen = vec![false; mesh.positions.len()];
         Pass {
@@ -49,6 +53,7 @@ impl<'a> Pass<'a> {
             ring: Vec::new(),
             costs: None,
             cap: f64::INFINITY,
+            dear,
         }
     }
 
@@ -94,7 +99,7 @@ impl<'a> Pass<'a> {
             }
         };
         let merges = self.merge(&candidates, &order, cap);
-        if merges == 0 && cap.is_finite() {
+        if merges == 0 && cap.is_finite() && self.dear {
             // Every cheap candidate was frozen or refused: the dear ones
             // may go, rather than features being freed for want of merges.
             return self.merge(&candidates, &order, f64::INFINITY);

@@ -32,7 +32,7 @@ pub enum VoronoiPlacement {
 /// The anchor's pull, relative to the trace of a cell's quadric: small
 /// enough that a curved cell's minimum moves by a fraction of a per cent,
 /// large enough to pin the free directions of a flat one.
-const ANCHOR_WEIGHT: f64 = 1e-3;
+const ANCHOR_WEIGHT: f64 = 1e-5;
 
 /// A border edge's plane weighs this much per squared length, against the
 /// faces' area: it holds the rim (Garland & Heckbert's boundary planes).
