@@ -366,3 +366,39 @@ fn shared_scans_keep_their_topology() {
         }
     }
 }
+
+/// A shared scan, repaired as the CLI does; `None` when absent.
+fn shared_scan(name: &str) -> Option<IndexedMesh> {
+    use vitrine_mesh::import::{import_path, ImportOptions};
+    use vitrine_mesh::repair::{prepare, RepairOptions};
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../../shared/data/meshes")
+        .join(name);
+    if !path.exists() {
+        eprintln!("skipped: {} is absent", path.display());
+        return None;
+    }
+    let mesh = import_path(&path, &ImportOptions::default()).unwrap();
+    Some(prepare(mesh, &RepairOptions::default()).unwrap().0)
+}
+
+#[test]
+fn a_scan_is_refined_where_it_fails_not_without_end() {
+    // nefertiti-rgb-10k at r = 0.035: dual faces whose centroid fell in a
+    // fourth cell around their Voronoi vertex counted as outside their
+    // cells, and splitting made more of them each round: 386 cover sites
+    // became 1,048 (27 rounds).
+    let Some(mesh) = shared_scan("nefertiti-rgb-10k.off") else {
+        return;
+    };
+    let o = options(Method::Dijkstra, Order::Farthest, Radius::Fraction(0.035));
+    let out = simplify_voronoi(&mesh, &o).unwrap();
+    assert_sound("nefertiti-rgb-10k", &mesh, &out);
+    assert!(
+        2 * out.sites < 3 * out.cover_sites,
+        "{} sites from a cover of {} ({} rounds)",
+        out.sites,
+        out.cover_sites,
+        out.rounds
+    );
+}
