@@ -230,7 +230,8 @@ fn quadric_placement_keeps_the_plate_sharp() {
     // Crease cells stay on their crease, corner cells at their corner.
     let plate = plate_with_tunnels(3, 6);
     for r in [0.05, 0.08] {
-        let out = simplify_voronoi(&plate, &quadric(Method::Dijkstra, Radius::Fraction(r))).unwrap();
+        let out =
+            simplify_voronoi(&plate, &quadric(Method::Dijkstra, Radius::Fraction(r))).unwrap();
         assert_sound_moved("plate", &plate, &out);
         let h = hausdorff(&plate, &out.mesh, 50_000).relative();
         assert!(h < 1e-4, "r = {r}: Hausdorff {h} over the diagonal");
