@@ -4,9 +4,10 @@
 //! multi-source propagation, split the cells that break the closed-ball
 //! property (halving their radius and re-covering what falls outside it,
 //! re-propagating only from the new sites) until none does, and take the
-//! dual. The output's vertices are input vertices, bit for bit, and it has
-//! the input's genus, components and border loops (holes are coned while
-//! the diagram is built: `closure`).
+//! dual. The output's vertices are input vertices, bit for bit (or, with
+//! [`VoronoiPlacement::Quadric`], moved to their cells' quadric minimum:
+//! `placement`), and it has the input's genus, components and border loops
+//! (holes are coned while the diagram is built: `closure`).
 
 mod closed_ball;
 mod closure;
