@@ -4,13 +4,17 @@
 //! placement (the CLI's default), Melax's collapses (seed 003, sine crease
 //! term) and the intrinsic Voronoi simplifier (seed 001) with Dijkstra and
 //! fast-marching distances (farthest-point cover, the radius searched for
-//! the vertex count). Each cell: Hausdorff over quadric's at the same
+//! the vertex count), its vertices at the sites (the seed) or moved by
+//! their cells' quadrics. Each cell: Hausdorff over quadric's at the same
 //! fraction (symmetric, over the bounding-box diagonal), then faces and
 //! seconds; `stopped` where a method cannot reach the count.
 //!
 //!     pip install fast-simplification plyfile numpy
 //!     cargo run --release -p vitrine-simplify --example simplifiers_bench -- \
-//!         --peer scripts/peer_quadric.py [--fractions 0.1,0.05,0.01] plate MESH…
+//!         --peer scripts/peer_quadric.py [--fractions 0.1,0.05,0.01] \
+//!         [--methods 2,6,7] plate MESH…
+//!
+//! `--methods` picks columns by their index in `METHODS` (all by default).
 //!
 //! `plate` is the generated genus-3 plate (flat faces, sharp edges).
 
@@ -21,7 +25,7 @@ use vitrine_quality::metrics::hausdorff;
 use vitrine_simplify::melax::{melax_simplify, MelaxCost};
 use vitrine_simplify::{
     simplify, simplify_voronoi, Collapse, Distance, Placement, Radius, SimplifyOptions, StopReason,
-    Target, VoronoiOptions,
+    Target, VoronoiOptions, VoronoiPlacement,
 };
 
 #[path = "support/mod.rs"]
@@ -31,13 +35,15 @@ use support::{load, name, peer, ratio, Failure, SAMPLES};
 /// One method's output: the mesh, seconds, and whether it reached the count.
 type Run = (IndexedMesh, f64, bool);
 
-const METHODS: [&str; 6] = [
+const METHODS: [&str; 8] = [
     "normal deviation, edge",
     "normal deviation, half-edge",
     "normal deviation, triangle",
     "Melax",
     "Voronoi, Dijkstra",
     "Voronoi, fast marching",
+    "Voronoi, Dijkstra, quadric placement",
+    "Voronoi, fast marching, quadric placement",
 ];
 
 fn run(method: usize, mesh: &IndexedMesh, fraction: f64) -> Result<Run, Failure> {
@@ -59,12 +65,18 @@ fn run(method: usize, mesh: &IndexedMesh, fraction: f64) -> Result<Run, Failure>
             (out.mesh, out.reached)
         }
         _ => {
-            let distance = [Distance::Dijkstra, Distance::FastMarching][method - 4];
+            let distance = [Distance::Dijkstra, Distance::FastMarching][method % 2];
+            let placement = if method >= 6 {
+                VoronoiPlacement::Quadric
+            } else {
+                VoronoiPlacement::Sites
+            };
             let used = used_vertices(mesh);
             let want = ((fraction * used as f64).round() as usize).max(4);
             let options = VoronoiOptions {
                 distance,
                 radius: Radius::TargetVertices(want),
+                placement,
                 ..VoronoiOptions::default()
             };
             let out = simplify_voronoi(mesh, &options)?;
@@ -88,9 +100,16 @@ fn main() -> Result<(), Failure> {
     let mut args: Vec<String> = std::env::args().skip(1).collect();
     let mut script = None;
     let mut fractions = vec![0.10, 0.05, 0.01];
+    let mut methods: Vec<usize> = (0..METHODS.len()).collect();
     while args.len() > 1 && args[0].starts_with("--") {
         match args[0].as_str() {
             "--peer" => script = Some(args[1].clone()),
+            "--methods" => {
+                methods = args[1]
+                    .split(',')
+                    .map(str::parse)
+                    .collect::<Result<_, _>>()?
+            }
             "--fractions" => {
                 fractions = args[1]
                     .split(',')
@@ -103,11 +122,15 @@ fn main() -> Result<(), Failure> {
     }
     let script =
         script.ok_or("--peer scripts/peer_quadric.py is needed: cells are ratios to it")?;
+    if let Some(m) = methods.iter().find(|&&m| m >= METHODS.len()) {
+        return Err(format!("no method {m}: 0–{}", METHODS.len() - 1).into());
+    }
+    let names: Vec<&str> = methods.iter().map(|&m| METHODS[m]).collect();
     println!(
         "| scan | kept | quadric: faces, H, s | {} |",
-        METHODS.join(" | ")
+        names.join(" | ")
     );
-    println!("|---|---:|---|{}", "---|".repeat(METHODS.len()));
+    println!("|---|---:|---|{}", "---|".repeat(methods.len()));
     for path in &args {
         let mesh = load(path)?;
         for &fraction in &fractions {
@@ -117,7 +140,7 @@ fn main() -> Result<(), Failure> {
                 name(path),
                 100.0 * fraction
             );
-            for method in 0..METHODS.len() {
+            for &method in &methods {
                 row += &match run(method, &mesh, fraction) {
                     Ok((out, seconds, reached)) => {
                         let h = hausdorff(&mesh, &out, SAMPLES).relative();

@@ -18,7 +18,9 @@
 //!   kept, one collapse order for every frame of an animated model.
 //! - [`simplify_voronoi`]: the intrinsic Voronoi simplifier (Oliveira,
 //!   seed 001): geodesic discs, their Voronoi diagram refined to the
-//!   closed-ball property, and its dual; input vertices only, topology kept.
+//!   closed-ball property, and its dual; topology kept, its vertices input
+//!   vertices or ([`VoronoiPlacement::Quadric`]) moved to their cells'
+//!   quadric minimum.
 //!
 //! ```
 //! use vitrine_simplify::{simplify, Collapse, SimplifyOptions, StopReason, Target};
@@ -55,5 +57,6 @@ pub use feature_search::{
     GuardSearch, GuardSetting, LevelMeasure, DEFAULT_CONNECTIVITY_BUDGET, SEARCHED_SETTINGS,
 };
 pub use voronoi::{
-    simplify_voronoi, Distance, Order, Radius, VoronoiOptions, VoronoiSimplified, SHARP_DEGREES,
+    simplify_voronoi, Distance, Order, Radius, VoronoiOptions, VoronoiPlacement, VoronoiSimplified,
+    SHARP_DEGREES,
 };

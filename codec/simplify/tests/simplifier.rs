@@ -485,11 +485,13 @@ fn quadric_placement_stays_closer_to_a_smooth_surface() {
         assert_eq!(seed.mesh.vertex_count(), quadric.mesh.vertex_count());
         let (s, q) = (rms(&seed.mesh), rms(&quadric.mesh));
         // Half-edge collapses keep input positions (only their order
-        // moves); triangle collapses choose among the face's own points.
-        let bound = if collapse == Collapse::Edge {
-            0.5
-        } else {
+        // moves). Triangle collapses that chose among the face's centroid
+        // and corners, unpriced, kept 0.64 of the seed's distance; at the
+        // summed quadric's minimum and cheapest first, 0.22.
+        let bound = if collapse == Collapse::HalfEdge {
             0.75
+        } else {
+            0.5
         };
         assert!(q < bound * s, "{collapse:?}: quadric {q}, seed {s}");
     }
@@ -500,8 +502,10 @@ fn a_plate_keeps_its_sharp_edges_under_quadric_placement() {
     // Flat faces and 90° edges: quadric simplification loses nothing at 10
     // and 5 %. A vertex whose cheap merges were refused used to take its
     // dearest one across an edge of the plate (8 % of the diagonal).
+    // Triangle collapses went to the centroid or a corner, unpriced and
+    // uncapped, and cut its edges by 6–9 %.
     let plate = plate_with_tunnels(3, 6);
-    for collapse in [Collapse::Edge, Collapse::HalfEdge] {
+    for collapse in VARIANTS {
         for fraction in [0.10, 0.05] {
             let out = simplify(
                 &plate,

@@ -32,7 +32,7 @@
 
 mod cleanup;
 mod pass;
-mod quadric;
+pub(crate) mod quadric;
 pub(crate) mod topology;
 pub(crate) mod working;
 
@@ -283,6 +283,11 @@ fn run(
     };
     let target = options.target.vertices(working.live_vertices);
     let mut passes = Vec::new();
+    // Triangle collapses make dear merges only once no feature is left to
+    // free: a feature's triangles along its crease cost nothing, and the
+    // dear ones cut across it (the genus-3 plate's edges, 6–9 % of its
+    // diagonal). Edge merges into a feature's vertex need no such wait.
+    let mut dear = options.collapse != Collapse::Triangle;
     let stopped = loop {
         if working.live_vertices <= target {
             break StopReason::Target;
@@ -290,7 +295,7 @@ fn run(
         if passes.len() >= options.max_passes {
             break StopReason::MaxPasses;
         }
-        let mut pass = Pass::new(&mut working, options, threshold, target);
+        let mut pass = Pass::new(&mut working, options, threshold, target, dear);
         if options.features == Features::Last
             && options.placement == Placement::Quadric
             && pass.features_cheaper()
@@ -303,16 +308,16 @@ fn run(
         let merges = pass.run();
         let cleanup = cleanup::clean(&mut working, threshold, target);
         if merges == 0 && cleanup == Cleanup::default() {
-            match options.features {
-                Features::Last => match release(&working, threshold, target) {
-                    Some(raised) => {
-                        threshold = raised;
-                        continue;
-                    }
-                    None => break StopReason::NoCandidate,
-                },
-                Features::Keep => break StopReason::NoCandidate,
+            let raised = match options.features {
+                Features::Last => release(&working, threshold, target),
+                Features::Keep => None,
+            };
+            match raised {
+                Some(raised) => threshold = raised,
+                None if !dear => dear = true,
+                None => break StopReason::NoCandidate,
             }
+            continue;
         }
         let report = PassReport {
             merges,

@@ -28,6 +28,9 @@ pub(super) struct Pass<'a> {
     costs: Option<Vec<f64>>,
     /// With quadric placement, the dearest merge this round may make.
     cap: f64,
+    /// Whether a pass whose cheaper half merged nothing may make dear
+    /// merges (else it ends, and features are freed first).
+    dear: bool,
 }
 
 impl<'a> Pass<'a> {
@@ -36,6 +39,7 @@ impl<'a> Pass<'a> {
         options: &SimplifyOptions,
         threshold: f64,
         target: usize,
+        dear: bool,
     ) -> Self {
         let frozen = vec![false; mesh.positions.len()];
         Pass {
@@ -49,6 +53,7 @@ impl<'a> Pass<'a> {
             ring: Vec::new(),
             costs: None,
             cap: f64::INFINITY,
+            dear,
         }
     }
 
@@ -94,7 +99,7 @@ impl<'a> Pass<'a> {
             }
         };
         let merges = self.merge(&candidates, &order, cap);
-        if merges == 0 && cap.is_finite() {
+        if merges == 0 && cap.is_finite() && self.dear {
             // Every cheap candidate was frozen or refused: the dear ones
             // may go, rather than features being freed for want of merges.
             return self.merge(&candidates, &order, f64::INFINITY);
@@ -145,7 +150,12 @@ impl<'a> Pass<'a> {
             if !self.mesh.removable(v, f64::INFINITY) {
                 continue;
             }
-            let cost = self.cheapest(v);
+            // A protected vertex has no face whose corners may all move:
+            // triangle collapses are weighed as edge merges here.
+            let cost = match self.collapse {
+                Collapse::Triangle => self.cheapest_edge(v),
+                _ => self.cheapest(v),
+            };
             let candidate = self.mesh.removable(v, self.threshold);
             if candidate {
                 costs[v as usize] = cost;
@@ -159,7 +169,9 @@ impl<'a> Pass<'a> {
                 protected.push(cost);
             }
         }
-        self.costs = Some(costs);
+        if self.collapse != Collapse::Triangle {
+            self.costs = Some(costs);
+        }
         match (median(&mut protected), median(&mut candidates)) {
             (Some(p), Some(c)) => p < c,
             _ => false,
@@ -194,10 +206,22 @@ impl<'a> Pass<'a> {
     /// With quadric placement, the cost of `v`'s cheapest merge this pass
     /// could make (the order of the candidates).
     fn cheapest(&mut self, v: u32) -> f64 {
-        let merges = match self.collapse {
-            Collapse::Edge | Collapse::Triangle => self.quadric_edges(v),
-            Collapse::HalfEdge => self.merges_into_neighbours(v),
-        };
+        match self.collapse {
+            Collapse::Edge => self.cheapest_edge(v),
+            Collapse::HalfEdge => {
+                let merges = self.merges_into_neighbours(v);
+                merges.first().map_or(f64::INFINITY, |m| self.cost(m))
+            }
+            Collapse::Triangle => self
+                .collapsible_faces(v)
+                .first()
+                .map_or(f64::INFINITY, |c| c.0),
+        }
+    }
+
+    /// The cost of `v`'s cheapest quadric edge merge.
+    fn cheapest_edge(&mut self, v: u32) -> f64 {
+        let merges = self.quadric_edges(v);
         merges.first().map_or(f64::INFINITY, |m| self.cost(m))
     }
 
@@ -268,11 +292,7 @@ impl<'a> Pass<'a> {
     /// plate's crease vertex went across the plate's edge, 8 % of its
     /// diagonal, where quadric simplification loses nothing).
     fn first_allowed(&mut self, merges: impl IntoIterator<Item = Merge>) -> Option<u32> {
-        // (A triangle collapse goes to the centroid, which the cap, priced
-        // on edge merges, does not measure.)
-        let capped = self.placement == Placement::Quadric
-            && self.collapse != Collapse::Triangle
-            && self.cap.is_finite();
+        let capped = self.placement == Placement::Quadric && self.cap.is_finite();
         for m in merges {
             if capped && self.cost(&m) > self.cap {
                 return None;
@@ -305,36 +325,75 @@ impl<'a> Pass<'a> {
         Some((self.first_allowed(merges)?, 1))
     }
 
-    /// A face's three corners to its centroid (−2 vertices, −4 faces), as
-    /// two checked merges; smallest face first (ties by index). When the
-    /// second merge is refused the first stands on its own (−1 vertex).
+    /// A face's three corners to one point (−2 vertices, −4 faces), as two
+    /// checked merges: with the seed's placement the smallest face first,
+    /// to its centroid; with quadric placement the cheapest face first, to
+    /// the point its summed quadric prefers, and none dearer than the
+    /// pass's cap (a collapse that crosses a crease costs what it cuts).
+    /// When the second merge is refused the first stands on its own
+    /// (−1 vertex).
     fn triangle(&mut self, v: u32) -> Option<(u32, usize)> {
-        let mut faces: Vec<(f64, u32)> = self.mesh.faces_of[v as usize]
+        for (cost, f, to) in self.collapsible_faces(v) {
+            if cost > self.cap {
+                return None;
+            }
+            let t = self.mesh.triangles[f as usize];
+            let others: Vec<u32> = t.iter().copied().filter(|&w| w != v).collect();
+            let merge = |gone| Merge {
+                keep: v,
+                gone,
+                to,
+                colour: self.mean_colour(&t),
+            };
+            let (first, second) = (merge(others[0]), merge(others[1]));
+            if !self.allowed(&first) {
+                continue;
+            }
+            self.mesh.apply(&first);
+            let second = self.allowed(&second) && {
+                self.mesh.apply(&second);
+                true
+            };
+            return Some((v, 1 + usize::from(second)));
+        }
+        None
+    }
+
+    /// The faces around `v` whose corners may all move, each with the cost
+    /// of collapsing it (its area with the seed's placement, which takes the
+    /// smallest first; the summed quadric's error at the chosen point with
+    /// quadric placement), cheapest first, ties by face index.
+    fn collapsible_faces(&self, v: u32) -> Vec<(f64, u32, [f32; 3])> {
+        let mut faces: Vec<(f64, u32, [f32; 3])> = self.mesh.faces_of[v as usize]
             .iter()
             .filter(|&&f| {
                 let t = self.mesh.triangles[f as usize];
                 t.iter().all(|&w| self.usable(w))
             })
-            .map(|&f| (self.area(f), f))
+            .map(|&f| {
+                let t = self.mesh.triangles[f as usize];
+                let (to, cost) = self.triangle_point(&t);
+                let order = match self.placement {
+                    Placement::Seed => self.area(f),
+                    Placement::Quadric => cost,
+                };
+                (order, f, to)
+            })
             .collect();
         faces.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
-        for (_, f) in faces {
-            let t = self.mesh.triangles[f as usize];
-            let others: Vec<u32> = t.iter().copied().filter(|&w| w != v).collect();
-            let (to, colour) = self.centroid(&t);
-            let merge = |gone| Merge {
-                keep: v,
-                gone,
-                to,
-                colour,
-            };
-            if self.first_allowed([merge(others[0])]).is_none() {
-                continue;
-            }
-            let second = self.first_allowed([merge(others[1])]).is_some();
-            return Some((v, 1 + usize::from(second)));
-        }
-        None
+        faces
+    }
+
+    /// Whether the checks allow `m` (the link condition, no flips).
+    fn allowed(&mut self, m: &Merge) -> bool {
+        allows(self.mesh, m, &mut self.scratch)
+    }
+
+    fn mean_colour(&self, t: &[u32; 3]) -> Option<[f32; 3]> {
+        self.mesh
+            .colours
+            .as_ref()
+            .map(|c| [0, 1, 2].map(|k| t.iter().map(|&w| c[w as usize][k]).sum::<f32>() / 3.0))
     }
 
     fn midpoint(&self, a: u32, b: u32) -> Merge {
@@ -354,31 +413,37 @@ impl<'a> Pass<'a> {
         }
     }
 
-    /// The centroid, or with quadric placement whichever of the centroid
-    /// and the three corners the summed quadric prefers (the free minimum
-    /// can leave the face's patch on sharp creases and fold a face there:
-    /// tests/simplifier.rs, the genus-3 plate); colour averaged.
-    fn centroid(&self, t: &[u32; 3]) -> ([f32; 3], Option<[f32; 3]>) {
-        let centroid = t.iter().map(|&w| self.mesh.point(w)).sum::<DVec3>() / 3.0;
+    /// Where a triangle collapse goes, and the summed quadric's error there:
+    /// the seed's centroid; or with quadric placement the quadric's minimum
+    /// when it lies near the face, else the best of the centroid, the
+    /// corners and the edges' midpoints (the free minimum of a near-flat or
+    /// crease patch can lie far off and fold a face: tests/simplifier.rs,
+    /// the genus-3 plate).
+    fn triangle_point(&self, t: &[u32; 3]) -> ([f32; 3], f64) {
+        let p = t.map(|w| self.mesh.point(w));
+        let centroid = (p[0] + p[1] + p[2]) / 3.0;
+        let q = t
+            .iter()
+            .map(|&w| self.mesh.quadric(w))
+            .fold(super::quadric::Quadric::default(), |a, b| a + b);
         let best = match self.placement {
-            Placement::Seed => None,
+            Placement::Seed => centroid,
             Placement::Quadric => {
-                let q = t
-                    .iter()
-                    .map(|&w| self.mesh.quadric(w))
-                    .fold(super::quadric::Quadric::default(), |a, b| a + b);
-                std::iter::once(centroid)
-                    .chain(t.iter().map(|&w| self.mesh.point(w)))
-                    .min_by(|a, b| q.error(*a).total_cmp(&q.error(*b)))
+                let reach = (0..3)
+                    .map(|k| p[k].distance(p[(k + 1) % 3]))
+                    .fold(0.0, f64::max);
+                q.minimum()
+                    .filter(|x| x.distance(centroid) <= reach)
+                    .unwrap_or_else(|| {
+                        [centroid, p[0], p[1], p[2]]
+                            .into_iter()
+                            .chain((0..3).map(|k| (p[k] + p[(k + 1) % 3]) * 0.5))
+                            .min_by(|a, b| q.error(*a).total_cmp(&q.error(*b)))
+                            .unwrap_or(centroid)
+                    })
             }
         };
-        let to = best.unwrap_or(centroid).as_vec3().to_array();
-        let colour = self
-            .mesh
-            .colours
-            .as_ref()
-            .map(|c| [0, 1, 2].map(|k| t.iter().map(|&w| c[w as usize][k]).sum::<f32>() / 3.0));
-        (to, colour)
+        (best.as_vec3().to_array(), q.error(best))
     }
 
     fn area(&self, f: u32) -> f64 {

@@ -65,6 +65,24 @@ impl Quadric {
         }
     }
 
+    /// The least of the error plus `weight` times the trace of A times the
+    /// squared distance to `anchor`: the minimum where the planes pin a
+    /// point down, and towards `anchor` along the directions they leave
+    /// free (a flat patch's tangent plane, a crease's line), so a
+    /// near-singular A cannot throw the point far off.
+    pub fn minimum_near(&self, anchor: DVec3, weight: f64) -> Option<DVec3> {
+        let trace = self.a.x_axis.x + self.a.y_axis.y + self.a.z_axis.z;
+        if trace.is_nan() || trace <= 0.0 {
+            return Some(anchor);
+        }
+        let lambda = weight * trace;
+        let a = self.a + DMat3::from_diagonal(DVec3::splat(lambda));
+        if a.determinant().abs() <= f64::MIN_POSITIVE {
+            return None;
+        }
+        Some(a.inverse() * (anchor * lambda - self.b)).filter(|v| v.is_finite())
+    }
+
     /// Where a merge of `p` and `q` goes: the minimum, unless it is far
     /// from the edge (a near-singular A would stretch the surface); then
     /// the best of the ends, the midpoint and the quarter points.
@@ -146,6 +164,20 @@ mod tests {
             + Quadric::plane(DVec3::Z, corner, 1.0);
         let v = q.best_on(DVec3::new(0.5, 2.0, 3.0), DVec3::new(1.5, 2.5, 3.0));
         assert!(v.distance(corner) < 1e-9, "{v}");
+    }
+
+    #[test]
+    fn near_an_anchor_a_plane_pins_only_its_normal() {
+        // z = 1 leaves x and y free: they stay at the anchor's, z goes to
+        // the plane (but for the small pull of the anchor).
+        let q = Quadric::plane(DVec3::Z, DVec3::new(0.0, 0.0, 1.0), 3.0);
+        let v = q.minimum_near(DVec3::new(2.0, -1.0, 0.0), 1e-4).unwrap();
+        assert!((v.x - 2.0).abs() < 1e-9 && (v.y + 1.0).abs() < 1e-9, "{v}");
+        assert!((v.z - 1.0).abs() < 1e-3, "{v}");
+        assert_eq!(
+            Quadric::default().minimum_near(DVec3::ONE, 1e-4),
+            Some(DVec3::ONE)
+        );
     }
 
     #[test]

@@ -4,9 +4,10 @@
 //! multi-source propagation, split the cells that break the closed-ball
 //! property (halving their radius and re-covering what falls outside it,
 //! re-propagating only from the new sites) until none does, and take the
-//! dual. The output's vertices are input vertices, bit for bit, and it has
-//! the input's genus, components and border loops (holes are coned while
-//! the diagram is built: `closure`).
+//! dual. The output's vertices are input vertices, bit for bit (or, with
+//! [`VoronoiPlacement::Quadric`], moved to their cells' quadric minimum:
+//! `placement`), and it has the input's genus, components and border loops
+//! (holes are coned while the diagram is built: `closure`).
 
 mod closed_ball;
 mod closure;
@@ -15,6 +16,7 @@ mod creases;
 mod curvature;
 mod dual;
 mod faces;
+mod placement;
 mod search;
 
 use std::time::{Duration, Instant};
@@ -29,6 +31,7 @@ use closed_ball::Violation;
 use closure::Closed;
 pub use cover::Order;
 pub use creases::SHARP_DEGREES;
+pub use placement::VoronoiPlacement;
 
 /// The disc radius.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -52,6 +55,9 @@ pub struct VoronoiOptions {
     /// creases, whose vertices the cover takes first (`creases`); `None`
     /// covers as the seed does.
     pub sharp_degrees: Option<f64>,
+    /// Where the output's vertices go: at the sites (the seed), or where
+    /// their cells' quadrics put them (`placement`).
+    pub placement: VoronoiPlacement,
 }
 
 impl Default for VoronoiOptions {
@@ -62,6 +68,7 @@ impl Default for VoronoiOptions {
             radius: Radius::Fraction(0.05),
             max_rounds: 500,
             sharp_degrees: Some(SHARP_DEGREES),
+            placement: VoronoiPlacement::Sites,
         }
     }
 }
@@ -78,10 +85,11 @@ pub struct Stages {
 /// The simplified mesh and how it came about.
 #[derive(Clone, Debug)]
 pub struct VoronoiSimplified {
-    /// Only input vertices (the sites), in input order, positions and
-    /// colours copied; faces oriented as the input.
+    /// One vertex per site used, in the sites' input order, colours
+    /// copied; positions the sites' own, bit for bit, unless the placement
+    /// moved them; faces oriented as the input.
     pub mesh: IndexedMesh,
-    /// For each output vertex, the input vertex it is.
+    /// For each output vertex, the input vertex that is its site.
     pub origin: Vec<u32>,
     /// r over the bounding box's diagonal, as given or as the search found.
     pub radius_fraction: f64,
@@ -186,7 +194,7 @@ impl<'a> Diagram<'a> {
         let (mut rounds, mut splits) = (0, 0);
         let checks = faces::FaceChecks::new(surface, closed.first_cone);
         let mut dual_time;
-        let faces = loop {
+        let (faces, labels) = loop {
             let labels = diagram.labels();
             let mut violations =
                 closed_ball::violations(surface, &labels, diagram.site_vertex.len());
@@ -202,7 +210,7 @@ impl<'a> Diagram<'a> {
                 let members = Members::new(&labels, diagram.site_vertex.len());
                 violations.retain(|v| diagram.cell_to_split(v, &members).is_some());
                 if violations.is_empty() {
-                    break faces;
+                    break (faces, labels);
                 }
             }
             if rounds == options.max_rounds {
@@ -218,7 +226,21 @@ impl<'a> Diagram<'a> {
         stages.refinement = started.elapsed().saturating_sub(dual_time);
         stages.dual = dual_time;
         let started = Instant::now();
-        let (mesh, origin) = compact(mesh, &faces);
+        let (mut mesh, origin) = compact(mesh, &faces);
+        if options.placement == VoronoiPlacement::Quadric {
+            let at = placement::Dual {
+                surface,
+                first_cone: closed.first_cone,
+                labels: &labels,
+                site_vertex: &diagram.site_vertex,
+                faces: &faces,
+                normals: &checks.normals,
+            }
+            .relocate();
+            for (p, &v) in mesh.positions.iter_mut().zip(&origin) {
+                *p = at[labels[v as usize] as usize].as_vec3().to_array();
+            }
+        }
         stages.dual += started.elapsed();
         Ok(VoronoiSimplified {
             mesh,
