@@ -8,7 +8,9 @@
 use clap::{Args, ValueEnum};
 use serde::Serialize;
 use vitrine_codec::IndexedMesh;
-use vitrine_simplify::{simplify_voronoi, Distance, Order, Radius, VoronoiOptions, SHARP_DEGREES};
+use vitrine_simplify::{
+    simplify_voronoi, Distance, Order, Radius, VoronoiOptions, VoronoiPlacement, SHARP_DEGREES,
+};
 
 /// How geodesic distance is measured.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -30,8 +32,22 @@ pub enum OrderKind {
     Curvature,
 }
 
+/// Where each output vertex goes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum VoronoiPlacementKind {
+    /// At its site, an input vertex (the seed's method: the output's
+    /// vertices are a subset of the input's, bit for bit).
+    Sites,
+    /// At the minimum of its cell's quadric error (Valette et al.'s ACVD
+    /// relocation): closer to the surface, vertices no longer the input's.
+    Quadric,
+}
+
 #[derive(Args, Debug)]
 pub struct VoronoiArgs {
+    /// voronoi: where each output vertex goes.
+    #[arg(long, value_enum, default_value_t = VoronoiPlacementKind::Sites)]
+    pub voronoi_placement: VoronoiPlacementKind,
     /// voronoi: geodesic distance by Dijkstra on edges or fast marching.
     #[arg(long, value_enum, default_value_t = DistanceKind::Dijkstra)]
     pub distance: DistanceKind,
@@ -48,6 +64,7 @@ pub struct VoronoiArgs {
 #[derive(Clone, Debug, Serialize)]
 pub struct VoronoiReport {
     pub distance: &'static str,
+    pub placement: &'static str,
     pub order: &'static str,
     /// r over the bounding box's diagonal (given, or found by the search).
     pub radius: f64,
@@ -102,8 +119,13 @@ pub fn run(mesh: &IndexedMesh, args: &VoronoiArgs, t: TargetFlags) -> anyhow::Re
             args.sharp_degrees
         );
     }
+    let (placement, placement_name) = match args.voronoi_placement {
+        VoronoiPlacementKind::Sites => (VoronoiPlacement::Sites, "sites"),
+        VoronoiPlacementKind::Quadric => (VoronoiPlacement::Quadric, "quadric"),
+    };
     let options = VoronoiOptions {
         distance,
+        placement,
         order,
         radius,
         sharp_degrees: (args.sharp_degrees > 0.0).then_some(args.sharp_degrees),
@@ -120,6 +142,7 @@ pub fn run(mesh: &IndexedMesh, args: &VoronoiArgs, t: TargetFlags) -> anyhow::Re
         stopped,
         report: VoronoiReport {
             distance: distance_name,
+            placement: placement_name,
             order: order_name,
             radius: out.radius_fraction,
             sites: out.sites,
@@ -134,7 +157,7 @@ pub fn run(mesh: &IndexedMesh, args: &VoronoiArgs, t: TargetFlags) -> anyhow::Re
 /// The report's extra words.
 pub fn describe(v: &VoronoiReport) -> String {
     format!(
-        " ({} distance, {} order, r = {:.5} × diagonal, {} sites from {} discs, {} splits, {} radii tried)",
-        v.distance, v.order, v.radius, v.sites, v.cover_sites, v.splits, v.attempts
+        " ({} distance, {} order, vertices at the {}, r = {:.5} × diagonal, {} sites from {} discs, {} splits, {} radii tried)",
+        v.distance, v.order, v.placement, v.radius, v.sites, v.cover_sites, v.splits, v.attempts
     )
 }
