@@ -370,7 +370,7 @@ pub async fn stale_stream_format_is_refused(db: TestDb) {
         .collect();
     assert_eq!(slugs, ["ring"]);
     // `vitrine models` names both stale ones, restricted or not.
-    let (table, stale_count) = models_listing(&*s).await.unwrap();
+    let (table, stale_count) = models_listing(s).await.unwrap();
     assert_eq!(stale_count, 2, "{table}");
     for slug in ["torus", "vault"] {
         let line = table.lines().find(|l| l.starts_with(slug)).unwrap();
@@ -399,6 +399,6 @@ pub async fn stale_stream_format_is_refused(db: TestDb) {
     let base = get(&app, manifest["levels"][0]["url"].as_str().unwrap(), &[]).await;
     assert_eq!(base.status, StatusCode::OK);
     Decoder::new(&base.body, Limits::default()).expect("the new version decodes");
-    let (table, stale_count) = models_listing(&*s).await.unwrap();
+    let (table, stale_count) = models_listing(s).await.unwrap();
     assert_eq!(stale_count, 1, "only the restricted one is left: {table}");
 }
