@@ -394,6 +394,15 @@ fn vitrine_geodesic_surface(mesh: &IndexedMesh) -> vitrine_geodesic::Surface {
     vitrine_geodesic::Surface::new(mesh).expect("a manifold")
 }
 
+/// `vitrine simplify --method voronoi` with `flags`, its JSON report.
+fn voronoi_report(input: &Path, output: &Path, flags: &[&str]) -> serde_json::Value {
+    let mut args = vec!["simplify", text(input), "--method", "voronoi"];
+    args.extend_from_slice(flags);
+    args.extend(["--hausdorff-samples", "20000", "--json", "-o", text(output)]);
+    let (stdout, _) = succeeds(&args);
+    serde_json::from_str(&stdout).expect("JSON on stdout")
+}
+
 #[test]
 fn simplify_by_voronoi_keeps_the_plates_topology_in_every_configuration() {
     let dir = tempfile::tempdir().unwrap();
@@ -405,24 +414,8 @@ fn simplify_by_voronoi_keeps_the_plates_topology_in_every_configuration() {
         ("fmm", "curvature"),
     ] {
         let output = dir.path().join(format!("{distance}-{order}.ply"));
-        let (stdout, _) = succeeds(&[
-            "simplify",
-            text(&input),
-            "--method",
-            "voronoi",
-            "--distance",
-            distance,
-            "--order",
-            order,
-            "--radius",
-            "0.05",
-            "--hausdorff-samples",
-            "20000",
-            "--json",
-            "-o",
-            text(&output),
-        ]);
-        let report: serde_json::Value = serde_json::from_str(&stdout).expect("JSON on stdout");
+        let flags = ["--distance", distance, "--order", order, "--radius", "0.05"];
+        let report = voronoi_report(&input, &output, &flags);
         assert_eq!(report["method"], "voronoi");
         assert_eq!(report["stopped"], "radius");
         assert_eq!(report["voronoi"]["distance"], distance);
@@ -445,22 +438,8 @@ fn simplify_by_voronoi_with_quadric_placement_keeps_the_plate_exact() {
     let dir = tempfile::tempdir().unwrap();
     let input = plate(dir.path());
     let output = dir.path().join("quadric.ply");
-    let (stdout, _) = succeeds(&[
-        "simplify",
-        text(&input),
-        "--method",
-        "voronoi",
-        "--voronoi-placement",
-        "quadric",
-        "--radius",
-        "0.05",
-        "--hausdorff-samples",
-        "20000",
-        "--json",
-        "-o",
-        text(&output),
-    ]);
-    let report: serde_json::Value = serde_json::from_str(&stdout).expect("JSON on stdout");
+    let flags = ["--voronoi-placement", "quadric", "--radius", "0.05"];
+    let report = voronoi_report(&input, &output, &flags);
     assert_eq!(report["voronoi"]["placement"], "quadric");
     check_manifold(&read(&output)).unwrap();
     // Flat faces and sharp edges: each cell's quadric minimum lies on the

@@ -3,7 +3,7 @@
 //! the router's answer could differ.
 
 use super::harness::{ingest_sample, test_config, TestDb};
-use super::story::{get, token_for, Reply};
+use super::story::{get, get_from, token_for, Reply};
 use axum::http::StatusCode;
 use vitrine::{app, serving, AppState};
 
@@ -21,27 +21,7 @@ async fn through(
     uri: &str,
     headers: &[(&str, &str)],
 ) -> Reply {
-    use axum::body::Body;
-    use axum::http::Request;
-    use http_body_util::BodyExt;
-    use tower::ServiceExt;
-    let mut request = Request::get(uri);
-    for (name, value) in headers {
-        request = request.header(*name, *value);
-    }
-    let response = service
-        .clone()
-        .oneshot(request.body(Body::empty()).unwrap())
-        .await
-        .unwrap();
-    let status = response.status();
-    let headers = response.headers().clone();
-    let body = response.into_body().collect().await.unwrap().to_bytes();
-    Reply {
-        status,
-        headers,
-        body,
-    }
+    get_from(service.clone(), uri, headers).await
 }
 
 fn same(fast: &Reply, router: &Reply, what: &str) {

@@ -34,12 +34,23 @@ impl Reply {
 }
 
 pub async fn get(app: &Router, uri: &str, headers: &[(&str, &str)]) -> Reply {
+    get_from(app.clone(), uri, headers).await
+}
+
+/// A GET through any service that answers as the router does.
+pub async fn get_from<S>(service: S, uri: &str, headers: &[(&str, &str)]) -> Reply
+where
+    S: tower::Service<
+        Request<Body>,
+        Response = axum::response::Response,
+        Error = std::convert::Infallible,
+    >,
+{
     let mut request = Request::get(uri);
     for (name, value) in headers {
         request = request.header(*name, *value);
     }
-    let response = app
-        .clone()
+    let response = service
         .oneshot(request.body(Body::empty()).unwrap())
         .await
         .unwrap();
