@@ -61,14 +61,19 @@ where
 
     fn call(&mut self, request: Request<B>) -> Self::Future {
         use futures_util::future::Either;
-        match answer(
-            &self.state,
-            request.method(),
-            request.uri(),
-            request.headers(),
-        ) {
-            Some(response) => Either::Left(ready(Ok(response))),
-            None => Either::Right(self.inner.call(request)),
+        // Outside the router's panic layer: a panic here (a bug) hands the
+        // request to the router rather than dropping the connection.
+        let fast = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+            answer(
+                &self.state,
+                request.method(),
+                request.uri(),
+                request.headers(),
+            )
+        }));
+        match fast {
+            Ok(Some(response)) => Either::Left(ready(Ok(response))),
+            Ok(None) | Err(_) => Either::Right(self.inner.call(request)),
         }
     }
 }
@@ -129,6 +134,9 @@ fn answer(
             return None;
         }
     }
+    // (A record whose levels do not cover its batch count is the router's
+    // to report.)
+    let sha256 = &record.levels.get(level as usize)?.sha256;
     let key = if level == 0 {
         PayloadKey::Base(id)
     } else {
@@ -144,7 +152,7 @@ fn answer(
     let length = HeaderValue::from(bytes.len());
     let mut response = payload_response(
         bytes,
-        etag(&record.levels[level as usize].sha256),
+        etag(sha256),
         cache_control(&record, level),
         HeaderValue::from_static(OCTET_STREAM),
     );
