@@ -107,7 +107,6 @@ fn answer(
     uri: &axum::http::Uri,
     headers: &HeaderMap,
 ) -> Option<Response> {
-    let started = Instant::now();
     if method != Method::GET
         || uri.query().is_some()
         || headers.contains_key(header::AUTHORIZATION)
@@ -117,6 +116,7 @@ fn answer(
         return None;
     }
     let (id, level, route) = payload_path(uri.path())?;
+    let started = Instant::now();
     let metrics = state.metrics();
     let record = state.caches().record_now(metrics, id)?;
     if !record.policy.public_access || !record.servable() || level > record.batch_count() {
@@ -147,7 +147,7 @@ fn answer(
     };
     // The concurrency limit holds here too (the guard's permit is released
     // once the handler returns, as this one is at once).
-    drop(state.permits().clone().try_acquire_owned().ok()?);
+    drop(state.permits().try_acquire().ok()?);
     let inflight = state.load().begin();
     let length = HeaderValue::from(bytes.len());
     let mut response = payload_response(
