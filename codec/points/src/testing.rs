@@ -1,6 +1,6 @@
 //! Generated clouds with known normals for the tests, benches and examples:
 //! a deterministic random source and samplers of a sphere, a cube and a
-//! solid made of rectangles (an L-shaped block).
+//! solid made of rectangles (an L-shaped block); points sampled on a mesh.
 
 /// SplitMix64 step.
 pub fn next(state: &mut u64) -> u64 {
@@ -178,4 +178,44 @@ pub fn faces_sample(faces: &[Rect], n: usize, seed: u64) -> (Vec<[f32; 3]>, Vec<
         nrm.push(face.normal);
     }
     (pos, nrm)
+}
+
+/// `n` points uniformly on a mesh's triangles (area-weighted), seeded: a
+/// cloud as a positions-only scan of the surface arrives.
+pub fn sample_triangles(
+    positions: &[[f32; 3]],
+    triangles: &[[u32; 3]],
+    n: usize,
+    seed: u64,
+) -> Vec<[f32; 3]> {
+    let corner = |t: &[u32; 3], i: usize| positions[t[i] as usize].map(f64::from);
+    let mut cumulative = Vec::with_capacity(triangles.len());
+    let mut total = 0.0f64;
+    for t in triangles {
+        let (a, b, c) = (corner(t, 0), corner(t, 1), corner(t, 2));
+        let u = [0, 1, 2].map(|k| b[k] - a[k]);
+        let v = [0, 1, 2].map(|k| c[k] - a[k]);
+        let x = [
+            u[1] * v[2] - u[2] * v[1],
+            u[2] * v[0] - u[0] * v[2],
+            u[0] * v[1] - u[1] * v[0],
+        ];
+        total += 0.5 * (x[0] * x[0] + x[1] * x[1] + x[2] * x[2]).sqrt();
+        cumulative.push(total);
+    }
+    let mut s = seed;
+    (0..n)
+        .map(|_| {
+            let r = (next(&mut s) >> 11) as f64 / (1u64 << 53) as f64 * total;
+            let t = &triangles[cumulative
+                .partition_point(|&c| c < r)
+                .min(triangles.len() - 1)];
+            let (mut e1, mut e2) = (f64::from(unit(&mut s)), f64::from(unit(&mut s)));
+            if e1 + e2 > 1.0 {
+                (e1, e2) = (1.0 - e1, 1.0 - e2);
+            }
+            let (a, b, c) = (corner(t, 0), corner(t, 1), corner(t, 2));
+            [0, 1, 2].map(|k| (a[k] + e1 * (b[k] - a[k]) + e2 * (c[k] - a[k])) as f32)
+        })
+        .collect()
 }
