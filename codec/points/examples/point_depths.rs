@@ -1,7 +1,7 @@
 //! Where a point stream's position bits go, depth by depth (issue 42):
 //!
 //! ```sh
-//! cargo run --release -p vitrine-points --example point_depths -- MESH POINTS BITS [VERSIONS] [--dump FILE]
+//! cargo run --release -p vitrine-points --example point_depths -- MESH POINTS BITS [VERSIONS] [--dump FILE] [--ingest-stream FILE]
 //! ```
 //! POINTS > 0 samples that many points on the mesh's triangles (as
 //! `point_bytes`); 0 takes the mesh's vertices as the cloud (a scan's own
@@ -12,14 +12,16 @@
 //! holding one point, and the share with no occupied cell among their 26
 //! neighbours. VERSIONS is a comma list (default `1,3`). `--dump FILE`
 //! writes the quantized positions (u32 × 3, little-endian, stream order) for
-//! `scripts/points-bound.py`. Every stream is decoded and compared.
+//! `scripts/points-bound.py`; `--ingest-stream FILE` writes the cloud as
+//! ingest stores it (normals estimated, default options) for
+//! `web/bench/splat-levels.mjs`. Every stream is decoded and compared.
 
 use std::collections::HashMap;
 
 use vitrine_mesh::import::{import_path, ImportOptions};
 use vitrine_points::stream::{decode, encode, EncodeOptions, Limits};
 use vitrine_points::testing::sample_triangles;
-use vitrine_points::PointCloud;
+use vitrine_points::{estimate_normals, PointCloud, DEFAULT_K};
 
 fn main() {
     let mut args: Vec<String> = std::env::args().skip(1).collect();
@@ -28,7 +30,13 @@ fn main() {
         args.drain(i..i + 2);
         file
     });
-    let usage = "usage: point_depths MESH POINTS BITS [VERSIONS] [--dump FILE]";
+    let ingest_stream = args.iter().position(|a| a == "--ingest-stream").map(|i| {
+        let file = args.get(i + 1).expect("--ingest-stream FILE").clone();
+        args.drain(i..i + 2);
+        file
+    });
+    let usage =
+        "usage: point_depths MESH POINTS BITS [VERSIONS] [--dump FILE] [--ingest-stream FILE]";
     let path = args.first().expect(usage);
     let n: usize = args.get(1).expect(usage).parse().expect("POINTS");
     let bits: u8 = args.get(2).expect(usage).parse().expect("BITS");
@@ -45,6 +53,19 @@ fn main() {
         sample_triangles(&mesh.positions, &mesh.triangles, n, 0x5eed)
     };
     let cloud = PointCloud::from_positions(positions);
+    if let Some(file) = &ingest_stream {
+        let with_normals = PointCloud {
+            normals: Some(estimate_normals(&cloud.positions, DEFAULT_K)),
+            ..cloud.clone()
+        };
+        let encoded = encode(&with_normals, &EncodeOptions::default()).expect("encode");
+        std::fs::write(file, &encoded.bytes).expect("write the stream");
+        println!(
+            "{file}: {} bytes, points per level {:?}",
+            encoded.bytes.len(),
+            encoded.level_points
+        );
+    }
     for (i, &version) in versions.iter().enumerate() {
         let options = EncodeOptions {
             bits,
