@@ -1,6 +1,9 @@
 //! Generated clouds with known normals for the tests, benches and examples:
 //! a deterministic random source and samplers of a sphere, a cube and a
-//! solid made of rectangles (an L-shaped block); points sampled on a mesh.
+//! solid made of rectangles (an L-shaped block); points sampled on a mesh;
+//! a CPU ray-cast of splats ([`raycast`]).
+
+pub mod raycast;
 
 /// SplitMix64 step.
 pub fn next(state: &mut u64) -> u64 {
