@@ -16,43 +16,8 @@ use std::time::Instant;
 
 use vitrine_mesh::import::{import_path, ImportOptions};
 use vitrine_points::stream::{decode, encode, EncodeOptions, Limits, VERSIONS};
-use vitrine_points::testing::{next, unit};
+use vitrine_points::testing::sample_triangles;
 use vitrine_points::PointCloud;
-
-/// `n` points uniformly on the triangles (area-weighted), seeded: the same
-/// points as `point_bytes`'s sample.
-fn sample(positions: &[[f32; 3]], triangles: &[[u32; 3]], n: usize, seed: u64) -> Vec<[f32; 3]> {
-    let corner = |t: &[u32; 3], i: usize| positions[t[i] as usize].map(f64::from);
-    let mut cumulative = Vec::with_capacity(triangles.len());
-    let mut total = 0.0f64;
-    for t in triangles {
-        let (a, b, c) = (corner(t, 0), corner(t, 1), corner(t, 2));
-        let u = [0, 1, 2].map(|k| b[k] - a[k]);
-        let v = [0, 1, 2].map(|k| c[k] - a[k]);
-        let x = [
-            u[1] * v[2] - u[2] * v[1],
-            u[2] * v[0] - u[0] * v[2],
-            u[0] * v[1] - u[1] * v[0],
-        ];
-        total += 0.5 * (x[0] * x[0] + x[1] * x[1] + x[2] * x[2]).sqrt();
-        cumulative.push(total);
-    }
-    let mut s = seed;
-    (0..n)
-        .map(|_| {
-            let r = (next(&mut s) >> 11) as f64 / (1u64 << 53) as f64 * total;
-            let t = &triangles[cumulative
-                .partition_point(|&c| c < r)
-                .min(triangles.len() - 1)];
-            let (mut e1, mut e2) = (f64::from(unit(&mut s)), f64::from(unit(&mut s)));
-            if e1 + e2 > 1.0 {
-                (e1, e2) = (1.0 - e1, 1.0 - e2);
-            }
-            let (a, b, c) = (corner(t, 0), corner(t, 1), corner(t, 2));
-            [0, 1, 2].map(|k| (a[k] + e1 * (b[k] - a[k]) + e2 * (c[k] - a[k])) as f32)
-        })
-        .collect()
-}
 
 fn fnv1a64(bytes: &[u8]) -> u64 {
     bytes.iter().fold(0xcbf2_9ce4_8422_2325, |h, &b| {
@@ -82,7 +47,7 @@ fn main() {
         a.split(',').map(|v| v.parse().expect("VERSIONS")).collect()
     });
     let mesh = import_path(path.as_ref(), &ImportOptions::default()).expect("import");
-    let cloud = PointCloud::from_positions(sample(&mesh.positions, &mesh.triangles, n, 0x5eed));
+    let cloud = PointCloud::from_positions(sample_triangles(&mesh.positions, &mesh.triangles, n, 0x5eed));
     let name = std::path::Path::new(path)
         .file_stem()
         .unwrap()
