@@ -47,7 +47,12 @@ fn main() {
         a.split(',').map(|v| v.parse().expect("VERSIONS")).collect()
     });
     let mesh = import_path(path.as_ref(), &ImportOptions::default()).expect("import");
-    let cloud = PointCloud::from_positions(sample_triangles(&mesh.positions, &mesh.triangles, n, 0x5eed));
+    let cloud = PointCloud::from_positions(sample_triangles(
+        &mesh.positions,
+        &mesh.triangles,
+        n,
+        0x5eed,
+    ));
     let name = std::path::Path::new(path)
         .file_stem()
         .unwrap()
