@@ -1,7 +1,7 @@
 //! Where a point stream's position bits go, depth by depth (issue 42):
 //!
 //! ```sh
-//! cargo run --release -p vitrine-points --example point_depths -- MESH POINTS BITS [VERSIONS] [--dump FILE] [--ingest-stream FILE]
+//! cargo run --release -p vitrine-points --example point_depths -- MESH POINTS BITS [VERSIONS] [--dump FILE] [--ingest-stream FILE] [--write-streams DIR]
 //! ```
 //! POINTS > 0 samples that many points on the mesh's triangles (as
 //! `point_bytes`); 0 takes the mesh's vertices as the cloud (a scan's own
@@ -14,7 +14,11 @@
 //! writes the quantized positions (u32 × 3, little-endian, stream order) for
 //! `scripts/points-bound.py`; `--ingest-stream FILE` writes the cloud as
 //! ingest stores it (normals estimated, default options) for
-//! `web/bench/splat-levels.mjs`. Every stream is decoded and compared.
+//! `web/bench/splat-levels.mjs`; `--write-streams DIR` writes, for each
+//! version, DIR/NAME-vV.vpts (positions only, default options but `BITS`)
+//! and DIR/NAME-vV.f32 (the cloud, x y z little-endian f32) for
+//! `scripts/peer_draco_points.py` and `web/bench/points-decode.mjs`.
+//! Every stream is decoded and compared.
 
 use std::collections::HashMap;
 
@@ -35,8 +39,13 @@ fn main() {
         args.drain(i..i + 2);
         file
     });
+    let write_streams = args.iter().position(|a| a == "--write-streams").map(|i| {
+        let dir = args.get(i + 1).expect("--write-streams DIR").clone();
+        args.drain(i..i + 2);
+        std::path::PathBuf::from(dir)
+    });
     let usage =
-        "usage: point_depths MESH POINTS BITS [VERSIONS] [--dump FILE] [--ingest-stream FILE]";
+        "usage: point_depths MESH POINTS BITS [VERSIONS] [--dump FILE] [--ingest-stream FILE] [--write-streams DIR]";
     let path = args.first().expect(usage);
     let n: usize = args.get(1).expect(usage).parse().expect("POINTS");
     let bits: u8 = args.get(2).expect(usage).parse().expect("BITS");
@@ -66,7 +75,29 @@ fn main() {
             encoded.level_points
         );
     }
+    let name = std::path::Path::new(path)
+        .file_stem()
+        .expect("a file name")
+        .to_string_lossy()
+        .to_string();
     for (i, &version) in versions.iter().enumerate() {
+        if let Some(dir) = &write_streams {
+            let options = EncodeOptions {
+                bits,
+                version,
+                ..Default::default()
+            };
+            let encoded = encode(&cloud, &options).expect("encode");
+            let stem = dir.join(format!("{name}-v{version}"));
+            std::fs::write(stem.with_extension("vpts"), &encoded.bytes).expect("write");
+            let raw: Vec<u8> = cloud
+                .positions
+                .iter()
+                .flatten()
+                .flat_map(|v| v.to_le_bytes())
+                .collect();
+            std::fs::write(stem.with_extension("f32"), raw).expect("write");
+        }
         let options = EncodeOptions {
             bits,
             version,
