@@ -25,6 +25,7 @@ mod format;
 mod models;
 mod neighbourhood;
 mod occupancy;
+mod predict;
 mod probability;
 mod region;
 

@@ -6,6 +6,7 @@ use vitrine_codec::entropy::{BitModel, IntModel, RangeDecoder, RangeEncoder};
 use super::attr::{colour_apply, colour_residual};
 use super::context::{Around, CODED, CONTEXTS};
 use super::occupancy::MaskCoder;
+use super::predict::{Prediction, CLASSES};
 
 /// Occupancy contexts: the parent's child count (1..=8) minus one.
 const PARENT_CLASSES: usize = 8;
@@ -41,6 +42,9 @@ pub(crate) struct Models {
     duplicates: IntModel,
     normal: [IntModel; 2],
     colour: [IntModel; 3],
+    /// Predicted attributes (flag bit 2): residual models per class.
+    predicted_normal: Vec<[IntModel; 2]>,
+    predicted_colour: Vec<[IntModel; 3]>,
     has_normals: bool,
     has_colours: bool,
 }
@@ -54,6 +58,8 @@ impl Models {
             duplicates: IntModel::new(),
             normal: [IntModel::new(), IntModel::new()],
             colour: [IntModel::new(), IntModel::new(), IntModel::new()],
+            predicted_normal: vec![[IntModel::new(), IntModel::new()]; CLASSES],
+            predicted_colour: vec![[IntModel::new(), IntModel::new(), IntModel::new()]; CLASSES],
             has_normals,
             has_colours,
         }
@@ -170,6 +176,50 @@ impl Models {
         if self.has_colours {
             let r = [0, 1, 2].map(|k| dec.decode_int(&mut self.colour[k]));
             a.colour = colour_apply(r, pred.colour)?;
+        }
+        Some(a)
+    }
+
+    /// Codes a new point's attributes against a neighbourhood prediction
+    /// (flag bit 2), with the models of the prediction's classes.
+    pub fn encode_predicted(&mut self, enc: &mut RangeEncoder, a: Attr, p: &Prediction) {
+        if self.has_normals {
+            let models = &mut self.predicted_normal[usize::from(p.normal_class)];
+            for (k, model) in models.iter_mut().enumerate() {
+                let d = i32::from(a.normal[k]) - i32::from(p.attr.normal[k]);
+                enc.encode_int(model, d);
+            }
+        }
+        if self.has_colours {
+            let r = colour_residual(a.colour, p.attr.colour);
+            let models = &mut self.predicted_colour[usize::from(p.colour_class)];
+            for (k, model) in models.iter_mut().enumerate() {
+                enc.encode_int(model, r[k]);
+            }
+        }
+    }
+
+    /// Decodes what [`encode_predicted`](Self::encode_predicted) coded;
+    /// `None` when a value leaves its range (corrupt).
+    pub fn decode_predicted(
+        &mut self,
+        dec: &mut RangeDecoder<'_>,
+        p: &Prediction,
+        normal_max: u16,
+    ) -> Option<Attr> {
+        let mut a = Attr::default();
+        if self.has_normals {
+            let models = &mut self.predicted_normal[usize::from(p.normal_class) % CLASSES];
+            for (k, model) in models.iter_mut().enumerate() {
+                let d = dec.decode_int(model);
+                let v = i32::from(p.attr.normal[k]).checked_add(d)?;
+                a.normal[k] = u16::try_from(v).ok().filter(|&v| v <= normal_max)?;
+            }
+        }
+        if self.has_colours {
+            let models = &mut self.predicted_colour[usize::from(p.colour_class) % CLASSES];
+            let r = [0, 1, 2].map(|k| dec.decode_int(&mut models[k]));
+            a.colour = colour_apply(r, p.attr.colour)?;
         }
         Some(a)
     }

@@ -1,0 +1,178 @@
+//! Attributes predicted from the decoded neighbourhood (header flag bit 2,
+//! `FORMAT.md` "Predicted attributes"): a new point's normal and colour
+//! against the inverse-square-distance weighted mean of the points the
+//! decoder already has near it, and a class (how far those neighbours
+//! stray from the mean) that picks the residual models. A lifting-style
+//! predictor as in MPEG G-PCC (ISO/IEC 23090-9 §10.6), with the neighbours
+//! found in a window of the coding order instead of a k-nearest search, so
+//! that a point costs a few dozen integer operations.
+//!
+//! Everything is in integers: the encoder and every decoder (native,
+//! WebAssembly) predict the same values.
+
+use super::models::Attr;
+
+/// Cells at the child depth coded just before the new point (its earlier
+/// siblings, the parent's representative's cell, the children of the
+/// parents before) that are candidates.
+pub(crate) const BEHIND: usize = 16;
+/// Cells at the parent depth after the new point's parent that are
+/// candidates (their representatives).
+pub(crate) const AHEAD: usize = 8;
+/// A candidate is a neighbour if it is at most this far on every axis, in
+/// half child cells (2 child cells).
+const REACH: i32 = 4;
+/// Residual model classes per attribute.
+pub(crate) const CLASSES: usize = 8;
+
+/// The neighbours of one new point, gathered as they are offered: the
+/// nearest one's normal, the weighted colour sums and each component's
+/// range.
+pub(crate) struct Neighbours {
+    /// The new point's cell centre, in half cells of its depth.
+    at: [i32; 3],
+    count: u32,
+    nearest: u32,
+    normal: [u16; 2],
+    weights: u32,
+    colour: [u32; 3],
+    /// Smallest and largest normal code components and colour channels.
+    low: [u16; 5],
+    high: [u16; 5],
+}
+
+/// What a new point's attributes are coded against.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Prediction {
+    pub attr: Attr,
+    pub normal_class: u8,
+    pub colour_class: u8,
+}
+
+/// The centre of the cell `at` of the child depth, in half child cells.
+pub(crate) fn child_centre(at: [u32; 3]) -> [i32; 3] {
+    at.map(|v| (2 * v + 1) as i32)
+}
+
+/// The centre of the cell `at` of the parent depth, in half child cells.
+pub(crate) fn parent_centre(at: [u32; 3]) -> [i32; 3] {
+    at.map(|v| (4 * v + 2) as i32)
+}
+
+impl Neighbours {
+    /// For the new point whose cell (at the child depth) is `at`.
+    pub fn new(at: [u32; 3]) -> Self {
+        Neighbours {
+            at: child_centre(at),
+            count: 0,
+            nearest: 0,
+            normal: [0; 2],
+            weights: 0,
+            colour: [0; 3],
+            low: [u16::MAX; 5],
+            high: [0; 5],
+        }
+    }
+
+    /// Offers the point at `centre` (half child cells) with attributes `a`.
+    #[inline]
+    pub fn offer(&mut self, centre: [i32; 3], a: Attr) {
+        let d = [0, 1, 2].map(|k| centre[k] - self.at[k]);
+        if d.iter().any(|v| v.abs() > REACH) {
+            return;
+        }
+        // d² ≥ 1: a candidate's centre is never the new point's.
+        let d2 = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).max(1) as u32;
+        let w = 65_536 / d2;
+        self.count += 1;
+        if w > self.nearest {
+            self.nearest = w;
+            self.normal = a.normal;
+        }
+        self.weights += w;
+        for k in 0..3 {
+            self.colour[k] += w * u32::from(a.colour[k]);
+        }
+        let values = [a.normal[0], a.normal[1]]
+            .into_iter()
+            .chain(a.colour.map(u16::from));
+        for (k, v) in values.enumerate() {
+            self.low[k] = self.low[k].min(v);
+            self.high[k] = self.high[k].max(v);
+        }
+    }
+
+    /// The prediction: the nearest neighbour's normal, the colour mean
+    /// weighted by 1/d², each with the class of the neighbours' range;
+    /// `fallback` (the parent's representative) in class 0 without
+    /// neighbours.
+    pub fn predict(&self, fallback: Attr) -> Prediction {
+        if self.count == 0 {
+            return Prediction {
+                attr: fallback,
+                normal_class: 0,
+                colour_class: 0,
+            };
+        }
+        let range = |k: usize| u32::from(self.high[k] - self.low[k]);
+        let total = self.weights;
+        Prediction {
+            attr: Attr {
+                normal: self.normal,
+                colour: self.colour.map(|c| ((c + total / 2) / total) as u8),
+            },
+            normal_class: class(range(0).max(range(1))),
+            colour_class: class(range(2).max(range(3)).max(range(4))),
+        }
+    }
+}
+
+/// Class 1..CLASSES − 1 of a range, from its bit length.
+fn class(range: u32) -> u8 {
+    let bits = 32 - range.leading_zeros();
+    1 + bits.min(CLASSES as u32 - 2) as u8
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn agreeing_neighbours_predict_their_value_in_the_lowest_class() {
+        let a = Attr {
+            normal: [300, 900],
+            colour: [10, 200, 30],
+        };
+        let mut n = Neighbours::new([5, 5, 5]);
+        n.offer(child_centre([4, 5, 5]), a);
+        n.offer(parent_centre([2, 2, 2]), a);
+        n.offer(child_centre([90, 5, 5]), Attr::default()); // too far
+        let p = n.predict(Attr::default());
+        assert_eq!(p.attr, a);
+        assert_eq!((p.normal_class, p.colour_class), (1, 1));
+    }
+
+    #[test]
+    fn nearest_normal_weighted_colour_and_range_classes() {
+        let near = Attr {
+            normal: [100, 100],
+            colour: [0, 0, 0],
+        };
+        let far = Attr {
+            normal: [110, 100],
+            colour: [250, 250, 250],
+        };
+        let mut n = Neighbours::new([8, 8, 8]);
+        n.offer(child_centre([9, 8, 8]), near); // d² = 4
+        n.offer(child_centre([10, 8, 8]), far); // d² = 16
+        let p = n.predict(Attr::default());
+        assert_eq!(p.attr.normal, [100, 100]);
+        // (0 · 16384 + 250 · 4096 + 10240) / 20480 = 50.5 → 50.
+        assert_eq!(p.attr.colour, [50; 3]);
+        // Ranges 10 (4 bits) and 250 (8 bits, capped at class 7).
+        assert_eq!((p.normal_class, p.colour_class), (5, 7));
+        // Nobody near: the fallback, class 0.
+        let alone = Neighbours::new([0, 0, 0]).predict(far);
+        assert_eq!((alone.attr, alone.normal_class, alone.colour_class), (far, 0, 0));
+    }
+}
