@@ -15,7 +15,8 @@
 //! as bits per point, and the whole stream's decode ms (median of R, old
 //! and new interleaved). `--write DIR` writes DIR/NAME.f32 (positions),
 //! NAME.nrm.f32 (normals) and NAME.rgb (colours) for
-//! `scripts/peer_draco_attrs.py`. The time normal estimation takes on the
+//! `scripts/peer_draco_attrs.py`. `--decode-loop K [--old]` only decodes the
+//! first cloud's 12-bit stream (new coding, or old) K times, for a profiler. The time normal estimation takes on the
 //! cloud (what a visitor pays for a stream without normals) goes to stderr.
 
 use std::path::{Path, PathBuf};
@@ -175,9 +176,25 @@ fn main() {
     let n: usize = take("--points").map_or(300_000, |v| v.parse().expect("N"));
     let runs: usize = take("--runs").map_or(5, |v| v.parse().expect("R"));
     let write = take("--write").map(PathBuf::from);
+    let decode_loop: Option<usize> = take("--decode-loop").map(|v| v.parse().expect("K"));
+    let old = args.iter().position(|a| a == "--old").map(|i| args.remove(i));
     let data = PathBuf::from(args.first().expect("usage: point_attrs DATA"));
     println!("cloud\tpoints\tbits\tpos_bytes\tnormal_b/p_old\tnormal_b/p_new\tcolour_b/p_old\tcolour_b/p_new\tattr_bytes_old\tattr_bytes_new\tdecode_ms_old\tdecode_ms_new");
     for (name, cloud) in clouds(&data, n) {
+        if let Some(k) = decode_loop {
+            // For a profiler: the first cloud's 12-bit stream, K decodes.
+            let opts = EncodeOptions {
+                bits: 12,
+                predict_attributes: old.is_none(),
+                ..Default::default()
+            };
+            let s = encode(&cloud, &opts).expect("encode");
+            for _ in 0..k {
+                let d = decode(&s.bytes, None, Limits::default()).expect("decode");
+                std::hint::black_box(d.point_count());
+            }
+            return;
+        }
         if let Some(dir) = &write {
             write_for_draco(dir, &name, &cloud);
         }

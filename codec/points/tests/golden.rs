@@ -70,8 +70,25 @@ fn clouds() -> Vec<(&'static str, PointCloud, EncodeOptions)> {
         ),
         (
             "v3-sphere-5000-normals-colours-14bit",
-            painted,
+            painted.clone(),
             small_v3.clone(),
+        ),
+        // Attributes predicted from the neighbourhood (flag bit 2).
+        (
+            "predicted-sphere-5000-normals-colours-14bit",
+            painted.clone(),
+            EncodeOptions {
+                predict_attributes: true,
+                ..small.clone()
+            },
+        ),
+        (
+            "v3-predicted-sphere-5000-normals-colours-14bit",
+            painted,
+            EncodeOptions {
+                predict_attributes: true,
+                ..small_v3.clone()
+            },
         ),
         (
             "v3-cube-8000-positions-11bit",

@@ -244,7 +244,8 @@ impl PointDecoder {
                         (cell.rep, cell.attr)
                     } else {
                         let a = if self.header.predicted_attributes {
-                            let mut near = Neighbours::new(at);
+                            let h = &self.header;
+                            let mut near = Neighbours::new(at, h.has_normals(), h.has_colours);
                             for c in next.iter().rev().take(BEHIND) {
                                 near.offer(child_centre(c.at), c.attr);
                             }

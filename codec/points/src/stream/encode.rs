@@ -42,7 +42,7 @@ impl Default for EncodeOptions {
             normals: true,
             colours: true,
             version: VERSION,
-            predict_attributes: true,
+            predict_attributes: false,
         }
     }
 }
@@ -251,7 +251,7 @@ pub fn encode(cloud: &PointCloud, opts: &EncodeOptions) -> Result<EncodedPoints>
                         let (a, p) = (attrs[rep as usize], attrs[parent_rep as usize]);
                         if header.predicted_attributes {
                             let attr_of = |c: &Cell| attrs[sorted[c.start as usize].1 as usize];
-                            let mut near = Neighbours::new(at);
+                            let mut near = Neighbours::new(at, normals.is_some(), colours.is_some());
                             for c in next.iter().rev().take(BEHIND) {
                                 near.offer(child_centre(c.at), attr_of(c));
                             }
