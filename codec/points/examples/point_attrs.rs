@@ -3,14 +3,15 @@
 //! neighbourhood (on), and decode time of both, on the clouds of issue 42:
 //!
 //! ```sh
-//! cargo run --release -p vitrine-points --example point_attrs -- DATA [--points N] [--runs R] [--write DIR]
+//! cargo run --release -p vitrine-points --example point_attrs -- DATA [--points N] [--runs R] [--normal-bits B] [--write DIR]
 //! ```
 //! DATA is `shared/data/meshes`. Clouds: N points (default 300,000) sampled
 //! on `lucy-100k.ply` with normals estimated as at ingest; the vertices of
 //! `nefertiti-rgb-10k.off` with their colours (and estimated normals); N/3
 //! points sampled on `banana/` with the texture's colour (nearest texel)
 //! and estimated normals; the golden sphere (5,000 points, exact normals,
-//! colours from the position). For each, at 12 and 14 bits, version 1:
+//! colours from the position). For each, at 12 and 14 bits, version 1,
+//! B octahedral bits per normal component (default 11, as ingest):
 //! positions-only bytes, the bytes normals add and colours add (old, new),
 //! as bits per point, and the whole stream's decode ms (median of R, old
 //! and new interleaved). `--write DIR` writes DIR/NAME.f32 (positions),
@@ -118,7 +119,8 @@ fn clouds(data: &Path, n: usize) -> Vec<(String, PointCloud)> {
             .iter()
             .map(|&(_, ti, e1, e2)| {
                 let t = tex.triangles[ti].map(|i| tex.uvs[i as usize].map(f64::from));
-                let uv = [0, 1].map(|k| t[0][k] + e1 * (t[1][k] - t[0][k]) + e2 * (t[2][k] - t[0][k]));
+                let uv =
+                    [0, 1].map(|k| t[0][k] + e1 * (t[1][k] - t[0][k]) + e2 * (t[2][k] - t[0][k]));
                 let x = (uv[0].rem_euclid(1.0) * f64::from(w)) as u32;
                 let y = (uv[1].rem_euclid(1.0) * f64::from(h)) as u32;
                 tex.image.get_pixel(x.min(w - 1), y.min(h - 1)).0
@@ -155,7 +157,8 @@ fn median(mut t: Vec<f64>) -> f64 {
 }
 
 fn write_for_draco(dir: &Path, name: &str, cloud: &PointCloud) {
-    let f32s = |v: &[[f32; 3]]| -> Vec<u8> { v.iter().flatten().flat_map(|x| x.to_le_bytes()).collect() };
+    let f32s =
+        |v: &[[f32; 3]]| -> Vec<u8> { v.iter().flatten().flat_map(|x| x.to_le_bytes()).collect() };
     std::fs::write(dir.join(format!("{name}.f32")), f32s(&cloud.positions)).expect("write");
     if let Some(n) = &cloud.normals {
         std::fs::write(dir.join(format!("{name}.nrm.f32")), f32s(n)).expect("write");
@@ -175,9 +178,13 @@ fn main() {
     };
     let n: usize = take("--points").map_or(300_000, |v| v.parse().expect("N"));
     let runs: usize = take("--runs").map_or(5, |v| v.parse().expect("R"));
+    let normal_bits: u8 = take("--normal-bits").map_or(11, |v| v.parse().expect("B"));
     let write = take("--write").map(PathBuf::from);
     let decode_loop: Option<usize> = take("--decode-loop").map(|v| v.parse().expect("K"));
-    let old = args.iter().position(|a| a == "--old").map(|i| args.remove(i));
+    let old = args
+        .iter()
+        .position(|a| a == "--old")
+        .map(|i| args.remove(i));
     let data = PathBuf::from(args.first().expect("usage: point_attrs DATA"));
     println!("cloud\tpoints\tbits\tpos_bytes\tnormal_b/p_old\tnormal_b/p_new\tcolour_b/p_old\tcolour_b/p_new\tattr_bytes_old\tattr_bytes_new\tdecode_ms_old\tdecode_ms_new");
     for (name, cloud) in clouds(&data, n) {
@@ -202,6 +209,7 @@ fn main() {
         for bits in [12u8, 14] {
             let opts = |normals, colours, predict| EncodeOptions {
                 bits,
+                normal_bits,
                 normals,
                 colours,
                 predict_attributes: predict,
@@ -217,7 +225,8 @@ fn main() {
             let has_c = cloud.colours.is_some();
             let (n_old, n_new) = (size(has_n, false, false), size(has_n, false, true));
             let (c_old, c_new) = (size(false, has_c, false), size(false, has_c, true));
-            let streams = [false, true].map(|p| encode(&cloud, &opts(true, true, p)).expect("encode"));
+            let streams =
+                [false, true].map(|p| encode(&cloud, &opts(true, true, p)).expect("encode"));
             for s in &streams {
                 let d = decode(&s.bytes, None, Limits::default()).expect("decode");
                 assert_eq!(d.quantized(), &s.quantized[..], "positions");

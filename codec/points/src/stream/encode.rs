@@ -29,7 +29,9 @@ pub struct EncodeOptions {
     pub version: u8,
     /// Code new points' normals and colours against a prediction from the
     /// decoded neighbourhood (header flag bit 2, any version) instead of
-    /// their parent's representative alone.
+    /// their parent's representative alone: 1–6 % smaller normals, 3–9 %
+    /// smaller colours on the clouds measured, 18 % more decoding
+    /// instructions, so off by default (session 34).
     pub predict_attributes: bool,
 }
 
@@ -251,7 +253,8 @@ pub fn encode(cloud: &PointCloud, opts: &EncodeOptions) -> Result<EncodedPoints>
                         let (a, p) = (attrs[rep as usize], attrs[parent_rep as usize]);
                         if header.predicted_attributes {
                             let attr_of = |c: &Cell| attrs[sorted[c.start as usize].1 as usize];
-                            let mut near = Neighbours::new(at, normals.is_some(), colours.is_some());
+                            let mut near =
+                                Neighbours::new(at, normals.is_some(), colours.is_some());
                             for c in next.iter().rev().take(BEHIND) {
                                 near.offer(child_centre(c.at), attr_of(c));
                             }
