@@ -246,12 +246,13 @@ impl PointDecoder {
                         let a = if self.header.predicted_attributes {
                             let h = &self.header;
                             let mut near = Neighbours::new(at, h.has_normals(), h.has_colours);
-                            for c in next.iter().rev().take(BEHIND) {
-                                near.offer(child_centre(c.at), c.attr);
-                            }
-                            for c in cells[i + 1..].iter().take(AHEAD) {
-                                near.offer(parent_centre(c.at), c.attr);
-                            }
+                            let behind = next.iter().rev().take(BEHIND);
+                            let ahead = cells[i + 1..].iter().take(AHEAD);
+                            near.offer(
+                                behind
+                                    .map(|c| (child_centre(c.at), c.attr))
+                                    .chain(ahead.map(|c| (parent_centre(c.at), c.attr))),
+                            );
                             let prediction = near.predict(cell.attr);
                             self.models
                                 .decode_predicted(&mut dec, &prediction, normal_max)

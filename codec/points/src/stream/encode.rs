@@ -255,12 +255,13 @@ pub fn encode(cloud: &PointCloud, opts: &EncodeOptions) -> Result<EncodedPoints>
                             let attr_of = |c: &Cell| attrs[sorted[c.start as usize].1 as usize];
                             let mut near =
                                 Neighbours::new(at, normals.is_some(), colours.is_some());
-                            for c in next.iter().rev().take(BEHIND) {
-                                near.offer(child_centre(c.at), attr_of(c));
-                            }
-                            for c in cells[i + 1..].iter().take(AHEAD) {
-                                near.offer(parent_centre(c.at), attr_of(c));
-                            }
+                            let behind = next.iter().rev().take(BEHIND);
+                            let ahead = cells[i + 1..].iter().take(AHEAD);
+                            near.offer(
+                                behind
+                                    .map(|c| (child_centre(c.at), attr_of(c)))
+                                    .chain(ahead.map(|c| (parent_centre(c.at), attr_of(c)))),
+                            );
                             let prediction = near.predict(p);
                             models.encode_predicted(&mut enc, a, &prediction);
                         } else {

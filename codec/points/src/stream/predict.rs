@@ -106,33 +106,59 @@ impl Neighbours {
         }
     }
 
-    /// Offers the point at `centre` (half child cells) with attributes `a`.
+    /// Offers the candidates: each point's centre (half child cells) and
+    /// attributes. (One loop over local accumulators, so that they stay in
+    /// registers.)
     #[inline(always)]
-    pub fn offer(&mut self, centre: [i32; 3], a: Attr) {
-        let d = [0, 1, 2].map(|k| centre[k] - self.at[k]);
-        if d[0].abs() > REACH || d[1].abs() > REACH || d[2].abs() > REACH {
-            return;
+    pub fn offer(&mut self, candidates: impl Iterator<Item = ([i32; 3], Attr)>) {
+        match (self.normals, self.colours) {
+            (true, true) => self.gather::<true, true>(candidates),
+            (true, false) => self.gather::<true, false>(candidates),
+            (false, true) => self.gather::<false, true>(candidates),
+            (false, false) => self.gather::<false, false>(candidates),
         }
-        let w = WEIGHTS[(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]) as usize];
-        self.count += 1;
-        if self.normals {
-            if w > self.nearest {
-                self.nearest = w;
-                self.normal = a.normal;
+    }
+
+    #[inline(always)]
+    fn gather<const NORMALS: bool, const COLOURS: bool>(
+        &mut self,
+        candidates: impl Iterator<Item = ([i32; 3], Attr)>,
+    ) {
+        let (mut count, mut nearest, mut normal) = (self.count, self.nearest, self.normal);
+        let (mut n_low, mut n_high) = (self.normal_low, self.normal_high);
+        let (mut weights, mut colour) = (self.weights, self.colour);
+        let (mut c_low, mut c_high) = (self.colour_low, self.colour_high);
+        let inside = |v: i32| (v + REACH) as u32 <= 2 * REACH as u32;
+        for (centre, a) in candidates {
+            let d = [0, 1, 2].map(|k| centre[k] - self.at[k]);
+            if !(inside(d[0]) && inside(d[1]) && inside(d[2])) {
+                continue;
             }
-            for k in 0..2 {
-                self.normal_low[k] = self.normal_low[k].min(a.normal[k]);
-                self.normal_high[k] = self.normal_high[k].max(a.normal[k]);
+            let w = WEIGHTS[(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]) as usize];
+            count += 1;
+            if NORMALS {
+                if w > nearest {
+                    nearest = w;
+                    normal = a.normal;
+                }
+                for k in 0..2 {
+                    n_low[k] = n_low[k].min(a.normal[k]);
+                    n_high[k] = n_high[k].max(a.normal[k]);
+                }
+            }
+            if COLOURS {
+                weights += w;
+                for k in 0..3 {
+                    colour[k] += w * u32::from(a.colour[k]);
+                    c_low[k] = c_low[k].min(a.colour[k]);
+                    c_high[k] = c_high[k].max(a.colour[k]);
+                }
             }
         }
-        if self.colours {
-            self.weights += w;
-            for k in 0..3 {
-                self.colour[k] += w * u32::from(a.colour[k]);
-                self.colour_low[k] = self.colour_low[k].min(a.colour[k]);
-                self.colour_high[k] = self.colour_high[k].max(a.colour[k]);
-            }
-        }
+        (self.count, self.nearest, self.normal) = (count, nearest, normal);
+        (self.normal_low, self.normal_high) = (n_low, n_high);
+        (self.weights, self.colour) = (weights, colour);
+        (self.colour_low, self.colour_high) = (c_low, c_high);
     }
 
     /// The prediction: the nearest neighbour's normal, the colour mean
@@ -180,9 +206,14 @@ mod tests {
             colour: [10, 200, 30],
         };
         let mut n = Neighbours::new([5, 5, 5], true, true);
-        n.offer(child_centre([4, 5, 5]), a);
-        n.offer(parent_centre([2, 2, 2]), a);
-        n.offer(child_centre([90, 5, 5]), Attr::default()); // too far
+        n.offer(
+            [
+                (child_centre([4, 5, 5]), a),
+                (parent_centre([2, 2, 2]), a),
+                (child_centre([90, 5, 5]), Attr::default()), // too far
+            ]
+            .into_iter(),
+        );
         let p = n.predict(Attr::default());
         assert_eq!(p.attr, a);
         assert_eq!((p.normal_class, p.colour_class), (1, 1));
@@ -199,8 +230,14 @@ mod tests {
             colour: [250, 250, 250],
         };
         let mut n = Neighbours::new([8, 8, 8], true, true);
-        n.offer(child_centre([9, 8, 8]), near); // d² = 4
-        n.offer(child_centre([10, 8, 8]), far); // d² = 16
+        // d² = 4 and 16.
+        n.offer(
+            [
+                (child_centre([9, 8, 8]), near),
+                (child_centre([10, 8, 8]), far),
+            ]
+            .into_iter(),
+        );
         let p = n.predict(Attr::default());
         assert_eq!(p.attr.normal, [100, 100]);
         // (0 · 16384 + 250 · 4096 + 10240) / 20480 = 50.5 → 50.
