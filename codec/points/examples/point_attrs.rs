@@ -16,7 +16,9 @@
 //! as bits per point, and the whole stream's decode ms (median of R, old
 //! and new interleaved). `--write DIR` writes DIR/NAME.f32 (positions),
 //! NAME.nrm.f32 (normals) and NAME.rgb (colours) for
-//! `scripts/peer_draco_attrs.py`. `--decode-loop K [--old]` only decodes the
+//! `scripts/peer_draco_attrs.py`, and the streams with both attributes,
+//! NAME-BITS-old.vpts and NAME-BITS-new.vpts, for
+//! `web/bench/points-attrs-decode.mjs`. `--decode-loop K [--old]` only decodes the
 //! first cloud's 12-bit stream (new coding, or old) K times, for a profiler. The time normal estimation takes on the
 //! cloud (what a visitor pays for a stream without normals) goes to stderr.
 
@@ -246,6 +248,12 @@ fn main() {
                 }
             }
             let [t_old, t_new] = times.map(median);
+            if let Some(dir) = &write {
+                for (s, coding) in streams.iter().zip(["old", "new"]) {
+                    let path = dir.join(format!("{name}-{bits}-{coding}.vpts"));
+                    std::fs::write(path, &s.bytes).expect("write");
+                }
+            }
             println!(
                 "{name}\t{len}\t{bits}\t{pos}\t{:.2}\t{:.2}\t{:.2}\t{:.2}\t{}\t{}\t{t_old:.1}\t{t_new:.1}",
                 bpp(n_old),
