@@ -29,10 +29,12 @@ fn clouds() -> Vec<(&'static str, PointCloud, EncodeOptions)> {
         colours: Some(colours),
     };
     let (cube_pos, _) = cube(8000, 1.0, 7);
-    // Version 1 streams must stay byte for byte what they were.
+    // Version 1 streams must stay byte for byte what they were; these
+    // record the parent-only attribute coding (the default before session 34).
     let small = EncodeOptions {
         base_points: 256,
         version: 1,
+        predict_attributes: false,
         ..Default::default()
     };
     let small_v2 = EncodeOptions {

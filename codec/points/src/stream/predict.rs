@@ -13,9 +13,10 @@
 //! Measured (session 34, `docs/bench-log/2026-12-08-session-34-point-attributes.md`):
 //! the mean of the neighbours' normals (re-encoded octahedrally) coded
 //! estimated normals 10 % larger than the parent's normal alone; the
-//! nearest neighbour's, 1–6 % smaller. Wider windows (16 behind, 8 ahead)
-//! saved 0.1 % more on normals and 1–4 % on colours for up to twice the
-//! prediction's time.
+//! nearest neighbour's, 1–6 % smaller, and with the second residual's
+//! models chosen by the first's size (`models.rs`), 2–12 % smaller. Wider
+//! windows (16 behind, 8 ahead) saved 0.1 % more on normals and 1–4 % on
+//! colours for up to twice the prediction's time.
 //!
 //! Everything is in integers: the encoder and every decoder (native,
 //! WebAssembly) predict the same values.
