@@ -104,16 +104,21 @@ fn main() {
             normals: attrs.then_some(nrm),
             ..vitrine_points::PointCloud::from_positions(pos)
         };
-        // Every stream version (2 and 3: neighbour-dependent mask contexts).
+        // Every stream version (2 and 3: neighbour-dependent mask contexts),
+        // and with attributes, also predicted from the neighbourhood (flag bit 2).
         for version in vitrine_points::stream::VERSIONS {
-            let opts = vitrine_points::stream::EncodeOptions {
-                bits: 10,
-                base_points: 16,
-                version,
-                ..Default::default()
-            };
-            let s = vitrine_points::stream::encode(&cloud, &opts).unwrap();
-            write("decode_points", &format!("sphere-{i}-v{version}"), &s.bytes);
+            for predict in [false, true].into_iter().filter(|&p| attrs || !p) {
+                let opts = vitrine_points::stream::EncodeOptions {
+                    bits: 10,
+                    base_points: 16,
+                    version,
+                    predict_attributes: predict,
+                    ..Default::default()
+                };
+                let s = vitrine_points::stream::encode(&cloud, &opts).unwrap();
+                let tail = if predict { "-predicted" } else { "" };
+                write("decode_points", &format!("sphere-{i}-v{version}{tail}"), &s.bytes);
+            }
         }
     }
 

@@ -29,10 +29,12 @@ fn clouds() -> Vec<(&'static str, PointCloud, EncodeOptions)> {
         colours: Some(colours),
     };
     let (cube_pos, _) = cube(8000, 1.0, 7);
-    // Version 1 streams must stay byte for byte what they were.
+    // Version 1 streams must stay byte for byte what they were; these
+    // record the parent-only attribute coding (the default before session 34).
     let small = EncodeOptions {
         base_points: 256,
         version: 1,
+        predict_attributes: false,
         ..Default::default()
     };
     let small_v2 = EncodeOptions {
@@ -70,8 +72,25 @@ fn clouds() -> Vec<(&'static str, PointCloud, EncodeOptions)> {
         ),
         (
             "v3-sphere-5000-normals-colours-14bit",
-            painted,
+            painted.clone(),
             small_v3.clone(),
+        ),
+        // Attributes predicted from the neighbourhood (flag bit 2).
+        (
+            "predicted-sphere-5000-normals-colours-14bit",
+            painted.clone(),
+            EncodeOptions {
+                predict_attributes: true,
+                ..small.clone()
+            },
+        ),
+        (
+            "v3-predicted-sphere-5000-normals-colours-14bit",
+            painted,
+            EncodeOptions {
+                predict_attributes: true,
+                ..small_v3.clone()
+            },
         ),
         (
             "v3-cube-8000-positions-11bit",

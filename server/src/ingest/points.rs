@@ -224,6 +224,7 @@ fn compression(encoding: &Encoding, options: &IngestOptions) -> NewCompression {
             "base_points": points.base_points,
             "normals": points.normals,
             "colours": points.colours,
+            "predict_attributes": header.predicted_attributes,
         })
         .to_string(),
         stats: json!({

@@ -88,6 +88,8 @@ pub async fn points_streamed_under_caps(db: TestDb) {
     ingest_sample(&*db.storage, "torus", "open").await;
     // What the encoder itself makes of the same cloud with the same options.
     let own = stream::encode(&sample_cloud(), &point_options().points).unwrap();
+    // Ingest codes attributes against the decoded neighbourhood (session 34).
+    assert!(own.header.predicted_attributes);
     let counts = &own.level_points;
     let last = counts.len() - 1;
     assert!(last >= 3, "the sample needs at least 4 levels: {counts:?}");

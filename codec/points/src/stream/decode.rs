@@ -7,6 +7,7 @@ use super::attr::octahedral_decode;
 use super::format::{read_chunk, PointHeader};
 use super::models::{root_prediction, Attr, Models};
 use super::neighbourhood::Neighbourhood;
+use super::predict::{child_centre, parent_centre, Neighbours, AHEAD, BEHIND};
 use crate::PointCloud;
 
 /// Budgets for decoding untrusted streams.
@@ -36,6 +37,9 @@ struct Cell {
     rep: u32,
     /// Parent's child count − 1.
     class: u8,
+    /// The representative's attributes (a copy: predictions read the
+    /// cells near in coding order, not points scattered over `attrs`).
+    attr: Attr,
 }
 
 /// Decodes a stream level by level; after each level it holds every point
@@ -201,19 +205,20 @@ impl PointDecoder {
                 at: [0; 3],
                 rep,
                 class: 7,
+                attr: a,
             });
         }
         let last = self.header.level_depths[self.level];
         while self.depth < last {
             let cells = std::mem::take(&mut self.cells);
-            let mut next = Vec::with_capacity(cells.len().min(count as usize));
+            let mut next: Vec<Cell> = Vec::with_capacity(cells.len().min(count as usize));
             let v2 = self.header.version >= 2;
             if v2 {
                 let depth = u32::from(self.depth);
                 self.neighbourhood
                     .start_depth(depth, depth + 1 == u32::from(self.header.bits));
             }
-            for cell in &cells {
+            for (i, cell) in cells.iter().enumerate() {
                 dec.check_overrun()?;
                 let mask = if self.header.version >= 3 {
                     let around = self.neighbourhood.around(cell.at);
@@ -234,19 +239,36 @@ impl PointDecoder {
                     if mask & (1 << k) == 0 {
                         continue;
                     }
-                    let rep = if first {
-                        cell.rep
+                    let at = [0, 1, 2].map(|a| cell.at[a] * 2 + ((k >> a) & 1));
+                    let (rep, attr) = if first {
+                        (cell.rep, cell.attr)
                     } else {
-                        let pred = self.attrs[cell.rep as usize];
-                        let a = self
-                            .models
-                            .decode_attr(&mut dec, pred, normal_max)
-                            .ok_or_else(bad_attr)?;
-                        self.new_point(a)?
+                        let a = if self.header.predicted_attributes {
+                            let h = &self.header;
+                            let mut near = Neighbours::new(at, h.has_normals(), h.has_colours);
+                            let behind = next.iter().rev().take(BEHIND);
+                            let ahead = cells[i + 1..].iter().take(AHEAD);
+                            near.offer(
+                                behind
+                                    .map(|c| (child_centre(c.at), c.attr))
+                                    .chain(ahead.map(|c| (parent_centre(c.at), c.attr))),
+                            );
+                            let prediction = near.predict(cell.attr);
+                            self.models
+                                .decode_predicted(&mut dec, &prediction, normal_max)
+                        } else {
+                            self.models.decode_attr(&mut dec, cell.attr, normal_max)
+                        };
+                        let a = a.ok_or_else(bad_attr)?;
+                        (self.new_point(a)?, a)
                     };
                     first = false;
-                    let at = [0, 1, 2].map(|a| cell.at[a] * 2 + ((k >> a) & 1));
-                    next.push(Cell { at, rep, class });
+                    next.push(Cell {
+                        at,
+                        rep,
+                        class,
+                        attr,
+                    });
                 }
             }
             self.cells = next;
@@ -267,10 +289,9 @@ impl PointDecoder {
                     return Err(corrupt("more points than the header declares"));
                 }
                 for _ in 0..extra {
-                    let pred = self.attrs[cell.rep as usize];
                     let a = self
                         .models
-                        .decode_attr(&mut dec, pred, normal_max)
+                        .decode_attr(&mut dec, cell.attr, normal_max)
                         .ok_or_else(bad_attr)?;
                     self.new_point(a)?;
                     self.quantized.push(cell.at);

@@ -8,6 +8,7 @@ use super::context::morton;
 use super::format::{PointHeader, MAX_BITS, VERSION, VERSIONS};
 use super::models::{root_prediction, Attr, Models};
 use super::neighbourhood::Neighbourhood;
+use super::predict::{child_centre, parent_centre, Neighbours, AHEAD, BEHIND};
 use crate::PointCloud;
 
 /// How to encode.
@@ -26,6 +27,13 @@ pub struct EncodeOptions {
     pub colours: bool,
     /// Stream format version to write (1, 2 or 3; 2 and 3 code positions smaller).
     pub version: u8,
+    /// Code new points' normals and colours against a prediction from the
+    /// decoded neighbourhood (header flag bit 2, any version) instead of
+    /// their parent's representative alone: 3–10 % smaller normals and
+    /// 3–12 % smaller colours on the clouds measured, for 1.13–1.21× the
+    /// WebAssembly decode time, which the bytes saved outweigh at 10 Mbit/s
+    /// (session 34). Decoders before session 34 refuse such streams.
+    pub predict_attributes: bool,
 }
 
 impl Default for EncodeOptions {
@@ -37,6 +45,7 @@ impl Default for EncodeOptions {
             normals: true,
             colours: true,
             version: VERSION,
+            predict_attributes: true,
         }
     }
 }
@@ -167,6 +176,7 @@ pub fn encode(cloud: &PointCloud, opts: &EncodeOptions) -> Result<EncodedPoints>
         bits,
         normal_bits,
         has_colours: colours.is_some(),
+        predicted_attributes: opts.predict_attributes && (normals.is_some() || colours.is_some()),
         origin: cloud.origin,
         min,
         step,
@@ -200,11 +210,11 @@ pub fn encode(cloud: &PointCloud, opts: &EncodeOptions) -> Result<EncodedPoints>
         }
         while depth < u32::from(last) {
             let shift = 3 * (b - depth - 1);
-            let mut next = Vec::with_capacity(cells.len() * 2);
+            let mut next: Vec<Cell> = Vec::with_capacity(cells.len() * 2);
             if header.version >= 2 {
                 neighbourhood.start_depth(depth, depth + 1 == b);
             }
-            for cell in &cells {
+            for (i, cell) in cells.iter().enumerate() {
                 let parent_rep = sorted[cell.start as usize].1;
                 let mut mask = 0u8;
                 let mut children = [(0u32, 0u32); 8];
@@ -236,16 +246,32 @@ pub fn encode(cloud: &PointCloud, opts: &EncodeOptions) -> Result<EncodedPoints>
                     if mask & (1 << k) == 0 {
                         continue;
                     }
+                    let k = k as u32;
+                    let at = [0, 1, 2].map(|a| cell.at[a] * 2 + ((k >> a) & 1));
                     if !first {
                         let rep = sorted[s as usize].1;
                         order.push(rep);
                         let (a, p) = (attrs[rep as usize], attrs[parent_rep as usize]);
-                        models.encode_attr(&mut enc, a, p);
+                        if header.predicted_attributes {
+                            let attr_of = |c: &Cell| attrs[sorted[c.start as usize].1 as usize];
+                            let mut near =
+                                Neighbours::new(at, normals.is_some(), colours.is_some());
+                            let behind = next.iter().rev().take(BEHIND);
+                            let ahead = cells[i + 1..].iter().take(AHEAD);
+                            near.offer(
+                                behind
+                                    .map(|c| (child_centre(c.at), attr_of(c)))
+                                    .chain(ahead.map(|c| (parent_centre(c.at), attr_of(c)))),
+                            );
+                            let prediction = near.predict(p);
+                            models.encode_predicted(&mut enc, a, &prediction);
+                        } else {
+                            models.encode_attr(&mut enc, a, p);
+                        }
                     }
                     first = false;
-                    let k = k as u32;
                     next.push(Cell {
-                        at: [0, 1, 2].map(|a| cell.at[a] * 2 + ((k >> a) & 1)),
+                        at,
                         start: s,
                         end: e,
                         class,

@@ -24,6 +24,9 @@ pub const VERSIONS: std::ops::RangeInclusive<u8> = 1..=3;
 pub(crate) const FLAG_NORMALS: u8 = 1;
 /// Header flag: points carry colours.
 pub(crate) const FLAG_COLOURS: u8 = 2;
+/// Header flag: new points' attributes are predicted from the decoded
+/// neighbourhood (`FORMAT.md` "Predicted attributes"), any version.
+pub(crate) const FLAG_PREDICTED: u8 = 4;
 
 /// Most position bits per axis (the octree depth): 3 × 20 bits fit the u64
 /// Morton keys.
@@ -44,6 +47,9 @@ pub struct PointHeader {
     /// Octahedral bits per normal component (0: no normals).
     pub normal_bits: u8,
     pub has_colours: bool,
+    /// New points' attributes are coded against a prediction from the
+    /// decoded neighbourhood (flag bit 2), not their parent's alone.
+    pub predicted_attributes: bool,
     /// Added to every dequantized position.
     pub origin: [f64; 3],
     /// Dequantized position = `min + q · step` (then `origin` added).
@@ -77,7 +83,12 @@ impl PointHeader {
         out.extend_from_slice(&MAGIC);
         out.push(self.version);
         let flags = if self.has_normals() { FLAG_NORMALS } else { 0 }
-            | if self.has_colours { FLAG_COLOURS } else { 0 };
+            | if self.has_colours { FLAG_COLOURS } else { 0 }
+            | if self.predicted_attributes {
+                FLAG_PREDICTED
+            } else {
+                0
+            };
         out.push(flags);
         out.push(self.bits);
         out.push(self.normal_bits);
@@ -117,7 +128,7 @@ impl PointHeader {
             return Err(err("truncated header"));
         }
         let flags = bytes[5];
-        if flags & !(FLAG_NORMALS | FLAG_COLOURS) != 0 {
+        if flags & !(FLAG_NORMALS | FLAG_COLOURS | FLAG_PREDICTED) != 0 {
             return Err(err("unknown header flags"));
         }
         let bits = bytes[6];
@@ -159,6 +170,7 @@ impl PointHeader {
             bits,
             normal_bits,
             has_colours: flags & FLAG_COLOURS != 0,
+            predicted_attributes: flags & FLAG_PREDICTED != 0,
             origin,
             min,
             step,

@@ -11,7 +11,9 @@
 //! depth d before any point of depth d + 1: every level is a prefix of the
 //! final order and an even subsample of the whole. Normals (octahedral) and
 //! colours of a new point are coded as residuals against its parent's
-//! representative. Several points in one finest cell are coded as a count.
+//! representative or, with header flag bit 2, against a prediction from the
+//! decoded points near it (`predict.rs`). Several points in one finest cell
+//! are coded as a count.
 //!
 //! The stream is a header plus one self-delimiting chunk per level; the
 //! decoder reproduces the quantized positions, normals and colours bit for
@@ -25,6 +27,7 @@ mod format;
 mod models;
 mod neighbourhood;
 mod occupancy;
+mod predict;
 mod probability;
 mod region;
 

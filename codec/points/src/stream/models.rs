@@ -6,6 +6,7 @@ use vitrine_codec::entropy::{BitModel, IntModel, RangeDecoder, RangeEncoder};
 use super::attr::{colour_apply, colour_residual};
 use super::context::{Around, CODED, CONTEXTS};
 use super::occupancy::MaskCoder;
+use super::predict::{Prediction, CLASSES};
 
 /// Occupancy contexts: the parent's child count (1..=8) minus one.
 const PARENT_CLASSES: usize = 8;
@@ -41,6 +42,13 @@ pub(crate) struct Models {
     duplicates: IntModel,
     normal: [IntModel; 2],
     colour: [IntModel; 3],
+    /// Predicted attributes (flag bit 2): residual models per class, the
+    /// second normal component's and the red and blue ones' also by the
+    /// size of the first residual (`linked`).
+    predicted_u: Vec<IntModel>,
+    predicted_v: Vec<IntModel>,
+    predicted_green: Vec<IntModel>,
+    predicted_red_blue: Vec<[IntModel; 2]>,
     has_normals: bool,
     has_colours: bool,
 }
@@ -54,6 +62,10 @@ impl Models {
             duplicates: IntModel::new(),
             normal: [IntModel::new(), IntModel::new()],
             colour: [IntModel::new(), IntModel::new(), IntModel::new()],
+            predicted_u: vec![IntModel::new(); CLASSES],
+            predicted_v: vec![IntModel::new(); CLASSES * LINKED],
+            predicted_green: vec![IntModel::new(); CLASSES],
+            predicted_red_blue: vec![[IntModel::new(), IntModel::new()]; CLASSES * LINKED],
             has_normals,
             has_colours,
         }
@@ -173,4 +185,64 @@ impl Models {
         }
         Some(a)
     }
+
+    /// Codes a new point's attributes against a neighbourhood prediction
+    /// (flag bit 2), with the models of the prediction's classes.
+    pub fn encode_predicted(&mut self, enc: &mut RangeEncoder, a: Attr, p: &Prediction) {
+        if self.has_normals {
+            let class = usize::from(p.normal_class);
+            let d = [0, 1].map(|k| i32::from(a.normal[k]) - i32::from(p.attr.normal[k]));
+            enc.encode_int(&mut self.predicted_u[class], d[0]);
+            enc.encode_int(&mut self.predicted_v[class * LINKED + linked(d[0])], d[1]);
+        }
+        if self.has_colours {
+            let class = usize::from(p.colour_class);
+            let r = colour_residual(a.colour, p.attr.colour);
+            enc.encode_int(&mut self.predicted_green[class], r[0]);
+            let models = &mut self.predicted_red_blue[class * LINKED + linked(r[0])];
+            enc.encode_int(&mut models[0], r[1]);
+            enc.encode_int(&mut models[1], r[2]);
+        }
+    }
+
+    /// Decodes what [`encode_predicted`](Self::encode_predicted) coded;
+    /// `None` when a value leaves its range (corrupt).
+    pub fn decode_predicted(
+        &mut self,
+        dec: &mut RangeDecoder<'_>,
+        p: &Prediction,
+        normal_max: u16,
+    ) -> Option<Attr> {
+        let mut a = Attr::default();
+        if self.has_normals {
+            let class = usize::from(p.normal_class) % CLASSES;
+            let du = dec.decode_int(&mut self.predicted_u[class]);
+            let dv = dec.decode_int(&mut self.predicted_v[class * LINKED + linked(du)]);
+            for (k, d) in [du, dv].into_iter().enumerate() {
+                let v = i32::from(p.attr.normal[k]).checked_add(d)?;
+                a.normal[k] = u16::try_from(v).ok().filter(|&v| v <= normal_max)?;
+            }
+        }
+        if self.has_colours {
+            let class = usize::from(p.colour_class) % CLASSES;
+            let g = dec.decode_int(&mut self.predicted_green[class]);
+            let models = &mut self.predicted_red_blue[class * LINKED + linked(g)];
+            let r = [
+                g,
+                dec.decode_int(&mut models[0]),
+                dec.decode_int(&mut models[1]),
+            ];
+            a.colour = colour_apply(r, p.attr.colour)?;
+        }
+        Some(a)
+    }
+}
+
+/// Bins of the first residual's size that pick the next residuals' models.
+const LINKED: usize = 8;
+
+/// The bin of a residual: its magnitude's bit length, at most `LINKED − 1`.
+fn linked(d: i32) -> usize {
+    let bits = 32 - d.unsigned_abs().leading_zeros();
+    (bits as usize).min(LINKED - 1)
 }
