@@ -58,5 +58,6 @@ pub use feature_search::{
 };
 pub use voronoi::{
     simplify_voronoi, Distance, Order, Radius, VoronoiOptions, VoronoiPlacement, VoronoiSimplified,
+    VoronoiSpacing,
     SHARP_DEGREES,
 };

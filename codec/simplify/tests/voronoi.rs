@@ -14,6 +14,7 @@ use vitrine_quality::metrics::hausdorff;
 use vitrine_samples::{add_noise, grid, icosphere, merge, plate_with_tunnels, punch_holes, torus};
 use vitrine_simplify::{
     simplify_voronoi, Order, Radius, VoronoiOptions, VoronoiPlacement, VoronoiSimplified,
+    VoronoiSpacing,
 };
 
 const ORDERS: [Order; 3] = [Order::Incremental, Order::Farthest, Order::Curvature];
@@ -235,6 +236,93 @@ fn quadric_placement_keeps_the_plate_sharp() {
         assert_sound_moved("plate", &plate, &out);
         let h = hausdorff(&plate, &out.mesh, 50_000).relative();
         assert!(h < 1e-4, "r = {r}: Hausdorff {h} over the diagonal");
+    }
+}
+
+/// A 48 × 48 grid, flat but for a narrow, tall bump (a Gaussian of height
+/// 6 and width 2 around (14, 14)): the curved part is a tenth of the area.
+fn bumped_grid() -> IndexedMesh {
+    let mut mesh = grid(48);
+    for p in &mut mesh.positions {
+        let d2 = (p[0] - 14.0).powi(2) + (p[1] - 14.0).powi(2);
+        p[2] = 6.0 * (-d2 / 8.0).exp();
+    }
+    mesh
+}
+
+fn adaptive(o: VoronoiOptions) -> VoronoiOptions {
+    VoronoiOptions {
+        spacing: VoronoiSpacing::Adaptive,
+        ..o
+    }
+}
+
+#[test]
+fn adaptive_spacing_puts_sites_on_the_bump_and_lowers_hausdorff() {
+    let mesh = bumped_grid();
+    let on_bump = |out: &VoronoiSimplified| {
+        out.mesh
+            .positions
+            .iter()
+            .filter(|p| (p[0] - 14.0).powi(2) + (p[1] - 14.0).powi(2) < 36.0)
+            .count()
+    };
+    for distance in DISTANCES {
+        for placement in [VoronoiPlacement::Sites, VoronoiPlacement::Quadric] {
+            let uniform_options = VoronoiOptions {
+                placement,
+                ..options(distance, Order::Farthest, Radius::TargetVertices(120))
+            };
+            let label = format!("{distance:?}, {placement:?}");
+            let uniform = simplify_voronoi(&mesh, &uniform_options).unwrap();
+            let adapted = simplify_voronoi(&mesh, &adaptive(uniform_options.clone()))
+                .unwrap_or_else(|e| panic!("{label}: {e}"));
+            if placement == VoronoiPlacement::Sites {
+                assert_sound(&label, &mesh, &adapted);
+            } else {
+                assert_sound_moved(&label, &mesh, &adapted);
+            }
+            // The same vertex count, give or take the search's tenth.
+            let (n, m) = (uniform.mesh.positions.len(), adapted.mesh.positions.len());
+            assert!(m.abs_diff(120) * 10 <= 120, "{label}: {m} vertices");
+            assert!(
+                on_bump(&adapted) > on_bump(&uniform) * 3 / 2,
+                "{label}: {} of {m} on the bump against {} of {n}",
+                on_bump(&adapted),
+                on_bump(&uniform)
+            );
+            let h = |out: &VoronoiSimplified| hausdorff(&mesh, &out.mesh, 50_000).relative();
+            let (hu, ha) = (h(&uniform), h(&adapted));
+            assert!(ha < 0.8 * hu, "{label}: Hausdorff {ha} adaptive, {hu} uniform");
+        }
+    }
+}
+
+#[test]
+fn adaptive_spacing_keeps_topology_everywhere() {
+    for (name, mesh) in corpus() {
+        for distance in DISTANCES {
+            for order in ORDERS {
+                let label = format!("{name}, {distance:?}, {order:?}, adaptive");
+                let o = adaptive(options(distance, order, Radius::Fraction(0.06)));
+                let out = simplify_voronoi(&mesh, &o).unwrap_or_else(|e| panic!("{label}: {e}"));
+                assert_sound(&label, &mesh, &out);
+            }
+        }
+    }
+}
+
+#[test]
+fn adaptive_spacing_on_a_flat_plane_is_uniform_spacing() {
+    // No height anywhere: every factor is the same, and the sites are the
+    // seed's.
+    let mesh = grid(30);
+    for distance in DISTANCES {
+        let o = options(distance, Order::Farthest, Radius::Fraction(0.08));
+        let uniform = simplify_voronoi(&mesh, &o).unwrap();
+        let adapted = simplify_voronoi(&mesh, &adaptive(o)).unwrap();
+        assert_eq!(uniform.origin, adapted.origin, "{distance:?}");
+        assert_eq!(uniform.mesh.triangles, adapted.mesh.triangles, "{distance:?}");
     }
 }
 

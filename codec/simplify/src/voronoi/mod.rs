@@ -18,6 +18,7 @@ mod dual;
 mod faces;
 mod placement;
 mod search;
+mod spacing;
 
 use std::time::{Duration, Instant};
 
@@ -32,6 +33,7 @@ use closure::Closed;
 pub use cover::Order;
 pub use creases::SHARP_DEGREES;
 pub use placement::VoronoiPlacement;
+pub use spacing::VoronoiSpacing;
 
 /// The disc radius.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -58,6 +60,9 @@ pub struct VoronoiOptions {
     /// Where the output's vertices go: at the sites (the seed), or where
     /// their cells' quadrics put them (`placement`).
     pub placement: VoronoiPlacement,
+    /// One cover radius everywhere (the seed), or smaller where the
+    /// surface bends (`spacing`).
+    pub spacing: VoronoiSpacing,
 }
 
 impl Default for VoronoiOptions {
@@ -69,6 +74,7 @@ impl Default for VoronoiOptions {
             max_rounds: 500,
             sharp_degrees: Some(SHARP_DEGREES),
             placement: VoronoiPlacement::Sites,
+            spacing: VoronoiSpacing::Uniform,
         }
     }
 }
@@ -128,18 +134,42 @@ pub fn simplify_voronoi(mesh: &IndexedMesh, options: &VoronoiOptions) -> Result<
     }
     let curvature =
         (options.order == Order::Curvature).then(|| curvature::gaussian_curvature(&closed.surface));
-    let run =
-        |fraction: f64| Diagram::simplify(&closed, mesh, curvature.as_deref(), options, fraction);
+    // The scale the adaptive density is measured at: r, or the search's
+    // first estimate of it.
+    let scale = match options.radius {
+        Radius::Fraction(f) if f.is_finite() && f > 0.0 && f <= 10.0 => f,
+        Radius::Fraction(f) => {
+            return Err(Error::Parameter(format!(
+                "radius must be a fraction of the diagonal within (0, 10], got {f}"
+            )))
+        }
+        Radius::TargetVertices(0) => {
+            return Err(Error::Parameter(
+                "target vertices must be at least 1".into(),
+            ))
+        }
+        Radius::TargetVertices(n) => search::first_fraction(&closed.surface, n),
+    } * closed.surface.diagonal();
+    let factors = (options.spacing == VoronoiSpacing::Adaptive)
+        .then(|| spacing::radius_factors(&closed.surface, closed.first_cone, scale));
+    let context = Context {
+        closed: &closed,
+        curvature: curvature.as_deref(),
+        factors: factors.as_deref(),
+    };
+    let run = |fraction: f64| Diagram::simplify(&context, mesh, options, fraction);
     match options.radius {
-        Radius::Fraction(f) if f.is_finite() && f > 0.0 && f <= 10.0 => run(f),
-        Radius::Fraction(f) => Err(Error::Parameter(format!(
-            "radius must be a fraction of the diagonal within (0, 10], got {f}"
-        ))),
-        Radius::TargetVertices(0) => Err(Error::Parameter(
-            "target vertices must be at least 1".into(),
-        )),
+        Radius::Fraction(f) => run(f),
         Radius::TargetVertices(n) => search::nearest(&closed.surface, n, run),
     }
+}
+
+/// What every radius tried shares.
+struct Context<'a> {
+    closed: &'a Closed,
+    curvature: Option<&'a [f64]>,
+    /// Each vertex's cover radius over r (`spacing`); `None`: uniform.
+    factors: Option<&'a [f64]>,
 }
 
 /// The diagram as it is refined: the sites (cones first), their radii and
@@ -148,6 +178,7 @@ struct Diagram<'a> {
     closed: &'a Closed,
     options: &'a VoronoiOptions,
     curvature: Option<&'a [f64]>,
+    factors: Option<&'a [f64]>,
     /// Each vertex's `creases` rank: the cover takes lower ranks first.
     ranks: Vec<u8>,
     site_vertex: Vec<u32>,
@@ -158,19 +189,20 @@ struct Diagram<'a> {
 
 impl<'a> Diagram<'a> {
     fn simplify(
-        closed: &'a Closed,
+        context: &Context<'a>,
         mesh: &IndexedMesh,
-        curvature: Option<&'a [f64]>,
         options: &'a VoronoiOptions,
         fraction: f64,
     ) -> Result<VoronoiSimplified> {
+        let closed = context.closed;
         let surface = &closed.surface;
         let r = fraction * surface.diagonal();
         let mut stages = Stages::default();
         let mut diagram = Diagram {
             closed,
             options,
-            curvature,
+            curvature: context.curvature,
+            factors: context.factors,
             ranks: match options.sharp_degrees {
                 // A crease shorter than a disc's diameter is left to the cover.
                 Some(degrees) => {
@@ -292,7 +324,13 @@ impl<'a> Diagram<'a> {
                     .collect();
                 if !pass.is_empty() {
                     let label = first + centres.len() as u32;
-                    let found = cover::farthest_points(&mut self.front, &pass, r / 2.0, label);
+                    let found = cover::farthest_points(
+                        &mut self.front,
+                        &pass,
+                        r / 2.0,
+                        self.factors,
+                        label,
+                    );
                     centres.extend(found);
                 }
             }
@@ -301,18 +339,21 @@ impl<'a> Diagram<'a> {
                 &mut self.front,
                 &candidates,
                 r,
+                self.factors,
                 label,
             ));
             centres
         } else {
             let mut near = vec![false; self.closed.surface.vertex_count()];
-            let mut centres = cover::greedy_discs(&mut self.scratch, &creases, r / 2.0, &mut near);
+            let mut centres =
+                cover::greedy_discs(&mut self.scratch, &creases, r / 2.0, self.factors, &mut near);
             let mut covered = vec![false; self.closed.surface.vertex_count()];
-            cover::mark_discs(&mut self.scratch, &centres, r, &mut covered);
+            cover::mark_discs(&mut self.scratch, &centres, r, self.factors, &mut covered);
             centres.extend(cover::greedy_discs(
                 &mut self.scratch,
                 &candidates,
                 r,
+                self.factors,
                 &mut covered,
             ));
             for (i, &c) in centres.iter().enumerate() {
@@ -320,8 +361,9 @@ impl<'a> Diagram<'a> {
             }
             centres
         };
-        // A crease site's cell splits as the others do, from r.
-        self.radius.extend(std::iter::repeat_n(r, centres.len()));
+        // A crease site's cell splits as the others do, from its r.
+        let factor = |v: u32| self.factors.map_or(1.0, |f| f[v as usize]);
+        self.radius.extend(centres.iter().map(|&c| r * factor(c)));
         self.site_vertex.extend(centres);
     }
 
@@ -371,7 +413,7 @@ impl<'a> Diagram<'a> {
                 );
             }
             self.order(&mut orphans);
-            for c in cover::greedy_discs(&mut self.scratch, &orphans, r, &mut covered) {
+            for c in cover::greedy_discs(&mut self.scratch, &orphans, r, None, &mut covered) {
                 self.front.seed(c, self.site_vertex.len() as u32, 0.0);
                 self.site_vertex.push(c);
                 self.radius.push(r);

@@ -19,8 +19,7 @@ pub(super) fn nearest(
     target: usize,
     run: impl Fn(f64) -> Result<VoronoiSimplified>,
 ) -> Result<VoronoiSimplified> {
-    let diagonal = surface.diagonal();
-    let mut fraction = (area(surface) / (AREA_PER_SITE * target as f64)).sqrt() / diagonal;
+    let mut fraction = first_fraction(surface, target);
     let (mut small, mut large) = (None::<f64>, None::<f64>); // r giving too many / too few
     let mut best: Option<VoronoiSimplified> = None;
     for attempt in 1..=ATTEMPTS {
@@ -57,4 +56,9 @@ pub(super) fn nearest(
         };
     }
     best.ok_or_else(|| vitrine_codec::Error::Parameter("no radius was tried".into()))
+}
+
+/// The first radius tried for `target` vertices, over the diagonal.
+pub(super) fn first_fraction(surface: &Surface, target: usize) -> f64 {
+    (area(surface) / (AREA_PER_SITE * target as f64)).sqrt() / surface.diagonal()
 }
