@@ -23,7 +23,9 @@ mod spacing;
 use std::time::{Duration, Instant};
 
 use vitrine_codec::{Error, IndexedMesh, Result};
+use glam::DVec3;
 use vitrine_geodesic::{Propagation, Surface};
+use vitrine_quality::metrics::distances_to_surface;
 
 /// How geodesic distance is measured (`vitrine_geodesic::Method`).
 pub use vitrine_geodesic::Method as Distance;
@@ -157,14 +159,55 @@ pub fn simplify_voronoi(mesh: &IndexedMesh, options: &VoronoiOptions) -> Result<
         curvature: curvature.as_deref(),
         factors: factors.as_deref(),
     };
-    let run = |fraction: f64| Diagram::simplify(&context, mesh, options, fraction);
-    match options.radius {
-        Radius::Fraction(f) => run(f),
-        Radius::TargetVertices(n) => search::nearest(&closed.surface, n, run),
+    let surface = &closed.surface;
+    let run = |context: &Context, start: f64, step: f64| {
+        let run = |fraction: f64| Diagram::simplify(context, mesh, options, fraction);
+        match options.radius {
+            Radius::Fraction(f) => run(f),
+            Radius::TargetVertices(n) => search::nearest(n, start, step, run),
+        }
+    };
+    let start = scale / surface.diagonal();
+    let mut out = run(&context, start, 2.0)?;
+    let Some(factors) = &factors else {
+        return Ok(out);
+    };
+    // Where the first pass left its error, the sites move closer (`spacing`);
+    // each pass is kept only if its worst input vertex lies closer.
+    let points: Vec<DVec3> = (0..closed.first_cone).map(|v| surface.position(v)).collect();
+    let worst = |out: &VoronoiSimplified| {
+        let d = distances_to_surface(&points, &out.mesh);
+        let max = d.iter().copied().fold(0.0, f64::max);
+        (d, max)
+    };
+    let (mut error, mut max) = worst(&out);
+    let mut factors = factors.clone();
+    for _ in 0..spacing::ERROR_PASSES {
+        let refined = spacing::refined_factors(surface, closed.first_cone, scale, &factors, &error);
+        let context = Context {
+            factors: Some(&refined),
+            ..context
+        };
+        // The density is normalised, so the last radius is nearly right.
+        let next = run(&context, out.radius_fraction, 1.05)?;
+        let attempts = out.attempts + next.attempts;
+        let (next_error, next_max) = worst(&next);
+        if next_max >= max {
+            out.attempts = attempts;
+            break;
+        }
+        (out, error, max, factors) = (
+            VoronoiSimplified { attempts, ..next },
+            next_error,
+            next_max,
+            refined,
+        );
     }
+    Ok(out)
 }
 
 /// What every radius tried shares.
+#[derive(Clone, Copy)]
 struct Context<'a> {
     closed: &'a Closed,
     curvature: Option<&'a [f64]>,

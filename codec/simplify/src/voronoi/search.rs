@@ -15,11 +15,12 @@ const ATTEMPTS: usize = 14;
 const AREA_PER_SITE: f64 = 1.5;
 
 pub(super) fn nearest(
-    surface: &Surface,
     target: usize,
+    start: f64,
+    step: f64,
     run: impl Fn(f64) -> Result<VoronoiSimplified>,
 ) -> Result<VoronoiSimplified> {
-    let mut fraction = first_fraction(surface, target);
+    let mut fraction = start;
     let (mut small, mut large) = (None::<f64>, None::<f64>); // r giving too many / too few
     let mut best: Option<VoronoiSimplified> = None;
     for attempt in 1..=ATTEMPTS {
@@ -50,8 +51,8 @@ pub(super) fn nearest(
         }
         fraction = match (small, large) {
             (Some(s), Some(l)) => (s * l).sqrt(),
-            (Some(s), None) => s * 2.0,
-            (None, Some(l)) => l / 2.0,
+            (Some(s), None) => s * step,
+            (None, Some(l)) => l / step,
             (None, None) => fraction, // not reached: one side was just set
         };
     }
