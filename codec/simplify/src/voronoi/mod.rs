@@ -76,7 +76,7 @@ impl Default for VoronoiOptions {
             max_rounds: 500,
             sharp_degrees: Some(SHARP_DEGREES),
             placement: VoronoiPlacement::Sites,
-            spacing: VoronoiSpacing::Uniform,
+            spacing: VoronoiSpacing::Adaptive,
         }
     }
 }
@@ -183,6 +183,9 @@ pub fn simplify_voronoi(mesh: &IndexedMesh, options: &VoronoiOptions) -> Result<
     let (mut error, mut max) = worst(&out);
     let mut factors = factors.clone();
     for _ in 0..spacing::ERROR_PASSES {
+        if max <= 1e-6 * surface.diagonal() {
+            break; // exact but for rounding: nothing to move sites for
+        }
         let refined = spacing::refined_factors(surface, closed.first_cone, scale, &factors, &error);
         let context = Context {
             factors: Some(&refined),
