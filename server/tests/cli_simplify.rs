@@ -449,6 +449,30 @@ fn simplify_by_voronoi_with_quadric_placement_keeps_the_plate_exact() {
 }
 
 #[test]
+fn simplify_by_voronoi_with_adaptive_spacing_keeps_topology_and_vertices() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = plate(dir.path());
+    let original = repaired(&input);
+    let output = dir.path().join("adaptive.ply");
+    let flags = ["--voronoi-spacing", "adaptive", "--radius", "0.05"];
+    let report = voronoi_report(&input, &output, &flags);
+    assert_eq!(report["voronoi"]["spacing"], "adaptive");
+    assert_eq!(report["voronoi"]["placement"], "sites");
+    let mesh = read(&output);
+    check_manifold(&mesh).unwrap();
+    same_topology_and_vertices(&original, &mesh);
+    // The plate's faces are flat and its edges kept: nothing is lost.
+    let h = report["hausdorff"].as_f64().unwrap();
+    assert!(h < 1e-6, "{report}");
+    let output = dir.path().join("uniform.ply");
+    let flags = ["--voronoi-spacing", "uniform", "--radius", "0.05"];
+    assert_eq!(
+        voronoi_report(&input, &output, &flags)["voronoi"]["spacing"],
+        "uniform"
+    );
+}
+
+#[test]
 fn simplify_by_voronoi_to_a_vertex_target_or_fraction() {
     let dir = tempfile::tempdir().unwrap();
     let input = plate(dir.path());
