@@ -299,13 +299,19 @@ fn adaptive_spacing_puts_sites_on_the_bump_and_lowers_hausdorff() {
             let (hu, ha) = (h(&uniform), h(&adapted));
             let (bu, ba) = (on_bump(&uniform), on_bump(&adapted));
             eprintln!("{label}: {ba} of {m} on the bump, H {ha}; uniform {bu} of {n}, H {hu}");
-            assert!(ba > bu, "{label}: {ba} of {m} on the bump against {bu} of {n}");
+            assert!(
+                ba > bu,
+                "{label}: {ba} of {m} on the bump against {bu} of {n}"
+            );
             assert!(ha < hu, "{label}: Hausdorff {ha} adaptive, {hu} uniform");
             // At the sites every face is a chord, and the bump's are the
             // deepest: the spacing is what helps there.
             if placement == VoronoiPlacement::Sites {
                 assert!(2 * ba >= 3 * bu, "{label}: {ba} on the bump against {bu}");
-                assert!(ha < 0.75 * hu, "{label}: Hausdorff {ha} adaptive, {hu} uniform");
+                assert!(
+                    ha < 0.75 * hu,
+                    "{label}: Hausdorff {ha} adaptive, {hu} uniform"
+                );
             }
         }
     }

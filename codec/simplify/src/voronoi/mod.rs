@@ -22,8 +22,8 @@ mod spacing;
 
 use std::time::{Duration, Instant};
 
-use vitrine_codec::{Error, IndexedMesh, Result};
 use glam::DVec3;
+use vitrine_codec::{Error, IndexedMesh, Result};
 use vitrine_geodesic::{Propagation, Surface};
 use vitrine_quality::metrics::distances_to_surface;
 
@@ -174,7 +174,9 @@ pub fn simplify_voronoi(mesh: &IndexedMesh, options: &VoronoiOptions) -> Result<
     };
     // Where the first pass left its error, the sites move closer (`spacing`);
     // each pass is kept only if its worst input vertex lies closer.
-    let points: Vec<DVec3> = (0..closed.first_cone).map(|v| surface.position(v)).collect();
+    let points: Vec<DVec3> = (0..closed.first_cone)
+        .map(|v| surface.position(v))
+        .collect();
     let worst = |out: &VoronoiSimplified| {
         let d = distances_to_surface(&points, &out.mesh);
         let max = d.iter().copied().fold(0.0, f64::max);
@@ -391,8 +393,13 @@ impl<'a> Diagram<'a> {
             centres
         } else {
             let mut near = vec![false; self.closed.surface.vertex_count()];
-            let mut centres =
-                cover::greedy_discs(&mut self.scratch, &creases, r / 2.0, self.factors, &mut near);
+            let mut centres = cover::greedy_discs(
+                &mut self.scratch,
+                &creases,
+                r / 2.0,
+                self.factors,
+                &mut near,
+            );
             let mut covered = vec![false; self.closed.surface.vertex_count()];
             cover::mark_discs(&mut self.scratch, &centres, r, self.factors, &mut covered);
             centres.extend(cover::greedy_discs(

@@ -215,7 +215,9 @@ fn finish(surface: &Surface, used: &[bool], mut factor: Vec<f64>, s: f64) -> Vec
     }
     let (lo, hi) = (0..n)
         .filter(|&v| used[v])
-        .fold((f64::MAX, 0.0f64), |(l, h), v| (l.min(factor[v]), h.max(factor[v])));
+        .fold((f64::MAX, 0.0f64), |(l, h), v| {
+            (l.min(factor[v]), h.max(factor[v]))
+        });
     if hi <= lo * (1.0 + 1e-12) {
         // Evenly curved (or flat): the seed's spacing, exactly.
         return vec![1.0; n];
@@ -302,7 +304,9 @@ mod tests {
         let at = |x: u32, y: u32| f[(y * 33 + x) as usize];
         assert!(at(8, 8) < 1.0, "on the bump: {}", at(8, 8));
         assert!(at(28, 28) > 1.0, "far from it: {}", at(28, 28));
-        let (lo, hi) = f.iter().fold((f64::MAX, 0.0f64), |(l, h), &x| (l.min(x), h.max(x)));
+        let (lo, hi) = f
+            .iter()
+            .fold((f64::MAX, 0.0f64), |(l, h), &x| (l.min(x), h.max(x)));
         assert!(hi / lo <= CAP * CAP * (1.0 + 1e-9), "{lo} – {hi}");
     }
 }
