@@ -479,8 +479,9 @@ fn simplify_by_voronoi_to_a_vertex_target_or_fraction() {
     let output = dir.path().join("v.obj");
     // The plate is a lattice, so its vertex count moves in steps with r; with
     // its creases covered first no radius gives 263–394 vertices. The seed's
-    // cover (`--sharp-degrees 0`) has steps fine enough for the search here,
-    // and the creases' own case follows.
+    // cover (`--sharp-degrees 0`, `--voronoi-spacing uniform`) has steps fine
+    // enough for the search here (adaptive spacing's: 245 for 275), and the
+    // creases' own case follows.
     let (stdout, _) = succeeds(&[
         "simplify",
         text(&input),
@@ -488,6 +489,8 @@ fn simplify_by_voronoi_to_a_vertex_target_or_fraction() {
         "voronoi",
         "--sharp-degrees",
         "0",
+        "--voronoi-spacing",
+        "uniform",
         "--target-vertices",
         "300",
         "--hausdorff-samples",
@@ -509,6 +512,8 @@ fn simplify_by_voronoi_to_a_vertex_target_or_fraction() {
         "voronoi",
         "--sharp-degrees",
         "0",
+        "--voronoi-spacing",
+        "uniform",
         "--target-fraction",
         "0.05",
         "--hausdorff-samples",
