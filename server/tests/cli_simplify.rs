@@ -449,14 +449,39 @@ fn simplify_by_voronoi_with_quadric_placement_keeps_the_plate_exact() {
 }
 
 #[test]
+fn simplify_by_voronoi_with_adaptive_spacing_keeps_topology_and_vertices() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = plate(dir.path());
+    let original = repaired(&input);
+    let output = dir.path().join("adaptive.ply");
+    let flags = ["--voronoi-spacing", "adaptive", "--radius", "0.05"];
+    let report = voronoi_report(&input, &output, &flags);
+    assert_eq!(report["voronoi"]["spacing"], "adaptive");
+    assert_eq!(report["voronoi"]["placement"], "sites");
+    let mesh = read(&output);
+    check_manifold(&mesh).unwrap();
+    same_topology_and_vertices(&original, &mesh);
+    // The plate's faces are flat and its edges kept: nothing is lost.
+    let h = report["hausdorff"].as_f64().unwrap();
+    assert!(h < 1e-6, "{report}");
+    let output = dir.path().join("uniform.ply");
+    let flags = ["--voronoi-spacing", "uniform", "--radius", "0.05"];
+    assert_eq!(
+        voronoi_report(&input, &output, &flags)["voronoi"]["spacing"],
+        "uniform"
+    );
+}
+
+#[test]
 fn simplify_by_voronoi_to_a_vertex_target_or_fraction() {
     let dir = tempfile::tempdir().unwrap();
     let input = plate(dir.path());
     let output = dir.path().join("v.obj");
     // The plate is a lattice, so its vertex count moves in steps with r; with
     // its creases covered first no radius gives 263–394 vertices. The seed's
-    // cover (`--sharp-degrees 0`) has steps fine enough for the search here,
-    // and the creases' own case follows.
+    // cover (`--sharp-degrees 0`, `--voronoi-spacing uniform`) has steps fine
+    // enough for the search here (adaptive spacing's: 245 for 275), and the
+    // creases' own case follows.
     let (stdout, _) = succeeds(&[
         "simplify",
         text(&input),
@@ -464,6 +489,8 @@ fn simplify_by_voronoi_to_a_vertex_target_or_fraction() {
         "voronoi",
         "--sharp-degrees",
         "0",
+        "--voronoi-spacing",
+        "uniform",
         "--target-vertices",
         "300",
         "--hausdorff-samples",
@@ -485,6 +512,8 @@ fn simplify_by_voronoi_to_a_vertex_target_or_fraction() {
         "voronoi",
         "--sharp-degrees",
         "0",
+        "--voronoi-spacing",
+        "uniform",
         "--target-fraction",
         "0.05",
         "--hausdorff-samples",

@@ -12,9 +12,11 @@
 //!     pip install fast-simplification plyfile numpy
 //!     cargo run --release -p vitrine-simplify --example simplifiers_bench -- \
 //!         --peer scripts/peer_quadric.py [--fractions 0.1,0.05,0.01] \
-//!         [--methods 2,6,7] plate MESH…
+//!         [--methods 2,6,7] [--spacing adaptive] plate MESH…
 //!
-//! `--methods` picks columns by their index in `METHODS` (all by default).
+//! `--methods` picks columns by their index in `METHODS` (all by default);
+//! `--spacing` sets the Voronoi columns' `VoronoiSpacing` (`uniform`, the
+//! seed's, by default).
 //!
 //! `plate` is the generated genus-3 plate (flat faces, sharp edges).
 
@@ -25,7 +27,7 @@ use vitrine_quality::metrics::hausdorff;
 use vitrine_simplify::melax::{melax_simplify, MelaxCost};
 use vitrine_simplify::{
     simplify, simplify_voronoi, Collapse, Distance, Placement, Radius, SimplifyOptions, StopReason,
-    Target, VoronoiOptions, VoronoiPlacement,
+    Target, VoronoiOptions, VoronoiPlacement, VoronoiSpacing,
 };
 
 #[path = "support/mod.rs"]
@@ -46,7 +48,12 @@ const METHODS: [&str; 8] = [
     "Voronoi, fast marching, quadric placement",
 ];
 
-fn run(method: usize, mesh: &IndexedMesh, fraction: f64) -> Result<Run, Failure> {
+fn run(
+    method: usize,
+    mesh: &IndexedMesh,
+    fraction: f64,
+    spacing: VoronoiSpacing,
+) -> Result<Run, Failure> {
     let started = Instant::now();
     let (out, reached) = match method {
         0..=2 => {
@@ -77,6 +84,7 @@ fn run(method: usize, mesh: &IndexedMesh, fraction: f64) -> Result<Run, Failure>
                 distance,
                 radius: Radius::TargetVertices(want),
                 placement,
+                spacing,
                 ..VoronoiOptions::default()
             };
             let out = simplify_voronoi(mesh, &options)?;
@@ -101,6 +109,7 @@ fn main() -> Result<(), Failure> {
     let mut script = None;
     let mut fractions = vec![0.10, 0.05, 0.01];
     let mut methods: Vec<usize> = (0..METHODS.len()).collect();
+    let mut spacing = VoronoiSpacing::Uniform;
     while args.len() > 1 && args[0].starts_with("--") {
         match args[0].as_str() {
             "--peer" => script = Some(args[1].clone()),
@@ -110,6 +119,7 @@ fn main() -> Result<(), Failure> {
                     .map(str::parse)
                     .collect::<Result<_, _>>()?
             }
+            "--spacing" => spacing = args[1].parse()?,
             "--fractions" => {
                 fractions = args[1]
                     .split(',')
@@ -141,7 +151,7 @@ fn main() -> Result<(), Failure> {
                 100.0 * fraction
             );
             for &method in &methods {
-                row += &match run(method, &mesh, fraction) {
+                row += &match run(method, &mesh, fraction, spacing) {
                     Ok((out, seconds, reached)) => {
                         let h = hausdorff(&mesh, &out, SAMPLES).relative();
                         let stopped = if reached { "" } else { ", stopped" };

@@ -58,5 +58,5 @@ pub use feature_search::{
 };
 pub use voronoi::{
     simplify_voronoi, Distance, Order, Radius, VoronoiOptions, VoronoiPlacement, VoronoiSimplified,
-    SHARP_DEGREES,
+    VoronoiSpacing, SHARP_DEGREES,
 };

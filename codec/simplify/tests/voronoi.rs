@@ -14,6 +14,7 @@ use vitrine_quality::metrics::hausdorff;
 use vitrine_samples::{add_noise, grid, icosphere, merge, plate_with_tunnels, punch_holes, torus};
 use vitrine_simplify::{
     simplify_voronoi, Order, Radius, VoronoiOptions, VoronoiPlacement, VoronoiSimplified,
+    VoronoiSpacing,
 };
 
 const ORDERS: [Order; 3] = [Order::Incremental, Order::Farthest, Order::Curvature];
@@ -186,10 +187,19 @@ fn quadric_placement_keeps_topology_and_folds_nothing() {
             let out = simplify_voronoi(&mesh, &quadric(distance, Radius::Fraction(0.06)))
                 .unwrap_or_else(|e| panic!("{label}: {e}"));
             assert_sound_moved(&label, &mesh, &out);
-            // The same diagram as at the sites: only positions differ.
+            // With uniform spacing, the same diagram as at the sites: only
+            // positions differ (adaptive spacing's error passes read the
+            // output, so its diagram depends on the placement).
+            let uniform = |o: VoronoiOptions| VoronoiOptions {
+                spacing: VoronoiSpacing::Uniform,
+                ..o
+            };
+            let out = simplify_voronoi(&mesh, &uniform(quadric(distance, Radius::Fraction(0.06))))
+                .unwrap_or_else(|e| panic!("{label}: {e}"));
+            assert_sound_moved(&label, &mesh, &out);
             let sites = simplify_voronoi(
                 &mesh,
-                &options(distance, Order::Farthest, Radius::Fraction(0.06)),
+                &uniform(options(distance, Order::Farthest, Radius::Fraction(0.06))),
             )
             .unwrap();
             assert_eq!(out.mesh.triangles, sites.mesh.triangles, "{label}");
@@ -235,6 +245,93 @@ fn quadric_placement_keeps_the_plate_sharp() {
         assert_sound_moved("plate", &plate, &out);
         let h = hausdorff(&plate, &out.mesh, 50_000).relative();
         assert!(h < 1e-4, "r = {r}: Hausdorff {h} over the diagonal");
+    }
+}
+
+/// A 48 × 48 grid, flat but for a narrow, tall bump (a Gaussian of height
+/// 6 and width 2 around (14, 14)): the curved part is a tenth of the area.
+fn bumped_grid() -> IndexedMesh {
+    let mut mesh = grid(48);
+    for p in &mut mesh.positions {
+        let d2 = (p[0] - 14.0).powi(2) + (p[1] - 14.0).powi(2);
+        p[2] = 6.0 * (-d2 / 8.0).exp();
+    }
+    mesh
+}
+
+fn adaptive(o: VoronoiOptions) -> VoronoiOptions {
+    VoronoiOptions {
+        spacing: VoronoiSpacing::Adaptive,
+        ..o
+    }
+}
+
+#[test]
+fn adaptive_spacing_puts_sites_on_the_bump_and_lowers_hausdorff() {
+    let mesh = bumped_grid();
+    let on_bump = |out: &VoronoiSimplified| {
+        out.mesh
+            .positions
+            .iter()
+            .filter(|p| (p[0] - 14.0).powi(2) + (p[1] - 14.0).powi(2) < 36.0)
+            .count()
+    };
+    for distance in DISTANCES {
+        for placement in [VoronoiPlacement::Sites, VoronoiPlacement::Quadric] {
+            let uniform_options = VoronoiOptions {
+                placement,
+                spacing: VoronoiSpacing::Uniform,
+                ..options(distance, Order::Farthest, Radius::TargetVertices(120))
+            };
+            let label = format!("{distance:?}, {placement:?}");
+            let uniform = simplify_voronoi(&mesh, &uniform_options).unwrap();
+            let adapted = simplify_voronoi(&mesh, &adaptive(uniform_options.clone()))
+                .unwrap_or_else(|e| panic!("{label}: {e}"));
+            if placement == VoronoiPlacement::Sites {
+                assert_sound(&label, &mesh, &adapted);
+            } else {
+                assert_sound_moved(&label, &mesh, &adapted);
+            }
+            // The same vertex count, give or take the search's tenth.
+            let (n, m) = (uniform.mesh.positions.len(), adapted.mesh.positions.len());
+            assert!(m.abs_diff(120) * 10 <= 120, "{label}: {m} vertices");
+            let h = |out: &VoronoiSimplified| hausdorff(&mesh, &out.mesh, 50_000).relative();
+            let (hu, ha) = (h(&uniform), h(&adapted));
+            let (bu, ba) = (on_bump(&uniform), on_bump(&adapted));
+            eprintln!("{label}: {ba} of {m} on the bump, H {ha}; uniform {bu} of {n}, H {hu}");
+            assert!(
+                ba > bu,
+                "{label}: {ba} of {m} on the bump against {bu} of {n}"
+            );
+            assert!(ha < hu, "{label}: Hausdorff {ha} adaptive, {hu} uniform");
+            // At the sites every face is a chord, and the bump's are the
+            // deepest: the spacing is what helps there.
+            if placement == VoronoiPlacement::Sites {
+                assert!(2 * ba >= 3 * bu, "{label}: {ba} on the bump against {bu}");
+                assert!(
+                    ha < 0.75 * hu,
+                    "{label}: Hausdorff {ha} adaptive, {hu} uniform"
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn uniform_spacing_keeps_topology_everywhere() {
+    // The seed's spacing (the default is adaptive since session 34).
+    for (name, mesh) in corpus() {
+        for distance in DISTANCES {
+            for order in ORDERS {
+                let label = format!("{name}, {distance:?}, {order:?}, uniform");
+                let o = VoronoiOptions {
+                    spacing: VoronoiSpacing::Uniform,
+                    ..options(distance, order, Radius::Fraction(0.06))
+                };
+                let out = simplify_voronoi(&mesh, &o).unwrap_or_else(|e| panic!("{label}: {e}"));
+                assert_sound(&label, &mesh, &out);
+            }
+        }
     }
 }
 

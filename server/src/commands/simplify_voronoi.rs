@@ -9,7 +9,8 @@ use clap::{Args, ValueEnum};
 use serde::Serialize;
 use vitrine_codec::IndexedMesh;
 use vitrine_simplify::{
-    simplify_voronoi, Distance, Order, Radius, VoronoiOptions, VoronoiPlacement, SHARP_DEGREES,
+    simplify_voronoi, Distance, Order, Radius, VoronoiOptions, VoronoiPlacement, VoronoiSpacing,
+    SHARP_DEGREES,
 };
 
 /// How geodesic distance is measured.
@@ -43,11 +44,25 @@ pub enum VoronoiPlacementKind {
     Quadric,
 }
 
+/// How far apart the sites are.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum VoronoiSpacingKind {
+    /// One disc radius everywhere (the seed's cover).
+    Uniform,
+    /// Smaller discs where the surface bends within a cell's reach, larger
+    /// where it is flat, then denser again where the error stayed largest.
+    Adaptive,
+}
+
 #[derive(Args, Debug)]
 pub struct VoronoiArgs {
     /// voronoi: where each output vertex goes.
     #[arg(long, value_enum, default_value_t = VoronoiPlacementKind::Sites)]
     pub voronoi_placement: VoronoiPlacementKind,
+    /// voronoi: one cover radius everywhere (the seed's), or adapted to the
+    /// surface (smaller where it bends or where the error stayed largest).
+    #[arg(long, value_enum, default_value_t = VoronoiSpacingKind::Adaptive)]
+    pub voronoi_spacing: VoronoiSpacingKind,
     /// voronoi: geodesic distance by Dijkstra on edges or fast marching.
     #[arg(long, value_enum, default_value_t = DistanceKind::Dijkstra)]
     pub distance: DistanceKind,
@@ -65,6 +80,7 @@ pub struct VoronoiArgs {
 pub struct VoronoiReport {
     pub distance: &'static str,
     pub placement: &'static str,
+    pub spacing: &'static str,
     pub order: &'static str,
     /// r over the bounding box's diagonal (given, or found by the search).
     pub radius: f64,
@@ -123,9 +139,14 @@ pub fn run(mesh: &IndexedMesh, args: &VoronoiArgs, t: TargetFlags) -> anyhow::Re
         VoronoiPlacementKind::Sites => (VoronoiPlacement::Sites, "sites"),
         VoronoiPlacementKind::Quadric => (VoronoiPlacement::Quadric, "quadric"),
     };
+    let (spacing, spacing_name) = match args.voronoi_spacing {
+        VoronoiSpacingKind::Uniform => (VoronoiSpacing::Uniform, "uniform"),
+        VoronoiSpacingKind::Adaptive => (VoronoiSpacing::Adaptive, "adaptive"),
+    };
     let options = VoronoiOptions {
         distance,
         placement,
+        spacing,
         order,
         radius,
         sharp_degrees: (args.sharp_degrees > 0.0).then_some(args.sharp_degrees),
@@ -143,6 +164,7 @@ pub fn run(mesh: &IndexedMesh, args: &VoronoiArgs, t: TargetFlags) -> anyhow::Re
         report: VoronoiReport {
             distance: distance_name,
             placement: placement_name,
+            spacing: spacing_name,
             order: order_name,
             radius: out.radius_fraction,
             sites: out.sites,
@@ -157,7 +179,7 @@ pub fn run(mesh: &IndexedMesh, args: &VoronoiArgs, t: TargetFlags) -> anyhow::Re
 /// The report's extra words.
 pub fn describe(v: &VoronoiReport) -> String {
     format!(
-        " ({} distance, {} order, vertices at the {}, r = {:.5} × diagonal, {} sites from {} discs, {} splits, {} radii tried)",
-        v.distance, v.order, v.placement, v.radius, v.sites, v.cover_sites, v.splits, v.attempts
+        " ({} distance, {} order, {} spacing, vertices at the {}, r = {:.5} × diagonal, {} sites from {} discs, {} splits, {} radii tried)",
+        v.distance, v.order, v.spacing, v.placement, v.radius, v.sites, v.cover_sites, v.splits, v.attempts
     )
 }

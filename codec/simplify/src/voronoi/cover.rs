@@ -40,13 +40,15 @@ impl FromStr for Order {
     }
 }
 
-/// Centres of discs of `radius` over `candidates`, taken in their order;
-/// `covered` marks the vertices already inside a disc and is updated.
-/// `scratch` is an empty propagation, left empty.
+/// Centres of discs of `radius` (times the centre's factor, if given) over
+/// `candidates`, taken in their order; `covered` marks the vertices
+/// already inside a disc and is updated. `scratch` is an empty
+/// propagation, left empty.
 pub(super) fn greedy_discs(
     scratch: &mut Propagation<'_>,
     candidates: &[u32],
     radius: f64,
+    factors: Option<&[f64]>,
     covered: &mut [bool],
 ) -> Vec<u32> {
     let mut centres = Vec::new();
@@ -56,6 +58,7 @@ pub(super) fn greedy_discs(
         }
         centres.push(c);
         covered[c as usize] = true;
+        let radius = radius * factors.map_or(1.0, |f| f[c as usize]);
         scratch.seed(c, 0, 0.0);
         scratch.run(radius);
         for &v in scratch.touched() {
@@ -68,14 +71,22 @@ pub(super) fn greedy_discs(
     centres
 }
 
-/// Marks the vertices within `radius` of `centres` as `covered`.
-/// `scratch` is an empty propagation, left empty.
+/// Marks the vertices within `radius` (times each centre's factor, if
+/// given) of `centres` as `covered`. `scratch` is an empty propagation,
+/// left empty.
 pub(super) fn mark_discs(
     scratch: &mut Propagation<'_>,
     centres: &[u32],
     radius: f64,
+    factors: Option<&[f64]>,
     covered: &mut [bool],
 ) {
+    if let Some(f) = factors {
+        for &c in centres {
+            mark_discs(scratch, &[c], radius * f[c as usize], None, covered);
+        }
+        return;
+    }
     for &c in centres {
         scratch.seed(c, 0, 0.0);
     }
@@ -91,19 +102,26 @@ pub(super) fn mark_discs(
 /// Farthest-point sampling on the diagram's own front: the vertex farthest
 /// from all sites becomes the next one (a vertex no site reaches, in a
 /// component of its own, first), until every vertex is within `radius`.
-/// Sites get labels from `first_label` on; the front ends up final.
+/// With `factors`, distances are over each vertex's own factor: the vertex
+/// farthest for its radius comes next, until every vertex is within
+/// `radius` × its factor. Sites get labels from `first_label` on; the
+/// front ends up final.
 pub(super) fn farthest_points(
     front: &mut Propagation<'_>,
     candidates: &[u32],
     radius: f64,
+    factors: Option<&[f64]>,
     first_label: u32,
 ) -> Vec<u32> {
     front.track_changes(true);
     front.run(f64::INFINITY);
+    let scaled = |front: &Propagation<'_>, v: u32| {
+        front.distance(v) / factors.map_or(1.0, |f| f[v as usize])
+    };
     // Largest distance first, then lowest vertex.
     let mut heap: BinaryHeap<(u64, Reverse<u32>)> = candidates
         .iter()
-        .map(|&v| (ordered(front.distance(v)), Reverse(v)))
+        .map(|&v| (ordered(scaled(front, v)), Reverse(v)))
         .collect();
     front.take_changed();
     let mut candidate = vec![false; front.surface().vertex_count()];
@@ -112,7 +130,7 @@ pub(super) fn farthest_points(
     }
     let mut centres = Vec::new();
     while let Some((k, Reverse(v))) = heap.pop() {
-        let d = front.distance(v);
+        let d = scaled(front, v);
         if k != ordered(d) {
             continue; // stale: v came closer to a newer site
         }
@@ -124,7 +142,7 @@ pub(super) fn farthest_points(
         front.run(f64::INFINITY);
         for w in front.take_changed() {
             if candidate[w as usize] {
-                heap.push((ordered(front.distance(w)), Reverse(w)));
+                heap.push((ordered(scaled(front, w)), Reverse(w)));
             }
         }
     }

@@ -18,11 +18,14 @@ mod dual;
 mod faces;
 mod placement;
 mod search;
+mod spacing;
 
 use std::time::{Duration, Instant};
 
+use glam::DVec3;
 use vitrine_codec::{Error, IndexedMesh, Result};
 use vitrine_geodesic::{Propagation, Surface};
+use vitrine_quality::metrics::distances_to_surface;
 
 /// How geodesic distance is measured (`vitrine_geodesic::Method`).
 pub use vitrine_geodesic::Method as Distance;
@@ -32,6 +35,7 @@ use closure::Closed;
 pub use cover::Order;
 pub use creases::SHARP_DEGREES;
 pub use placement::VoronoiPlacement;
+pub use spacing::VoronoiSpacing;
 
 /// The disc radius.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -58,6 +62,9 @@ pub struct VoronoiOptions {
     /// Where the output's vertices go: at the sites (the seed), or where
     /// their cells' quadrics put them (`placement`).
     pub placement: VoronoiPlacement,
+    /// One cover radius everywhere (the seed), or smaller where the
+    /// surface bends (`spacing`).
+    pub spacing: VoronoiSpacing,
 }
 
 impl Default for VoronoiOptions {
@@ -69,6 +76,7 @@ impl Default for VoronoiOptions {
             max_rounds: 500,
             sharp_degrees: Some(SHARP_DEGREES),
             placement: VoronoiPlacement::Sites,
+            spacing: VoronoiSpacing::Adaptive,
         }
     }
 }
@@ -128,18 +136,88 @@ pub fn simplify_voronoi(mesh: &IndexedMesh, options: &VoronoiOptions) -> Result<
     }
     let curvature =
         (options.order == Order::Curvature).then(|| curvature::gaussian_curvature(&closed.surface));
-    let run =
-        |fraction: f64| Diagram::simplify(&closed, mesh, curvature.as_deref(), options, fraction);
-    match options.radius {
-        Radius::Fraction(f) if f.is_finite() && f > 0.0 && f <= 10.0 => run(f),
-        Radius::Fraction(f) => Err(Error::Parameter(format!(
-            "radius must be a fraction of the diagonal within (0, 10], got {f}"
-        ))),
-        Radius::TargetVertices(0) => Err(Error::Parameter(
-            "target vertices must be at least 1".into(),
-        )),
-        Radius::TargetVertices(n) => search::nearest(&closed.surface, n, run),
+    // The scale the adaptive density is measured at: r, or the search's
+    // first estimate of it.
+    let scale = match options.radius {
+        Radius::Fraction(f) if f.is_finite() && f > 0.0 && f <= 10.0 => f,
+        Radius::Fraction(f) => {
+            return Err(Error::Parameter(format!(
+                "radius must be a fraction of the diagonal within (0, 10], got {f}"
+            )))
+        }
+        Radius::TargetVertices(0) => {
+            return Err(Error::Parameter(
+                "target vertices must be at least 1".into(),
+            ))
+        }
+        Radius::TargetVertices(n) => search::first_fraction(&closed.surface, n),
+    } * closed.surface.diagonal();
+    let factors = (options.spacing == VoronoiSpacing::Adaptive)
+        .then(|| spacing::radius_factors(&closed.surface, closed.first_cone, scale));
+    let context = Context {
+        closed: &closed,
+        curvature: curvature.as_deref(),
+        factors: factors.as_deref(),
+    };
+    let surface = &closed.surface;
+    let run = |context: &Context, start: f64, step: f64| {
+        let run = |fraction: f64| Diagram::simplify(context, mesh, options, fraction);
+        match options.radius {
+            Radius::Fraction(f) => run(f),
+            Radius::TargetVertices(n) => search::nearest(n, start, step, run),
+        }
+    };
+    let start = scale / surface.diagonal();
+    let mut out = run(&context, start, 2.0)?;
+    let Some(factors) = &factors else {
+        return Ok(out);
+    };
+    // Where the first pass left its error, the sites move closer (`spacing`);
+    // each pass is kept only if its worst input vertex lies closer.
+    let points: Vec<DVec3> = (0..closed.first_cone)
+        .map(|v| surface.position(v))
+        .collect();
+    let worst = |out: &VoronoiSimplified| {
+        let d = distances_to_surface(&points, &out.mesh);
+        let max = d.iter().copied().fold(0.0, f64::max);
+        (d, max)
+    };
+    let (mut error, mut max) = worst(&out);
+    let mut factors = factors.clone();
+    for _ in 0..spacing::ERROR_PASSES {
+        if max <= 1e-6 * surface.diagonal() {
+            break; // exact but for rounding: nothing to move sites for
+        }
+        let refined = spacing::refined_factors(surface, closed.first_cone, scale, &factors, &error);
+        let context = Context {
+            factors: Some(&refined),
+            ..context
+        };
+        // The density is normalised, so the last radius is nearly right.
+        let next = run(&context, out.radius_fraction, 1.05)?;
+        let attempts = out.attempts + next.attempts;
+        let (next_error, next_max) = worst(&next);
+        if next_max >= max {
+            out.attempts = attempts;
+            break;
+        }
+        (out, error, max, factors) = (
+            VoronoiSimplified { attempts, ..next },
+            next_error,
+            next_max,
+            refined,
+        );
     }
+    Ok(out)
+}
+
+/// What every radius tried shares.
+#[derive(Clone, Copy)]
+struct Context<'a> {
+    closed: &'a Closed,
+    curvature: Option<&'a [f64]>,
+    /// Each vertex's cover radius over r (`spacing`); `None`: uniform.
+    factors: Option<&'a [f64]>,
 }
 
 /// The diagram as it is refined: the sites (cones first), their radii and
@@ -148,6 +226,7 @@ struct Diagram<'a> {
     closed: &'a Closed,
     options: &'a VoronoiOptions,
     curvature: Option<&'a [f64]>,
+    factors: Option<&'a [f64]>,
     /// Each vertex's `creases` rank: the cover takes lower ranks first.
     ranks: Vec<u8>,
     site_vertex: Vec<u32>,
@@ -158,19 +237,20 @@ struct Diagram<'a> {
 
 impl<'a> Diagram<'a> {
     fn simplify(
-        closed: &'a Closed,
+        context: &Context<'a>,
         mesh: &IndexedMesh,
-        curvature: Option<&'a [f64]>,
         options: &'a VoronoiOptions,
         fraction: f64,
     ) -> Result<VoronoiSimplified> {
+        let closed = context.closed;
         let surface = &closed.surface;
         let r = fraction * surface.diagonal();
         let mut stages = Stages::default();
         let mut diagram = Diagram {
             closed,
             options,
-            curvature,
+            curvature: context.curvature,
+            factors: context.factors,
             ranks: match options.sharp_degrees {
                 // A crease shorter than a disc's diameter is left to the cover.
                 Some(degrees) => {
@@ -292,7 +372,13 @@ impl<'a> Diagram<'a> {
                     .collect();
                 if !pass.is_empty() {
                     let label = first + centres.len() as u32;
-                    let found = cover::farthest_points(&mut self.front, &pass, r / 2.0, label);
+                    let found = cover::farthest_points(
+                        &mut self.front,
+                        &pass,
+                        r / 2.0,
+                        self.factors,
+                        label,
+                    );
                     centres.extend(found);
                 }
             }
@@ -301,18 +387,26 @@ impl<'a> Diagram<'a> {
                 &mut self.front,
                 &candidates,
                 r,
+                self.factors,
                 label,
             ));
             centres
         } else {
             let mut near = vec![false; self.closed.surface.vertex_count()];
-            let mut centres = cover::greedy_discs(&mut self.scratch, &creases, r / 2.0, &mut near);
+            let mut centres = cover::greedy_discs(
+                &mut self.scratch,
+                &creases,
+                r / 2.0,
+                self.factors,
+                &mut near,
+            );
             let mut covered = vec![false; self.closed.surface.vertex_count()];
-            cover::mark_discs(&mut self.scratch, &centres, r, &mut covered);
+            cover::mark_discs(&mut self.scratch, &centres, r, self.factors, &mut covered);
             centres.extend(cover::greedy_discs(
                 &mut self.scratch,
                 &candidates,
                 r,
+                self.factors,
                 &mut covered,
             ));
             for (i, &c) in centres.iter().enumerate() {
@@ -320,8 +414,9 @@ impl<'a> Diagram<'a> {
             }
             centres
         };
-        // A crease site's cell splits as the others do, from r.
-        self.radius.extend(std::iter::repeat_n(r, centres.len()));
+        // A crease site's cell splits as the others do, from its r.
+        let factor = |v: u32| self.factors.map_or(1.0, |f| f[v as usize]);
+        self.radius.extend(centres.iter().map(|&c| r * factor(c)));
         self.site_vertex.extend(centres);
     }
 
@@ -371,7 +466,7 @@ impl<'a> Diagram<'a> {
                 );
             }
             self.order(&mut orphans);
-            for c in cover::greedy_discs(&mut self.scratch, &orphans, r, &mut covered) {
+            for c in cover::greedy_discs(&mut self.scratch, &orphans, r, None, &mut covered) {
                 self.front.seed(c, self.site_vertex.len() as u32, 0.0);
                 self.site_vertex.push(c);
                 self.radius.push(r);

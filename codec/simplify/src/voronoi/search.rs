@@ -15,12 +15,12 @@ const ATTEMPTS: usize = 14;
 const AREA_PER_SITE: f64 = 1.5;
 
 pub(super) fn nearest(
-    surface: &Surface,
     target: usize,
+    start: f64,
+    step: f64,
     run: impl Fn(f64) -> Result<VoronoiSimplified>,
 ) -> Result<VoronoiSimplified> {
-    let diagonal = surface.diagonal();
-    let mut fraction = (area(surface) / (AREA_PER_SITE * target as f64)).sqrt() / diagonal;
+    let mut fraction = start;
     let (mut small, mut large) = (None::<f64>, None::<f64>); // r giving too many / too few
     let mut best: Option<VoronoiSimplified> = None;
     for attempt in 1..=ATTEMPTS {
@@ -51,10 +51,15 @@ pub(super) fn nearest(
         }
         fraction = match (small, large) {
             (Some(s), Some(l)) => (s * l).sqrt(),
-            (Some(s), None) => s * 2.0,
-            (None, Some(l)) => l / 2.0,
+            (Some(s), None) => s * step,
+            (None, Some(l)) => l / step,
             (None, None) => fraction, // not reached: one side was just set
         };
     }
     best.ok_or_else(|| vitrine_codec::Error::Parameter("no radius was tried".into()))
+}
+
+/// The first radius tried for `target` vertices, over the diagonal.
+pub(super) fn first_fraction(surface: &Surface, target: usize) -> f64 {
+    (area(surface) / (AREA_PER_SITE * target as f64)).sqrt() / surface.diagonal()
 }
