@@ -27,7 +27,7 @@ use std::time::Instant;
 
 use vitrine_mesh::import::{import_path, import_path_textured, ImportOptions};
 use vitrine_points::stream::{decode, encode, EncodeOptions, Limits};
-use vitrine_points::testing::{next, sphere, unit};
+use vitrine_points::testing::{sample_triangles_where, sphere};
 use vitrine_points::{estimate_normals, PointCloud, DEFAULT_K};
 
 /// `n` points uniformly on the triangles (area-weighted), seeded (the
@@ -38,37 +38,9 @@ fn sample(
     n: usize,
     seed: u64,
 ) -> Vec<([f32; 3], usize, f64, f64)> {
-    let corner = |t: &[u32; 3], i: usize| positions[t[i] as usize].map(f64::from);
-    let mut cumulative = Vec::with_capacity(triangles.len());
-    let mut total = 0.0f64;
-    for t in triangles {
-        let (a, b, c) = (corner(t, 0), corner(t, 1), corner(t, 2));
-        let u = [0, 1, 2].map(|k| b[k] - a[k]);
-        let v = [0, 1, 2].map(|k| c[k] - a[k]);
-        let x = [
-            u[1] * v[2] - u[2] * v[1],
-            u[2] * v[0] - u[0] * v[2],
-            u[0] * v[1] - u[1] * v[0],
-        ];
-        total += 0.5 * (x[0] * x[0] + x[1] * x[1] + x[2] * x[2]).sqrt();
-        cumulative.push(total);
-    }
-    let mut s = seed;
-    (0..n)
-        .map(|_| {
-            let r = (next(&mut s) >> 11) as f64 / (1u64 << 53) as f64 * total;
-            let ti = cumulative
-                .partition_point(|&c| c < r)
-                .min(triangles.len() - 1);
-            let t = &triangles[ti];
-            let (mut e1, mut e2) = (f64::from(unit(&mut s)), f64::from(unit(&mut s)));
-            if e1 + e2 > 1.0 {
-                (e1, e2) = (1.0 - e1, 1.0 - e2);
-            }
-            let (a, b, c) = (corner(t, 0), corner(t, 1), corner(t, 2));
-            let p = [0, 1, 2].map(|k| (a[k] + e1 * (b[k] - a[k]) + e2 * (c[k] - a[k])) as f32);
-            (p, ti, e1, e2)
-        })
+    sample_triangles_where(positions, triangles, n, seed)
+        .into_iter()
+        .map(|s| (s.point, s.triangle, s.barycentric[0], s.barycentric[1]))
         .collect()
 }
 

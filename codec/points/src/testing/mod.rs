@@ -191,6 +191,29 @@ pub fn sample_triangles(
     n: usize,
     seed: u64,
 ) -> Vec<[f32; 3]> {
+    sample_triangles_where(positions, triangles, n, seed)
+        .into_iter()
+        .map(|s| s.point)
+        .collect()
+}
+
+/// A point of [`sample_triangles_where`]: where it lies, on which triangle,
+/// at which barycentrics (of the triangle's second and third corners).
+#[derive(Clone, Copy, Debug)]
+pub struct TrianglePoint {
+    pub point: [f32; 3],
+    pub triangle: usize,
+    pub barycentric: [f64; 2],
+}
+
+/// [`sample_triangles`] with each point's triangle and barycentrics (to
+/// sample a texture or per-corner attributes there).
+pub fn sample_triangles_where(
+    positions: &[[f32; 3]],
+    triangles: &[[u32; 3]],
+    n: usize,
+    seed: u64,
+) -> Vec<TrianglePoint> {
     let corner = |t: &[u32; 3], i: usize| positions[t[i] as usize].map(f64::from);
     let mut cumulative = Vec::with_capacity(triangles.len());
     let mut total = 0.0f64;
@@ -210,15 +233,21 @@ pub fn sample_triangles(
     (0..n)
         .map(|_| {
             let r = (next(&mut s) >> 11) as f64 / (1u64 << 53) as f64 * total;
-            let t = &triangles[cumulative
+            let triangle = cumulative
                 .partition_point(|&c| c < r)
-                .min(triangles.len() - 1)];
+                .min(triangles.len() - 1);
+            let t = &triangles[triangle];
             let (mut e1, mut e2) = (f64::from(unit(&mut s)), f64::from(unit(&mut s)));
             if e1 + e2 > 1.0 {
                 (e1, e2) = (1.0 - e1, 1.0 - e2);
             }
             let (a, b, c) = (corner(t, 0), corner(t, 1), corner(t, 2));
-            [0, 1, 2].map(|k| (a[k] + e1 * (b[k] - a[k]) + e2 * (c[k] - a[k])) as f32)
+            let point = [0, 1, 2].map(|k| (a[k] + e1 * (b[k] - a[k]) + e2 * (c[k] - a[k])) as f32);
+            TrianglePoint {
+                point,
+                triangle,
+                barycentric: [e1, e2],
+            }
         })
         .collect()
 }
