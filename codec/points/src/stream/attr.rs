@@ -1,5 +1,25 @@
-//! Octahedral normal quantization and the residual predictions of normals
-//! and colours.
+//! A point's coded attributes, octahedral normal quantization and the
+//! residual predictions of normals and colours.
+
+/// A point's coded attributes (only the ones the stream has are used).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub(crate) struct Attr {
+    pub normal: [u16; 2],
+    pub colour: [u8; 3],
+}
+
+/// What the root's representative is predicted from.
+pub(crate) fn root_prediction(normal_bits: u8) -> Attr {
+    let mid = if normal_bits == 0 {
+        0
+    } else {
+        1u16 << (normal_bits - 1)
+    };
+    Attr {
+        normal: [mid, mid],
+        colour: [128; 3],
+    }
+}
 
 /// A unit normal to octahedral coordinates of `bits` bits each (Meyer et
 /// al. 2010): the octahedron |x| + |y| + |z| = 1, its lower half folded

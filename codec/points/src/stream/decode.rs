@@ -4,8 +4,9 @@ use vitrine_codec::entropy::RangeDecoder;
 use vitrine_codec::{Error, Result};
 
 use super::attr::octahedral_decode;
+use super::attr::{root_prediction, Attr};
 use super::format::{read_chunk, PointHeader};
-use super::models::{root_prediction, Attr, Models};
+use super::models::Models;
 use super::neighbourhood::Neighbourhood;
 use super::predict::{child_centre, parent_centre, Neighbours, AHEAD, BEHIND};
 use crate::PointCloud;

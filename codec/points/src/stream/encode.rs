@@ -4,9 +4,10 @@ use vitrine_codec::entropy::RangeEncoder;
 use vitrine_codec::{Error, Result};
 
 use super::attr::octahedral_encode;
+use super::attr::{root_prediction, Attr};
 use super::context::morton;
 use super::format::{PointHeader, MAX_BITS, VERSION, VERSIONS};
-use super::models::{root_prediction, Attr, Models};
+use super::models::Models;
 use super::neighbourhood::Neighbourhood;
 use super::predict::{child_centre, parent_centre, Neighbours, AHEAD, BEHIND};
 use crate::PointCloud;

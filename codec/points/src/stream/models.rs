@@ -3,33 +3,13 @@
 
 use vitrine_codec::entropy::{BitModel, IntModel, RangeDecoder, RangeEncoder};
 
-use super::attr::{colour_apply, colour_residual};
+use super::attr::{colour_apply, colour_residual, Attr};
 use super::context::{Around, CODED, CONTEXTS};
 use super::occupancy::MaskCoder;
 use super::predict::{Prediction, CLASSES};
 
 /// Occupancy contexts: the parent's child count (1..=8) minus one.
 const PARENT_CLASSES: usize = 8;
-
-/// A point's coded attributes (only the ones the stream has are used).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub(crate) struct Attr {
-    pub normal: [u16; 2],
-    pub colour: [u8; 3],
-}
-
-/// What the root's representative is predicted from.
-pub(crate) fn root_prediction(normal_bits: u8) -> Attr {
-    let mid = if normal_bits == 0 {
-        0
-    } else {
-        1u16 << (normal_bits - 1)
-    };
-    Attr {
-        normal: [mid, mid],
-        colour: [128; 3],
-    }
-}
 
 pub(crate) struct Models {
     /// `PARENT_CLASSES` trees of 256 nodes: the mask's bits, lowest child

@@ -21,7 +21,7 @@
 //! Everything is in integers: the encoder and every decoder (native,
 //! WebAssembly) predict the same values.
 
-use super::models::Attr;
+use super::attr::Attr;
 
 /// Cells at the child depth coded just before the new point (its earlier
 /// siblings, the parent's representative's cell, the children of the
