@@ -44,6 +44,7 @@ console.log('|---|---|---|---|---:|');
 for (const stem of positionals) {
   const old = new Uint8Array(readFileSync(`${stem}-old.vpts`));
   const neu = new Uint8Array(readFileSync(`${stem}-new.vpts`));
+  /** @type {number[][]} */
   const times = [[], []];
   let n = 0;
   for (let r = 0; r < runs; r++) {
