@@ -3,8 +3,7 @@
 use vitrine_codec::entropy::RangeDecoder;
 use vitrine_codec::{Error, Result};
 
-use super::attr::octahedral_decode;
-use super::attr::{root_prediction, Attr};
+use super::attr::{octahedral_decode, root_prediction, Attr};
 use super::format::{read_chunk, PointHeader};
 use super::models::Models;
 use super::neighbourhood::Neighbourhood;

@@ -3,8 +3,7 @@
 use vitrine_codec::entropy::RangeEncoder;
 use vitrine_codec::{Error, Result};
 
-use super::attr::octahedral_encode;
-use super::attr::{root_prediction, Attr};
+use super::attr::{octahedral_encode, root_prediction, Attr};
 use super::context::morton;
 use super::format::{PointHeader, MAX_BITS, VERSION, VERSIONS};
 use super::models::Models;
